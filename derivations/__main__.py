@@ -1,0 +1,28 @@
+"""``python -m derivations [--check] [--print]``: regenerate (or check) the kernels."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m derivations", description=__doc__)
+    ap.add_argument("--check", action="store_true", help="regenerate into a temp dir; exit 1 on any difference")
+    ap.add_argument("--print", action="store_true", help="print the derivation summary (first integral, B1, laws)")
+    args = ap.parse_args(argv)
+    from . import codegen
+
+    if args.print:
+        from . import model
+
+        model.main()
+    if args.check:
+        return codegen.check()
+    path = codegen.write()
+    print(f"wrote {path}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,261 @@
+"""Full BVP (ipmc_asym.bvp) against independent computations written here.
+
+* linear model: exact solution ``C = 1 + (B1 - 1) sinh(z/z0)/sinh(1/z0)``;
+* constant / affine: first integral + layer quadratures (core neutral, exponentially
+  small error), with scipy.integrate.quad at tight tolerances.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy.integrate import quad
+
+from ipmc_asym import bvp
+from ipmc_asym.bvp import BVPResult, moment_integral_bvp, solve
+from ipmc_asym.params import NAFION_LI, Strip
+from ipmc_asym.permittivity import get_model
+
+NOMINAL = Strip(thickness=200e-6, voltage=1.0)
+QKW = dict(epsabs=1e-15, epsrel=1e-13, limit=400)
+
+
+def groups(model, strip=NOMINAL):
+    return get_model(model).groups(strip, NAFION_LI)
+
+
+# ---------------------------------------------------------------------------------------
+# independent references
+# ---------------------------------------------------------------------------------------
+def I_linear_exact(g):
+    """Exact ``I`` of the linear model (A1 = 0): the ODE is linear, C'' = (C - 1)/z0^2."""
+    A0, A2, A3 = g.A0, g.A2, g.A3
+    z0 = math.sqrt(A0 / A2)
+    t = math.tanh(0.5 * A2)  # B1 - 1 with B1 = 2/(1 + e^{-A2})
+    cw = 2.0 * math.exp(-A2) / (1.0 + math.exp(-A2))  # C(-1) = B1 e^{-A2}, no cancellation
+    den = -math.expm1(-2.0 / z0)
+
+    def ratio(x):  # sinh(x/z0)/sinh(1/z0) for 0 <= x <= 1, no overflow
+        return math.exp(-(1.0 - x) / z0) * (-math.expm1(-2.0 * x / z0)) / den
+
+    def one_minus_ratio(x):  # 1 - ratio(1 - d), d = 1 - x, cancellation-free
+        d = 1.0 - x
+        return (-math.expm1(-d / z0) + math.exp(-(2.0 - d) / z0) - math.exp(-2.0 / z0)) / den
+
+    # int (C - 1) z dz = 2 (B1 - 1)(z0 coth(1/z0) - z0^2)
+    coth = (1.0 + math.exp(-2.0 / z0)) / den
+    part1 = 2.0 * t * (z0 * coth - z0 * z0)
+
+    # int z ln C dz: cathode half z = x, anode half z = -(1 - d) with C = cw + t (1 - ratio)
+    def f_cat(x):
+        return x * math.log1p(t * ratio(x))
+
+    def f_an(d):
+        x = 1.0 - d
+        return -x * math.log(cw + t * one_minus_ratio(x))
+
+    brk = [z0 * k for k in (0.01, 0.1, 0.5, 1, 2, 5, 10, 20, 40)]
+    brk = [b for b in brk if b < 1.0]
+    Jc = sum(quad(f_cat, 1 - b2, 1 - b1, **QKW)[0]
+             for b1, b2 in zip([0.0] + brk, brk + [1.0]))
+    # anode: d from 0; the log has its knee at d ~ cw z0 / t (~1e-19): split there too
+    dk = cw * z0 / t
+    abrk = [dk * 10.0 ** k for k in range(-2, 40) if dk * 10.0 ** k < 0.01 * z0] + brk
+    Ja = sum(quad(f_an, b1, b2, **QKW)[0] for b1, b2 in zip([0.0] + abrk, abrk + [1.0]))
+    return part1 / A2 + A3 / A2 * (Jc + Ja)
+
+
+def _em1my(y):
+    """``e^y - 1 - y`` without cancellation."""
+    if abs(y) < 1e-3:
+        return y * y * (0.5 + y * (1 / 6 + y * (1 / 24 + y * (1 / 120 + y / 720))))
+    return math.expm1(y) - y
+
+
+def I_layer_quadrature(g):
+    """``I`` from the first integral, exact electroneutrality and per-layer quadratures."""
+    A0, A1, A2, A3 = g.A0, g.A1, g.A2, g.A3
+    em = -math.expm1(-A2)
+    a = 0.5 * A0 * (-math.expm1(-2 * A2))
+    bq = (A1 - A0) * em
+    c = -A1 * A2
+    B1 = (-bq + math.sqrt(bq * bq - 4 * a * c)) / (2 * a) if a > 0 else -c / bq
+    yc, ya = math.log(B1), math.log(B1) - A2
+
+    def H(y):
+        cm1 = math.expm1(y)
+        return 0.5 * A0 * cm1 * cm1 + A1 * _em1my(y)
+
+    def w(y):  # |dz/dy| in a layer
+        return (A0 * math.exp(y) + A1) / math.sqrt(2 * A2 * H(y))
+
+    def yw(y):
+        return y * w(y) if y != 0.0 else math.copysign(math.sqrt((A0 + A1) / A2), 1.0)
+
+    D1 = math.sqrt(2 * H(yc) / A2)
+    int_rho_z = 2 * D1 - A1 - A0 * B1 * em / A2
+
+    # cathode, z = 1 - u: int y z dz = M0 - M1;  M1 = int_0^yc w(y') m(y') dy',
+    # m(y') = int_0^y' y w dy  (u(y) = int_y^yc w)
+    M0 = quad(yw, 0.0, yc, **QKW)[0]
+    M1 = quad(lambda yp: w(yp) * quad(yw, 0.0, yp, **QKW)[0], 0.0, yc, **QKW)[0]
+    # anode, z = -1 + v: int y z dz = -M0a + M1a;  M1a = int_ya^0 w(y') int_y'^0 y w dy dy'
+    M0a = quad(yw, ya, 0.0, **QKW)[0]
+    pts = [p for p in (-30.0, -10.0, -3.0, -1.0) if p > ya]
+    M1a = quad(lambda yp: w(yp) * quad(yw, yp, 0.0, **QKW)[0], ya, 0.0, points=pts, **QKW)[0]
+    Jy = M0 - M1 - M0a + M1a
+    return int_rho_z / A2 + A3 / A2 * Jy, B1
+
+
+@pytest.fixture(scope="module")
+def nominal():
+    return {m: solve(NOMINAL, m) for m in ("constant", "linear", "affine")}
+
+
+# ---------------------------------------------------------------------------------------
+# accuracy at the nominal point
+# ---------------------------------------------------------------------------------------
+def test_linear_against_exact_solution(nominal):
+    r = nominal["linear"]
+    assert r.success and r.status == 0
+    ref = I_linear_exact(r.groups)
+    assert abs(r.I - ref) <= 1e-8 * abs(ref), (r.I, ref)
+    assert r.B1 == pytest.approx(2.0 / (1.0 + math.exp(-r.groups.A2)), rel=1e-12)
+
+
+@pytest.mark.parametrize("model", ["constant", "affine"])
+def test_layer_quadrature_reference(nominal, model):
+    r = nominal[model]
+    assert r.success and r.status == 0
+    ref, B1 = I_layer_quadrature(r.groups)
+    assert abs(r.I - ref) <= 1e-8 * abs(ref), (r.I, ref)
+    assert r.B1 == pytest.approx(B1, rel=1e-10)
+
+
+def test_profiles_consistent(nominal):
+    for r in nominal.values():
+        g = r.groups
+        assert r.z[0] == -1.0 and r.z[-1] == 1.0 and np.all(np.diff(r.z) > 0)
+        assert r.phi[0] == pytest.approx(1.0, abs=1e-12)
+        assert r.phi[-1] == pytest.approx(0.0, abs=1e-12)
+        assert r.D[0] == pytest.approx(r.D[-1], abs=1e-12)
+        np.testing.assert_allclose(r.C, r.B1 * np.exp(-g.A2 * r.phi), rtol=1e-9, atol=1e-300)
+        np.testing.assert_allclose(r.p, r.C / g.A2 - g.A3 * r.phi)
+        # electroneutrality, by the trapezoid rule on the (fine) mesh
+        assert abs(np.trapezoid(r.rhoZ, r.z)) < 1e-5
+        # D' = C - 1
+        np.testing.assert_allclose(np.gradient(r.D, r.z)[2:-2], r.rhoZ[2:-2], atol=2e-2 * r.B1)
+        assert r.n_nodes == r.z.size and r.max_rms_residual <= 1.01e-10
+        assert r.bc_residual < 1e-10
+
+
+def test_self_convergence():
+    for model in ("constant", "linear", "affine"):
+        a = solve(NOMINAL, model, tol=1e-10)
+        b = solve(NOMINAL, model, tol=2.5e-11)
+        assert b.success
+        assert abs(a.I - b.I) < 1e-9 * abs(b.I), (model, a.I, b.I)
+
+
+def test_speed(nominal):
+    assert sum(r.seconds for r in nominal.values()) < 10.0
+    for r in nominal.values():
+        assert r.seconds < 5.0
+
+
+# ---------------------------------------------------------------------------------------
+# range, symmetry, API
+# ---------------------------------------------------------------------------------------
+CORNERS = [(10e-6, 1e-3), (10e-6, 10.0), (4e-3, 1e-3), (4e-3, 10.0), (200e-6, 0.1)]
+
+
+@pytest.mark.parametrize("model", ["constant", "affine", "linear"])
+@pytest.mark.parametrize("thickness,voltage", CORNERS)
+def test_corners_converge(model, thickness, voltage):
+    """Corners and geometric centre of 10 um - 4 mm x 1 mV - 10 V, checked against the
+    independent references (the layer quadrature neglects the layers' overlap, ~exp(-2/lam))."""
+    r = solve(Strip(thickness=thickness, voltage=voltage), model)
+    assert r.success and r.status == 0, r.message
+    assert np.isfinite(r.I) and r.I > 0
+    assert r.max_rms_residual <= 1.01e-10 and r.bc_residual < 1e-10
+    if model == "linear":
+        ref, rtol = I_linear_exact(r.groups), 1e-8
+    else:
+        ref = I_layer_quadrature(r.groups)[0]
+        rtol = 1e-8 + 10.0 * math.exp(-2.0 / r.groups.debye)
+    assert abs(r.I - ref) <= rtol * abs(ref), (r.I, ref)
+
+
+def test_mirror_symmetry():
+    for model in ("constant", "linear"):
+        rp = solve(NOMINAL, model)
+        rm = solve(NOMINAL.with_(voltage=-1.0), model)
+        assert rm.success
+        assert rm.I == pytest.approx(-rp.I, rel=1e-13)
+        np.testing.assert_array_equal(rm.z, -rp.z[::-1])
+        np.testing.assert_allclose(rm.C, rp.C[::-1])
+        np.testing.assert_allclose(rm.D, -rp.D[::-1])
+        np.testing.assert_allclose(rm.phi, rp.phi[::-1] - 1.0)
+        assert rm.phi[0] == pytest.approx(-1.0) and rm.phi[-1] == pytest.approx(0.0, abs=1e-12)
+        assert moment_integral_bvp(200e-6, -1.0, model) == pytest.approx(-rp.I, rel=1e-13)
+
+
+def test_zero_voltage():
+    r = solve(NOMINAL.with_(voltage=0.0), "affine")
+    assert r.success and r.I == 0.0 and "zero voltage" in r.message
+    assert np.all(r.C == 1.0) and np.all(r.E == 0.0)
+    assert moment_integral_bvp(200e-6, 0.0) == 0.0
+
+
+def test_helper_and_errors(monkeypatch, nominal):
+    assert moment_integral_bvp(200e-6, 1.0, "constant") == pytest.approx(
+        nominal["constant"].I, rel=1e-13)
+    for bad in ((0.0, 1.0), (-1e-4, 1.0), (float("nan"), 1.0), (2e-4, float("inf")),
+                ("x", 1.0)):
+        with pytest.raises(ValueError):
+            moment_integral_bvp(*bad)
+    with pytest.raises(ValueError):
+        moment_integral_bvp(2e-4, 1.0, "quadratic")
+
+    def failed(*a, **k):
+        r = nominal["constant"]
+        return BVPResult(**{**r.__dict__, "success": False, "status": 1,
+                            "message": "The maximum number of mesh nodes is exceeded."})
+
+    monkeypatch.setattr(bvp, "solve", failed)
+    with pytest.raises(RuntimeError, match="did not converge.*maximum number"):
+        moment_integral_bvp(200e-6, 1.0)
+
+
+def test_continuation_path_agrees(nominal):
+    res, prob, g = bvp._continuation(NOMINAL, get_model("constant"), NAFION_LI, 1e-10, 300000)
+    assert res.status == 0
+    assert float(res.y[2, -1]) == pytest.approx(nominal["constant"].I, rel=1e-9)
+
+
+def test_custom_eps_matches_affine(nominal):
+    r = solve(NOMINAL, lambda C: 5e-6 + 1e-3 * C / NAFION_LI.C_moy)
+    assert r.success, r.message
+    assert r.I == pytest.approx(nominal["affine"].I, rel=1e-8)
+    with pytest.raises(ValueError, match="> 0"):
+        solve(NOMINAL, lambda C: 5e-6 - 1e-3 * C / NAFION_LI.C_moy)
+    with pytest.raises(ValueError, match="too small at the anode"):
+        solve(NOMINAL, lambda C: 1e-3 * C / NAFION_LI.C_moy)  # eps(0) = 0: use "linear"
+
+
+def test_extreme_voltage_no_fp_errors():
+    """Above ~18 V, exp(-A2) underflows: still finite, odd, converged (seterr=raise)."""
+    for model in ("linear", "constant"):
+        r = solve(NOMINAL.with_(voltage=-20.0), model)
+        assert r.success and np.isfinite(r.I) and r.I < 0
+        assert np.all(np.isfinite(r.E)) and np.all(np.isfinite(r.y))
+
+
+def test_b1_guess_limits():
+    A2 = 38.7
+    assert bvp.b1_guess(0.0, 1e-6, A2) == pytest.approx(A2 / -math.expm1(-A2), rel=1e-14)
+    assert bvp.b1_guess(1e-3, 0.0, A2) == pytest.approx(2 / (1 + math.exp(-A2)), rel=1e-14)
+    B = bvp.b1_guess(8.8e-4, 4.4e-6, A2)
+    assert 8.8e-4 / 2 * B * B + (4.4e-6 - 8.8e-4) * B - 4.4e-6 * A2 == pytest.approx(0, abs=1e-15)
