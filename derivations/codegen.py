@@ -98,15 +98,33 @@ fails on any difference.
 
 import math
 
+import numpy as np
+
 from .._jit import jit
 from .special import e2rel, exprel, li2, li3  # noqa: F401
 {consts}'''
 
 
-def render_module(kernels, constants: dict) -> str:
+def _table(name, rows) -> str:
+    out = [f"{name} = np.array(["]
+    for row in rows:
+        vals = ", ".join(repr(float(v)) for v in row)
+        out.append(f"    [{vals}],")
+    out.append("])")
+    return "\n".join(out)
+
+
+def render_module(kernels, constants: dict, tables: dict | None = None) -> str:
     consts = ""
     if constants:
         consts = "\n" + "\n".join(f"{k} = {float(v)!r}" for k, v in sorted(constants.items())) + "\n"
+    if tables:
+        consts += "\n# Taylor patches about Y = 2k, k = K_MIN..K_MAX: rows = patches, columns = powers of (Y - 2k)\n"
+        consts += f"K_MIN = {tables['_kmin']}\nK_MAX = {tables['_kmax']}\n"
+        for name in sorted(k for k in tables if not k.startswith("_")):
+            w0, w1 = tables[name]
+            consts += "\n" + _table(f"PATCH_W0_{name.upper()}", w0) + "\n"
+            consts += _table(f"PATCH_W1_{name.upper()}", w1) + "\n"
     body = HEADER.format(ver=sp.__version__, consts=consts)
     for k in sorted(kernels, key=lambda k: k.name):
         body += render_kernel(k) + "\n"
@@ -116,8 +134,8 @@ def render_module(kernels, constants: dict) -> str:
 def build_source() -> str:
     from . import kernels_spec
 
-    kernels, constants = kernels_spec.all_kernels()
-    return render_module(kernels, constants)
+    kernels, constants, tables = kernels_spec.all_kernels()
+    return render_module(kernels, constants, tables)
 
 
 def write(target: Path = TARGET) -> Path:

@@ -59,12 +59,8 @@ def base_kernels():
 
 def all_kernels():
     kernels = list(base_kernels())
-    constants = {}
-    try:
-        from . import closed_forms
-    except ImportError:  # during bootstrap
-        return kernels, constants
-    ck, cc = closed_forms.kernels()
+    from . import closed_forms
+
+    ck, constants, tables = closed_forms.kernels()
     kernels.extend(ck)
-    constants.update(cc)
-    return kernels, constants
+    return kernels, constants, tables

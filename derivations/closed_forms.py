@@ -1,0 +1,276 @@
+"""Closed forms of the layer functions W0(Y), W1(Y) for the three permittivity models.
+
+``W0(Y) = int_0^Y w dy`` and ``W1(Y) = int_0^Y (w/y) W0 dy`` (see ``model.py``) carry all
+the voltage dependence of ``I = lambda J1 + lambda^2 J2``.  ``w(y)`` is analytic on the real
+axis; its nearest complex singularities (zeros of ``Qhat``) are at ``2.09 +- 7.46i``
+(constant), ``-0.17 +- 6.07i`` (affine) and ``+-2 pi i`` (linear).
+
+Three regimes, each an expansion derived here:
+
+* Debye-Hueckel / matched region (``|Y|`` up to ~31): Taylor expansions of ``w`` computed
+  by exact power-series arithmetic (30 significant digits) about centres ``2k``, each used on
+  ``|Y - 2k| <= 1`` (ratio <= 1/6 of the convergence radius, 18 terms: truncation < 1e-14).
+  The patch at 0 is the small-voltage (Debye-Hueckel) expansion.
+* Depletion zone (anode, ``T = -Y > 31``, large ``A2``): ``w(-t) -> rho t / sqrt(a + b t)``
+  with ``a = 1 - 3 rho``, ``b = 2 rho`` up to ``O(t e^{-t})``; integrated in closed form
+  (SymPy), plus the constants ``K0 = lim (int_0^T w - Omega(T))`` and ``K1`` (mpmath).
+  For the constant model this is ``-W0 = (sqrt2/3) s^{3/2} + sqrt2 s^{1/2} + K0``,
+  ``s = T - 1``: the depletion zone whose width grows like ``sqrt(phi0)``.
+  For the linear model ``rho = 0``: no depletion zone, ``W0 -> -zeta(2)``, ``W1 -> -zeta(3)``.
+* Accumulation (cathode, ``Y > 9``, only reached by the constant model above ~80 V):
+  ``w ~ y e^{-y/2}/sqrt2``: ``W0 = W0inf - sqrt2 (Y + 2) e^{-Y/2}``,
+  ``W1 = W1inf - sqrt2 W0inf e^{-Y/2}`` (leading terms).
+
+The linear model also has the exact forms ``W0 = -Li2(1 - e^Y)``, ``W1 = -Li3(1 - e^Y)``
+(derived in :func:`linear_exact`), emitted as kernels and used as an independent check.
+"""
+
+from __future__ import annotations
+
+import mpmath as mp
+import sympy as sp
+
+from . import model as M
+from .codegen import Kernel
+
+mp.mp.dps = 24
+
+RHO = {"constant": mp.mpf(1), "linear": mp.mpf(0), "affine": mp.mpf(5) / 1005}
+MODEL_IDS = {"constant": 0, "linear": 1, "affine": 2}
+NTERMS = 18
+PATCH_HALF = 1  # patches centred on even integers, |Y - c| <= 1
+K_MIN = -15  # patches from Y = -31 ...
+K_MAX = 4  # ... to Y = 9
+T_ASYM = 31.0  # beyond: depletion asymptotics (error ~ T e^{-T} < 1e-12)
+Y_ACC = 9.0
+
+
+# ---- exact power-series arithmetic on mpmath numbers ----------------------------------
+def s_mul(a, b):
+    n = len(a)
+    return [mp.fsum(a[i] * b[k - i] for i in range(k + 1)) for k in range(n)]
+
+
+def s_inv(a):
+    n = len(a)
+    out = [mp.mpf(0)] * n
+    out[0] = 1 / a[0]
+    for k in range(1, n):
+        out[k] = -mp.fsum(a[i] * out[k - i] for i in range(1, k + 1)) / a[0]
+    return out
+
+
+def s_invsqrt(a):
+    """(a)^{-1/2} by the recurrence for f^2 a = 1 via g = sqrt(a)."""
+    n = len(a)
+    g = [mp.mpf(0)] * n
+    g[0] = mp.sqrt(a[0])
+    for k in range(1, n):
+        g[k] = (a[k] - mp.fsum(g[i] * g[k - i] for i in range(1, k))) / (2 * g[0])
+    return s_inv(g)
+
+
+def w_series(c, rho, n):
+    """Taylor coefficients of w(c + h) in h (n terms)."""
+    ec = mp.exp(c)
+    ex = [ec / mp.factorial(k) for k in range(n + 2)]  # e^{c+h}
+    if c == 0:
+        exprel = [1 / mp.factorial(k + 1) for k in range(n)]
+        e2rel = [2 / mp.factorial(k + 2) for k in range(n)]
+    else:
+        num1 = list(ex[:n])
+        num1[0] -= 1  # e^{c+h} - 1
+        inv_y = s_inv([mp.mpf(c), mp.mpf(1)] + [mp.mpf(0)] * (n - 2))
+        exprel = s_mul(num1, inv_y)
+        num2 = list(num1)
+        num2[0] -= c
+        num2[1] -= 1  # e^{c+h} - 1 - (c+h)
+        e2rel = [2 * v for v in s_mul(s_mul(num2, inv_y), inv_y)]
+    Q = [(1 - rho) * v for v in s_mul(exprel, exprel)]
+    Q = [Q[k] + rho * e2rel[k] for k in range(n)]
+    eh = [(1 - rho) * ex[k] for k in range(n)]
+    eh[0] += rho
+    return s_mul(eh, s_invsqrt(Q))
+
+
+def w_value(y, rho):
+    y = mp.mpf(y)
+    if abs(y) < mp.mpf("1e-6"):  # series: avoids 0/0 at working precision
+        e1 = 1 + y / 2 + y**2 / 6
+        e2 = 1 + y / 3 + y**2 / 12
+    else:
+        e1 = mp.expm1(y) / y
+        e2 = 2 * (mp.expm1(y) - y) / y**2
+    Q = (1 - rho) * e1**2 + rho * e2
+    return ((1 - rho) * mp.exp(y) + rho) / mp.sqrt(Q)
+
+
+NCONT = 44  # terms used to continue W0, W1 from one centre to the next (ratio <= 1/3)
+
+
+def _patch(c, rho, W0c, W1c, n):
+    """Taylor polynomials (n+1 coefficients) in h = Y - c of W0 and W1 about c."""
+    ws = w_series(c, rho, n + 2)
+    W0 = [W0c] + [ws[k] / (k + 1) for k in range(n + 1)]
+    if c == 0:
+        W0_over_y = [ws[k] / (k + 1) for k in range(n + 1)]
+        integrand = s_mul(ws[: n + 1], W0_over_y)
+    else:
+        inv_y = s_inv([mp.mpf(c), mp.mpf(1)] + [mp.mpf(0)] * (n - 1))
+        integrand = s_mul(s_mul(ws[: n + 1], inv_y), W0[: n + 1])
+    W1 = [W1c] + [integrand[k] / (k + 1) for k in range(n)]
+    return W0[: n + 1], W1[: n + 1]
+
+
+def _peval(coefs, h):
+    return mp.fsum(cf * h**k for k, cf in enumerate(coefs))
+
+
+def march(rho, kmin, kmax):
+    """Patches about c = 2k for k in [kmin, kmax] (kmin <= 0 <= kmax).
+
+    W0 and W1 at each centre are obtained by analytic continuation from the previous centre
+    (``NCONT``-term Taylor series evaluated at h = +-2, well inside the convergence radius),
+    starting from W0(0) = W1(0) = 0: no quadrature involved.
+    """
+    out = {}
+    for direction, klim in ((-1, kmin), (1, kmax)):
+        W0c = W1c = mp.mpf(0)
+        k = 0
+        while True:
+            c = mp.mpf(2 * k)
+            a, b = _patch(c, rho, W0c, W1c, NCONT)
+            out[k] = (a, b)
+            if k == klim:
+                break
+            h = mp.mpf(2 * direction)
+            W0c, W1c = _peval(a, h), _peval(b, h)
+            k += direction
+    return out
+
+
+def patch_coefficients(c, rho, n=NTERMS):
+    """Table rows for the centre c (first n+1 coefficients of the continued patch)."""
+    k = int(c) // 2
+    a, b = march(rho, min(k, 0), max(k, 0))[k]
+    return a[: n + 1], b[: n + 1]
+
+
+# ---- asymptotics (SymPy) ---------------------------------------------------------------
+t, T = sp.symbols("t T", positive=True)
+
+
+def depletion_forms(rho_val):
+    """Omega(T) = int w_inf, and the W1 integrand's primitive, for w_inf = rho t/sqrt(a + b t)."""
+    r = sp.nsimplify(str(rho_val)) if rho_val not in (0, 1) else sp.Integer(int(rho_val))
+    if r == 0:
+        return sp.Integer(0), sp.Integer(0), sp.Integer(0)
+    a, b = 1 - 3 * r, 2 * r
+    t1 = sp.Max(0, -a / b)  # where a + b t = 0 (constant model: t = 1)
+    u, U = sp.symbols("u U", positive=True)  # u = t - t1 >= 0
+    winf = r * (u + t1) / sp.sqrt(a + b * t1 + b * u)
+    Om_U = sp.simplify(sp.integrate(winf, (u, 0, U)))
+    K0 = sp.Symbol("K0")
+    P1_U = sp.simplify(sp.integrate(sp.expand(r / sp.sqrt(a + b * t1 + b * u) * (Om_U.subs(U, u) + K0)), (u, 0, U)))
+    Om = Om_U.subs(U, T - t1)
+    P1 = P1_U.subs(U, T - t1)
+    return Om, P1, t1
+
+
+def depletion_constants(rho_val, Om, P1, t1, patches=None):
+    """K0, K1 with -W0(-T) = Omega(T) + K0, -W1(-T) = P1(T) + K1 up to O(T e^{-T}).
+
+    W0(-60), W1(-60) come from the analytic continuation of the patches (``march``).
+    """
+    rho = mp.mpf(rho_val)
+    kfar = -30
+    pts = patches if patches is not None and kfar in patches else march(rho, kfar, 0)
+    Tb = mp.mpf(60)
+    W0T = -pts[kfar][0][0]
+    W1T = -pts[kfar][1][0]
+    Omf = sp.lambdify(T, Om, "mpmath")
+    K0 = W0T - (Omf(Tb) if Om != 0 else 0)
+    P1f = sp.lambdify((T, sp.Symbol("K0")), P1, "mpmath")
+    K1 = W1T - (P1f(Tb, K0) if P1 != 0 else 0)
+    return K0, K1
+
+
+def accumulation_constants(rho_val):
+    """W0(inf), W1(inf) for the constant model (continued to Y = 80; tail ~ e^{-40})."""
+    pts = march(mp.mpf(rho_val), 0, 40)
+    return pts[40][0][0], pts[40][1][0]
+
+
+def linear_exact():
+    """Linear model (rho = 0): w = y e^y/(e^y - 1), W0 = -Li2(1 - e^Y), W1 = -Li3(1 - e^Y)."""
+    y = M.y
+    w, _ = M.w_layer()
+    w0 = sp.simplify(w.subs(M.rho, 0).subs({M.exprel(y): M.EXPREL_DEF, M.e2rel(y): M.E2REL_DEF}))
+    W0 = -sp.polylog(2, 1 - sp.exp(y))
+    W1 = -sp.polylog(3, 1 - sp.exp(y))
+    # W0' = w and W1' = (w/y) W0, checked at sample points (polylog derivatives do not
+    # simplify symbolically through log(exp(y)))
+    r0 = sp.diff(W0, y) - y * sp.exp(y) / (sp.exp(y) - 1)
+    r1 = sp.diff(W1, y) - (sp.exp(y) / (sp.exp(y) - 1)) * W0
+    r2 = w0 - y * sp.exp(y) / (sp.exp(y) - 1)
+    for yv in (sp.Rational(-7, 2), sp.Rational(-1, 3), sp.Rational(1, 5), sp.Rational(5, 2)):
+        for r in (r0, r1, r2):
+            assert abs(complex(r.subs(y, yv).evalf(30))) < 1e-25, (r, yv)
+    return W0, W1
+
+
+# ---- kernels -------------------------------------------------------------------------
+def _poly_table(name, rows):
+    return name, [[float(v) for v in row] for row in rows]
+
+
+def model_tables(name):
+    rho = RHO[name]
+    pts = march(rho, -30, K_MAX)
+    W0rows = [pts[k][0][: NTERMS + 1] for k in range(K_MIN, K_MAX + 1)]
+    W1rows = [pts[k][1][: NTERMS + 1] for k in range(K_MIN, K_MAX + 1)]
+    return W0rows, W1rows, pts
+
+
+def kernels():
+    """Kernels and module constants for the closed forms."""
+    from sympy.codegen.cfunctions import expm1
+
+    ks, consts = [], {}
+    Y, y = M.Y, M.y
+    # linear exact (polylogs) -- independent check of the patches
+    W0l, W1l = linear_exact()
+    li2, li3 = sp.Function("li2"), sp.Function("li3")
+    arg = -expm1(Y)
+    ks.append(Kernel("w0_linear_exact", (Y,), (-li2(arg),), "W0 = -Li2(1 - e^Y), linear model (exact).",
+                     "derivations.closed_forms:linear_exact"))
+    ks.append(Kernel("w1_linear_exact", (Y,), (-li3(arg),), "W1 = -Li3(1 - e^Y), linear model (exact).",
+                     "derivations.closed_forms:linear_exact"))
+    tables = {}
+    for name in ("constant", "linear", "affine"):
+        W0rows, W1rows, pts = model_tables(name)
+        tables[name] = (W0rows, W1rows)
+        Om, P1, t1 = depletion_forms(RHO[name])
+        K0, K1 = depletion_constants(RHO[name], Om, P1, t1, pts)
+        consts[f"K0_{name.upper()}"] = K0
+        consts[f"K1_{name.upper()}"] = K1
+        K0s = sp.Symbol(f"K0_{name.upper()}")
+        K1s = sp.Symbol(f"K1_{name.upper()}")
+        Om_T = Om.subs(T, -Y)
+        P1_T = P1.subs(sp.Symbol("K0"), K0s).subs(T, -Y)
+        ks.append(Kernel(
+            f"depletion_{name}", (Y,), (-(Om_T + K0s), -(P1_T + K1s)),
+            f"(W0, W1) for Y << 0 (depletion zone, {name} model); error O(|Y| e^Y).",
+            "derivations.closed_forms:depletion_forms"))
+        W0inf, W1inf = accumulation_constants(RHO[name]) if name == "constant" else (mp.mpf(0), mp.mpf(0))
+        consts[f"W0INF_{name.upper()}"] = W0inf
+        consts[f"W1INF_{name.upper()}"] = W1inf
+    tables["_kmin"], tables["_kmax"] = K_MIN, K_MAX
+    accY = sp.Symbol("Y")
+    W0i, W1i = sp.Symbol("W0INF_CONSTANT"), sp.Symbol("W1INF_CONSTANT")
+    ks.append(Kernel(
+        "accumulation_constant", (accY,),
+        (W0i - sp.sqrt(2) * (accY + 2) * sp.exp(-accY / 2), W1i - sp.sqrt(2) * W0i * sp.exp(-accY / 2)),
+        "(W0, W1) for Y >> 1 (cathode accumulation, constant model), leading terms.",
+        "derivations.closed_forms:accumulation"))
+    return ks, consts, tables

@@ -1,0 +1,280 @@
+"""The moment integral ``I(e, phi0)`` at every fidelity, for one point or 10^7.
+
+Fidelity ladder (DESIGN.md section 5), named after the asymptotic order:
+
+``leading``
+    ``I ~ lambda J1``: the O(lambda) term of the layer expansion, closed form
+    (so ``I ~ 1/e``).  Error estimate: the next term ``lambda^2 |J2|`` plus the truncation of
+    the closed-form layer functions.
+``corrected``
+    ``I ~ lambda J1 + lambda^2 J2``, closed form.  The lambda-expansion stops there exactly
+    (derivations/model.py), so what is left is exponentially small in ``1/lambda`` plus the
+    truncation of the large-/small-``A2`` expansions of the layer functions.
+``quadrature``
+    The same two terms with the layer functions integrated numerically (Gauss-Legendre
+    panels in a compiled kernel).  Error: exponentially small in ``core/lambda`` while the
+    layers do not overlap.
+``bvp``
+    The full nonlinear BVP (:mod:`ipmc_asym.bvp`), point by point.
+
+``I`` is computed on ``|phi0|`` and carries the sign of the voltage (mirror symmetry);
+``I = 0`` at zero volts.  Thickness is the TOTAL thickness ``2e`` (SI).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ._jit import jit, jit_parallel, prange
+from .kernels.closed import MODEL_IDS, moment_closed
+from .kernels.quadrature import moment_quadrature
+from .params import NAFION_LI, Material, check_finite
+from .permittivity import Permittivity, get_model
+
+__all__ = ["FIDELITIES", "MomentResult", "moment_integral", "moment", "groups_arrays", "check_fidelity"]
+
+FIDELITIES = ("leading", "corrected", "quadrature", "bvp")
+_ORDER = {"leading": 1, "corrected": 2}
+
+#: error estimate beyond which a closed form / quadrature is declared outside its validity
+VALIDITY_LIMIT = 1e-2
+
+
+def check_fidelity(fidelity: str) -> str:
+    if fidelity not in FIDELITIES:
+        raise ValueError(f"fidelity must be one of {', '.join(FIDELITIES)}; got {fidelity!r}")
+    return fidelity
+
+
+@dataclass
+class MomentResult:
+    """Moment integral and its bookkeeping; arrays broadcast from the inputs.
+
+    Attributes
+    ----------
+    I : ndarray   moment integral (dimensionless, signed like the voltage)
+    error : ndarray   relative error estimate of ``I``
+    B1 : ndarray   cathode concentration ``C(1)/C_moy`` (for ``|phi0|``)
+    core : ndarray   length of the neutral core left between the layers (units of ``e``)
+    lam : ndarray   core Debye length / e
+    A2 : ndarray
+    valid : ndarray of bool   error estimate below ``VALIDITY_LIMIT`` and layers separate
+    fidelity : str
+    model : str
+    """
+
+    I: np.ndarray
+    error: np.ndarray
+    B1: np.ndarray
+    core: np.ndarray
+    lam: np.ndarray
+    A2: np.ndarray
+    valid: np.ndarray
+    fidelity: str
+    model: str
+
+
+def _material(material, kw) -> Material:
+    m = NAFION_LI if material is None else material
+    if kw:
+        try:
+            m = m.with_(**kw)
+        except TypeError as exc:
+            raise ValueError(f"unknown material parameter: {exc}") from None
+    return m
+
+
+def groups_arrays(thickness, voltage, perm: Permittivity, material: Material):
+    """Vectorised groups: ``(lam, A2, A3, rho, sign, A5_per_l)`` broadcast to one shape.
+
+    ``lam = sqrt(eps_core R T / (e^2 phi4 F^2 C_moy))`` does not depend on the voltage.
+    """
+    th = np.asarray(thickness, dtype=float)
+    v = np.asarray(voltage, dtype=float)
+    if not np.all(np.isfinite(th)) or np.any(th <= 0):
+        raise ValueError("thickness (total, 2e) must be finite and > 0 m")
+    if not np.all(np.isfinite(v)):
+        raise ValueError("voltage must be finite (volts)")
+    th, v = np.broadcast_arrays(th, v)
+    m = material
+    cm = m.C_moy
+    e = 0.5 * th
+    eps_core = perm.eps0 + perm.deps
+    lam = np.sqrt(eps_core * m.R * m.T / (e * e * m.phi4 * m.F * m.F * cm))
+    A2 = m.F * np.abs(v) / (m.R * m.T)
+    A3 = -m.rho2 * m.Z3 / (cm * m.F)
+    rho = perm.eps0 / eps_core
+    return lam, A2, A3, rho, np.sign(v)
+
+
+@jit_parallel
+def _sweep_quadrature(lam, A2, A3, rho, sign, I, err, B1, core):
+    for i in prange(lam.size):
+        if A2[i] == 0.0:
+            I[i] = 0.0
+            err[i] = 0.0
+            B1[i] = 1.0
+            core[i] = 2.0
+            continue
+        Ii, J1, J2, b1, c = moment_quadrature(lam[i], A2[i], A3, rho)
+        I[i] = sign[i] * Ii
+        # neglected core interaction: exponentially small in core/lambda (see docs)
+        err[i] = 4.0 * math.exp(-max(c, 0.0) / lam[i]) + 1e-14
+        B1[i] = b1
+        core[i] = c
+
+
+@jit_parallel
+def _sweep_closed(lam, A2, A3, rho, model_id, order, sign, I, err, B1, core):
+    for i in prange(lam.size):
+        if A2[i] == 0.0:
+            I[i] = 0.0
+            err[i] = 0.0
+            B1[i] = 1.0
+            core[i] = 2.0
+            continue
+        Ii, e_i, b1, c = moment_closed(lam[i], A2[i], A3, rho, model_id, order)
+        I[i] = sign[i] * Ii
+        err[i] = e_i + 4.0 * math.exp(-max(c, 0.0) / lam[i])
+        B1[i] = b1
+        core[i] = c
+
+
+def moment(thickness, voltage, model="constant", fidelity="quadrature", *, material: Material | None = None,
+           progress: bool | None = None, **material_kw) -> MomentResult:
+    """Moment integral with error estimate and validity flags.
+
+    Parameters
+    ----------
+    thickness : float or array_like
+        TOTAL thickness ``2e`` (m), > 0.
+    voltage : float or array_like
+        Voltage ``phi0`` (V); any sign, zero allowed.  Broadcast against ``thickness``.
+    model : {"constant", "linear", "affine"} or Permittivity or callable
+        Permittivity model; a custom ``eps(C)`` callable requires ``fidelity="bvp"``.
+    fidelity : {"leading", "corrected", "quadrature", "bvp"}
+    material : Material, optional
+        Defaults to the ``nafion-li`` preset; ``**material_kw`` override its fields
+        (e.g. ``c_moy="formula"``, ``phi4=0.4``).
+    progress : bool, optional
+        Progress bar for long BVP loops (default: when more than 20 points).
+
+    Returns
+    -------
+    MomentResult
+        Arrays of the broadcast shape (0-d arrays for scalar inputs).
+    """
+    check_fidelity(fidelity)
+    perm = get_model(model)
+    mat = _material(material, material_kw)
+    if perm.is_custom and fidelity != "bvp":
+        raise ValueError(f"a custom eps(C) needs fidelity 'bvp' (closed forms exist for "
+                         f"constant, linear, affine); got fidelity {fidelity!r}")
+    lam, A2, A3, rho, sign = groups_arrays(thickness, voltage, perm, mat)
+    shape = lam.shape
+    I = np.empty(shape)
+    err = np.empty(shape)
+    B1 = np.empty(shape)
+    core = np.empty(shape)
+    if fidelity == "bvp":
+        _bvp_loop(thickness, voltage, perm, mat, I, err, B1, core, progress)
+    else:
+        fl = [np.ascontiguousarray(a).reshape(-1) for a in (lam, A2, sign)]
+        outs = [np.empty(lam.size) for _ in range(4)]
+        if fidelity == "quadrature":
+            _sweep_quadrature(fl[0], fl[1], A3, rho, fl[2], *outs)
+        else:
+            mid = MODEL_IDS.get(perm.name, -1) if (perm.eps0, perm.deps) == _paper_values(perm.name) else -1
+            if mid < 0:
+                raise ValueError(
+                    f"closed forms ({fidelity!r}) are derived for the paper's constant, linear and affine "
+                    f"models only; use fidelity 'quadrature' or 'bvp' for {perm.name!r} with "
+                    f"eps0={perm.eps0:g}, eps_moy-eps0={perm.deps:g} F/m"
+                )
+            _sweep_closed(fl[0], fl[1], A3, rho, mid, _ORDER[fidelity], fl[2], *outs)
+        for dst, src in zip((I, err, B1, core), outs):
+            dst[...] = src.reshape(shape)
+    valid = (err < VALIDITY_LIMIT) & (core > 0)
+    return MomentResult(I=I, error=err, B1=B1, core=core, lam=lam, A2=A2, valid=valid,
+                        fidelity=fidelity, model=perm.name)
+
+
+def _paper_values(name):
+    from .permittivity import MODELS
+
+    p = MODELS.get(name)
+    return (p.eps0, p.deps) if p is not None else None
+
+
+def _bvp_loop(thickness, voltage, perm, mat, I, err, B1, core, progress):
+    from .bvp import solve
+    from .params import Strip
+
+    th, v = np.broadcast_arrays(np.asarray(thickness, float), np.asarray(voltage, float))
+    n = th.size
+    show = (n > 20) if progress is None else progress
+    bar = _progress(n, "BVP") if show else None
+    for k, idx in enumerate(np.ndindex(th.shape)):
+        res = solve(Strip(thickness=float(th[idx]), voltage=float(v[idx])), perm, mat)
+        if not res.success:
+            raise RuntimeError(
+                f"BVP did not converge at thickness={float(th[idx]):g} m, voltage={float(v[idx]):g} V "
+                f"({res.message}); try a looser tol or fidelity 'quadrature'"
+            )
+        I[idx] = res.I
+        # solve_bvp tolerance 1e-10 on the residuals; measured I accuracy ~1e-12 (tests/test_bvp.py)
+        err[idx] = 1e-9
+        B1[idx] = res.B1 if v[idx] >= 0 else res.B1 * math.exp(res.groups.A2)
+        core[idx] = 2.0
+        if bar:
+            bar(k + 1)
+    if bar:
+        bar(None)
+
+
+def _progress(n, label):
+    import sys
+    import time
+
+    t0 = time.perf_counter()
+    last = [0.0]
+
+    def update(k):
+        now = time.perf_counter()
+        if k is None:
+            sys.stderr.write("\n")
+            return
+        if now - last[0] > 0.2 or k == n:
+            last[0] = now
+            frac = k / n
+            bar = "#" * int(30 * frac)
+            sys.stderr.write(f"\r{label} [{bar:<30s}] {k}/{n} {now - t0:6.1f}s")
+            sys.stderr.flush()
+
+    return update
+
+
+def moment_integral(thickness, voltage, model="constant", fidelity="quadrature", *, material=None, **material_kw):
+    """Moment integral ``I = int_{-1}^{1} p_bar z_bar dz_bar`` (dimensionless).
+
+    Parameters
+    ----------
+    thickness : float or array_like
+        TOTAL thickness ``2e`` in metres.
+    voltage : float or array_like
+        Voltage ``phi0`` in volts (sign = bending direction; 0 gives 0).
+    model : {"constant", "linear", "affine"}, Permittivity or callable
+    fidelity : {"leading", "corrected", "quadrature", "bvp"}
+    material : Material, optional; ``**material_kw`` override fields of the preset.
+
+    Returns
+    -------
+    float or ndarray
+        ``I`` with the broadcast shape of the inputs (a float for scalar inputs).
+        ``M_A = A5 I`` with ``A5 = 6 l e^2 F |phi0| C_moy``.
+    """
+    r = moment(thickness, voltage, model, fidelity, material=material, **material_kw)
+    return float(r.I) if r.I.ndim == 0 else r.I
