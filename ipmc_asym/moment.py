@@ -173,7 +173,11 @@ def moment(thickness, voltage, model="constant", fidelity="quadrature", *, mater
     if perm.is_custom and fidelity != "bvp":
         raise ValueError(f"a custom eps(C) needs fidelity 'bvp' (closed forms exist for "
                          f"constant, linear, affine); got fidelity {fidelity!r}")
-    lam, A2, A3, rho, sign = groups_arrays(thickness, voltage, perm, mat)
+    gperm = perm
+    if perm.is_custom:  # groups of the secant through C = 0 and C_moy (bookkeeping only)
+        e0 = max(float(perm.func(0.0)), 0.0)
+        gperm = Permittivity("secant", eps0=e0, deps=max(float(perm.func(mat.C_moy)) - e0, 0.0))
+    lam, A2, A3, rho, sign = groups_arrays(thickness, voltage, gperm, mat)
     shape = lam.shape
     I = np.empty(shape)
     err = np.empty(shape)

@@ -1,0 +1,366 @@
+"""Speed/accuracy benchmark of the fidelity ladder (``ipmc-asym bench``).
+
+For each permittivity model (constant, linear, affine) and each fidelity:
+
+* time per point of the compiled sweep driver on ``N`` (default 10^6) random
+  ``(thickness, voltage)`` points -- thickness log-uniform in 10 um - 4 mm, voltage
+  log-uniform in 1 mV - 10 V -- single-threaded (``numba.set_num_threads(1)`` around the
+  ``prange`` driver) and parallel (all Numba threads, at most 2 here).  The groups
+  (``lambda``, ``A2``) are precomputed, so the figure is the kernel cost per point;
+* first-call compile time (a subprocess with ``NUMBA_CACHE_DIR`` pointing to a fresh
+  temporary directory) and cached-load time (a second subprocess with the same directory).
+  ``leading`` and ``corrected`` share one compiled driver, hence one compile time;
+* the wall time of one BVP solve, averaged over a small sample (``--bvp-points`` per model)
+  of the same distribution;
+* the relative error ``|I_f - I_bvp| / |I_bvp|`` of each fidelity on that sample (max and
+  median).
+
+Targets (checked side by side in one run, single-threaded): leading <= 50 ns/point,
+corrected <= 200 ns/point, quadrature <= 5 us/point; leading and corrected >= 1e6x and
+quadrature >= 1e4x faster per point than the BVP.
+
+:func:`run_bench` returns one JSON-ready dict; :func:`plot_speed_accuracy` draws
+``figures/speed_accuracy.png``.  Module-level imports are stdlib + numpy only.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+__all__ = ["run_bench", "sample_points", "plot_speed_accuracy", "format_table", "TARGETS", "register", "run"]
+
+MODELS = ("constant", "linear", "affine")
+FAST = ("leading", "corrected", "quadrature")
+THICKNESS_RANGE = (10e-6, 4e-3)
+VOLTAGE_RANGE = (1e-3, 10.0)
+
+#: single-threaded time per point (s) and minimum speed-up over one BVP solve
+TARGETS = {
+    "leading": {"seconds_per_point": 50e-9, "speedup_vs_bvp": 1e6},
+    "corrected": {"seconds_per_point": 200e-9, "speedup_vs_bvp": 1e6},
+    "quadrature": {"seconds_per_point": 5e-6, "speedup_vs_bvp": 1e4},
+}
+
+_ERR_FLOOR = 1e-16  # relative errors below this are reported as this (log plots)
+
+
+def sample_points(n: int, seed: int = 0):
+    """``n`` points, thickness (total, m) and voltage (V) log-uniform in the bench ranges.
+
+    Parameters
+    ----------
+    n : int
+        Number of points (>= 1).
+    seed : int
+        Seed of ``numpy.random.default_rng``.
+
+    Returns
+    -------
+    thickness, voltage : ndarray, shape (n,)
+    """
+    n = int(n)
+    if n < 1:
+        raise ValueError(f"points must be an integer >= 1; got {n!r}")
+    rng = np.random.default_rng(seed)
+    lo, hi = np.log(THICKNESS_RANGE)
+    th = np.exp(rng.uniform(lo, hi, n))
+    lo, hi = np.log(VOLTAGE_RANGE)
+    v = np.exp(rng.uniform(lo, hi, n))
+    return th, v
+
+
+def _time_driver(fidelity, model, th, v, threads, repeats):
+    """Best-of-``repeats`` seconds per point of the sweep driver with ``threads`` threads."""
+    import numba
+
+    from .kernels.closed import MODEL_IDS
+    from .moment import _ORDER, _sweep_closed, _sweep_quadrature, groups_arrays
+    from .params import NAFION_LI
+    from .permittivity import get_model
+
+    lam, A2, A3, rho, sign = groups_arrays(th, v, get_model(model), NAFION_LI)
+    lam, A2, sign = (np.ascontiguousarray(a, dtype=float) for a in (lam, A2, sign))
+    outs = [np.empty(lam.size) for _ in range(4)]
+    if fidelity == "quadrature":
+        def call():
+            _sweep_quadrature(lam, A2, A3, rho, sign, *outs)
+    else:
+        mid, order = MODEL_IDS[model], _ORDER[fidelity]
+
+        def call():
+            _sweep_closed(lam, A2, A3, rho, mid, order, sign, *outs)
+
+    old = numba.get_num_threads()
+    numba.set_num_threads(max(1, min(int(threads), numba.config.NUMBA_NUM_THREADS)))
+    try:
+        call()  # warm-up (compile or load from cache)
+        best = np.inf
+        for _ in range(repeats):
+            t0 = time.perf_counter()
+            call()
+            best = min(best, time.perf_counter() - t0)
+    finally:
+        numba.set_num_threads(old)
+    return best / lam.size, int(np.count_nonzero(~np.isfinite(outs[0])))
+
+
+_COMPILE_SNIPPET = """
+import json, time
+t0 = time.perf_counter()
+from ipmc_asym.moment import moment
+t1 = time.perf_counter()
+moment(2e-4, 1.0, "constant", {fid!r})
+t2 = time.perf_counter()
+print(json.dumps({{"import": t1 - t0, "first_call": t2 - t1}}))
+"""
+
+
+def _compile_times(fidelity_group: str):
+    """(compile s, cached-load s) of the driver used by ``fidelity_group`` in fresh processes."""
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    env = dict(os.environ)
+    env["PYTHONPATH"] = root + (os.pathsep + env["PYTHONPATH"] if env.get("PYTHONPATH") else "")
+    code = _COMPILE_SNIPPET.format(fid=fidelity_group)
+    out = []
+    with tempfile.TemporaryDirectory(prefix="ipmc_bench_cache_") as d:
+        env["NUMBA_CACHE_DIR"] = d
+        for _ in range(2):
+            p = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True,
+                               timeout=600)
+            if p.returncode != 0:
+                raise RuntimeError(f"bench: compile-time subprocess failed: {p.stderr.strip().splitlines()[-1:]}")
+            out.append(json.loads(p.stdout.strip().splitlines()[-1])["first_call"])
+    return out[0], out[1]
+
+
+def _bvp_sample(model, th, v):
+    """BVP solve times and ``I`` on the sample; points where it fails are dropped."""
+    from .bvp import solve
+    from .params import NAFION_LI, Strip
+
+    times, I, keep = [], [], []
+    for k, (t, u) in enumerate(zip(th, v)):
+        t0 = time.perf_counter()
+        try:
+            r = solve(Strip(thickness=float(t), voltage=float(u)), model, NAFION_LI)
+        except (ValueError, RuntimeError, FloatingPointError):
+            continue
+        dt = time.perf_counter() - t0
+        if r.success and np.isfinite(r.I) and r.I != 0.0:
+            times.append(dt)
+            I.append(r.I)
+            keep.append(k)
+    return np.array(times), np.array(I), np.array(keep, dtype=int)
+
+
+def run_bench(points: int = 10**6, bvp_points: int = 5, repeats: int = 3, seed: int = 0,
+              compile_times: bool = True, threads: int = 2) -> dict:
+    """Run the whole benchmark and return a JSON-ready dict.
+
+    Parameters
+    ----------
+    points : int
+        Sweep size ``N`` for the timings.
+    bvp_points : int
+        BVP sample size per model (drawn from the same distribution).
+    repeats : int
+        Timing repeats (best is kept).
+    seed : int
+    compile_times : bool
+        Measure compile / cached-load times in subprocesses (a few seconds each).
+    threads : int
+        Threads of the parallel timing.
+
+    Returns
+    -------
+    dict
+        ``{"points", "bvp_points", "threads", "ranges", "targets", "compile": {fidelity:
+        {"compile_s", "cached_load_s"}}, "results": [row, ...], "all_pass"}`` with one row per
+        ``(model, fidelity)``: ``seconds_per_point_serial``, ``seconds_per_point_parallel``
+        (None for bvp), ``nonfinite``, ``rel_error_max``, ``rel_error_median``,
+        ``error_estimate_max`` (the fidelity's own estimate on the sample), ``speedup_vs_bvp``,
+        ``target_seconds_per_point``, ``target_speedup``, ``pass_time``, ``pass_speedup``.
+    """
+    import numba
+
+    from .moment import moment
+
+    points = int(points)
+    th, v = sample_points(points, seed)
+    ths, vs = sample_points(max(int(bvp_points), 1), seed + 1)
+    threads = max(1, min(int(threads), numba.config.NUMBA_NUM_THREADS))
+    comp = {}
+    if compile_times:
+        closed = _compile_times("leading")
+        quad = _compile_times("quadrature")
+        comp = {
+            "leading": {"compile_s": closed[0], "cached_load_s": closed[1], "shared_with": "corrected"},
+            "corrected": {"compile_s": closed[0], "cached_load_s": closed[1], "shared_with": "leading"},
+            "quadrature": {"compile_s": quad[0], "cached_load_s": quad[1]},
+        }
+    rows = []
+    for model in MODELS:
+        bt, bI, keep = _bvp_sample(model, ths, vs)
+        t_bvp = float(np.mean(bt)) if bt.size else None
+        sub_th, sub_v = ths[keep], vs[keep]
+        rows.append({
+            "model": model, "fidelity": "bvp", "seconds_per_point_serial": t_bvp,
+            "seconds_per_point_parallel": None, "nonfinite": 0, "bvp_sample": int(bt.size),
+            "rel_error_max": 1e-9 if bt.size else None, "rel_error_median": 1e-9 if bt.size else None,
+            "error_estimate_max": 1e-9, "speedup_vs_bvp": 1.0, "target_seconds_per_point": None,
+            "target_speedup": None, "pass_time": None, "pass_speedup": None,
+            "note": "BVP error is its stated estimate (solve_bvp tol 1e-10), not measured",
+        })
+        for fid in FAST:
+            s1, bad = _time_driver(fid, model, th, v, 1, repeats)
+            s2, _ = _time_driver(fid, model, th, v, threads, repeats)
+            if bt.size:
+                r = moment(sub_th, sub_v, model, fid)
+                rel = np.maximum(np.abs(r.I - bI) / np.abs(bI), _ERR_FLOOR)
+                emax, emed, est = float(rel.max()), float(np.median(rel)), float(np.max(r.error))
+            else:
+                emax = emed = est = None
+            tgt = TARGETS[fid]
+            speed = (t_bvp / s1) if t_bvp else None
+            rows.append({
+                "model": model, "fidelity": fid, "seconds_per_point_serial": s1,
+                "seconds_per_point_parallel": s2, "nonfinite": bad, "bvp_sample": int(bt.size),
+                "rel_error_max": emax, "rel_error_median": emed, "error_estimate_max": est,
+                "speedup_vs_bvp": speed, "target_seconds_per_point": tgt["seconds_per_point"],
+                "target_speedup": tgt["speedup_vs_bvp"],
+                "pass_time": bool(s1 <= tgt["seconds_per_point"]),
+                "pass_speedup": None if speed is None else bool(speed >= tgt["speedup_vs_bvp"]),
+            })
+    checks = [r[k] for r in rows for k in ("pass_time", "pass_speedup") if r[k] is not None]
+    return {
+        "points": points, "bvp_points": int(bvp_points), "threads": threads, "repeats": int(repeats),
+        "ranges": {"thickness_m": list(THICKNESS_RANGE), "voltage_V": list(VOLTAGE_RANGE),
+                   "distribution": "log-uniform"},
+        "targets": TARGETS, "compile": comp, "results": rows, "all_pass": bool(all(checks)),
+    }
+
+
+def _t(x):
+    if x is None:
+        return "n/a"
+    for unit, f in (("s", 1.0), ("ms", 1e-3), ("us", 1e-6), ("ns", 1e-9)):
+        if x >= f or unit == "ns":
+            return f"{x / f:.3g} {unit}"
+    return f"{x:g}"
+
+
+def _pf(b):
+    return "-" if b is None else ("pass" if b else "FAIL")
+
+
+def format_table(res: dict) -> str:
+    """Human-readable table of :func:`run_bench`'s result."""
+    lines = [f"ipmc-asym bench: N = {res['points']} points (thickness 10 um - 4 mm, voltage 1 mV - 10 V, "
+             f"log-uniform), parallel = {res['threads']} threads, BVP sample {res['bvp_points']}/model"]
+    hdr = (f"{'model':9s} {'fidelity':10s} {'t/pt serial':>12s} {'t/pt par':>10s} {'target':>9s} {'time':>5s} "
+           f"{'x vs BVP':>9s} {'target':>7s} {'spd':>5s} {'err max':>9s} {'err med':>9s} {'estimate':>9s}")
+    lines.append(hdr)
+    for r in res["results"]:
+        def e(x):
+            return f"{x:9.2e}" if x is not None else f"{'n/a':>9s}"
+
+        sp = r["speedup_vs_bvp"]
+        ts = f"{r['target_speedup']:.0e}" if r["target_speedup"] else "-"
+        lines.append(
+            f"{r['model']:9s} {r['fidelity']:10s} {_t(r['seconds_per_point_serial']):>12s} "
+            f"{_t(r['seconds_per_point_parallel']):>10s} {_t(r['target_seconds_per_point']):>9s} "
+            f"{_pf(r['pass_time']):>5s} {(f'{sp:.2e}' if sp else 'n/a'):>9s} "
+            f"{ts:>7s} "
+            f"{_pf(r['pass_speedup']):>5s} {e(r['rel_error_max'])} {e(r['rel_error_median'])} "
+            f"{e(r['error_estimate_max'])}"
+        )
+    if res["compile"]:
+        lines.append("compile (fresh NUMBA_CACHE_DIR) / cached load, first call in a new process:")
+        for f, c in res["compile"].items():
+            lines.append(f"  {f:10s} compile {c['compile_s']:.2f} s   cached load {c['cached_load_s']:.3f} s"
+                         + (f"   (same driver as {c['shared_with']})" if "shared_with" in c else ""))
+    lines.append(f"all targets: {'pass' if res['all_pass'] else 'FAIL (see table)'}")
+    return "\n".join(lines)
+
+
+def plot_speed_accuracy(res: dict, path="figures/speed_accuracy.png") -> str:
+    """Log time per point (x) vs log relative error against the BVP (y).
+
+    Marker shape = fidelity, colour = model; the BVP is placed at its stated error estimate.
+
+    Returns
+    -------
+    str
+        The path written.
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.lines import Line2D
+
+    markers = {"leading": "o", "corrected": "s", "quadrature": "^", "bvp": "D"}
+    colours = {"constant": "tab:blue", "linear": "tab:orange", "affine": "tab:green"}
+    fig, ax = plt.subplots(figsize=(7, 5))
+    for r in res["results"]:
+        x, y = r["seconds_per_point_serial"], r["rel_error_max"]
+        if x is None or y is None:
+            continue
+        ax.scatter([x], [max(y, _ERR_FLOOR)], marker=markers[r["fidelity"]], color=colours[r["model"]],
+                   s=70, edgecolor="k", linewidth=0.6, zorder=3)
+    for f, t in TARGETS.items():
+        ax.axvline(t["seconds_per_point"], color="0.6", ls=":", lw=0.8)
+        ax.text(t["seconds_per_point"], 0.5, f" {f} target", rotation=90, fontsize=7, color="0.4",
+                va="top", transform=ax.get_xaxis_transform())
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("time per point, single thread [s]")
+    ax.set_ylabel("max relative error of I vs BVP (BVP: its estimate)")
+    ax.set_title(f"ipmc-asym: speed vs accuracy ({res['points']:.0e} points, "
+                 f"{res['bvp_points']} BVP points/model)")
+    ax.grid(True, which="major", alpha=0.3)
+    h = [Line2D([], [], ls="", marker=m, color="0.3", label=f) for f, m in markers.items()]
+    h += [Line2D([], [], ls="", marker="o", color=c, label=m) for m, c in colours.items()]
+    ax.legend(handles=h, loc="best", fontsize=8, ncol=2)
+    fig.tight_layout()
+    d = os.path.dirname(os.path.abspath(path))
+    os.makedirs(d, exist_ok=True)
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return str(path)
+
+
+def register(sub):
+    """Add the ``bench`` subcommand."""
+    p = sub.add_parser("bench", help="time and accuracy of each fidelity (10^6-point sweep vs BVP)")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument("--points", type=int, default=10**6, help="sweep size N (default 10^6)")
+    p.add_argument("--bvp-points", type=int, default=5, help="BVP sample per model (default 5)")
+    p.add_argument("--no-compile", action="store_true", help="skip the compile-time subprocesses")
+    p.add_argument("--figure", default="figures/speed_accuracy.png",
+                   help="where to draw the speed/accuracy plot ('' for none)")
+
+
+def run(args) -> int:
+    """Run ``ipmc-asym bench``."""
+    if args.points < 1:
+        raise ValueError(f"--points must be >= 1; got {args.points}")
+    if args.bvp_points < 1:
+        raise ValueError(f"--bvp-points must be >= 1; got {args.bvp_points}")
+    res = run_bench(args.points, args.bvp_points, compile_times=not args.no_compile)
+    if args.figure:
+        res["figure"] = plot_speed_accuracy(res, args.figure)
+    if args.json:
+        print(json.dumps(res, indent=2))
+    else:
+        print(format_table(res))
+        if args.figure:
+            print(f"figure: {res['figure']}")
+    return 0

@@ -1,0 +1,137 @@
+"""The paper's figures (seed Figs 4-10) regenerated: ``ipmc-asym figures --out figures/``.
+
+* ``profile_{C,phi,D,p}.png`` (Figs 4-7) and ``profile_{E,rhoZ}.png``: full BVP at nominal,
+  full thickness + log zooms at each electrode (:mod:`ipmc_asym.profiles`);
+* ``influence_length.png`` (Fig 8), ``influence_thickness.png`` (Fig 9),
+  ``influence_voltage.png`` (Fig 10), ``influence_width.png``: deflection, blocking force and
+  rotation, three models overlaid; points past a quarter turn drawn dotted (outside the model);
+* ``speed_accuracy.png`` if :func:`ipmc_asym.bench.speed_accuracy_figure` exists.
+
+matplotlib is imported lazily (Agg backend).
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+
+import numpy as np
+
+from .params import NAFION_LI, Material, Strip
+
+__all__ = ["influence_figure", "make_all", "register", "run"]
+
+MODELS3 = ("constant", "linear", "affine")
+_COL = {"constant": "C0", "linear": "C1", "affine": "C2"}
+
+#: variable -> (values SI, axis scale to display, axis label, file stem, paper fig)
+INFLUENCE = {
+    "length": (np.linspace(0.005, 0.04, 36), 1e2, "length L (cm)", "influence_length", 8),
+    "thickness": (np.linspace(50e-6, 400e-6, 36), 1e6, "TOTAL thickness 2e (µm)", "influence_thickness", 9),
+    "voltage": (np.linspace(0.02, 3.0, 60), 1.0, r"voltage $\varphi_0$ (V)", "influence_voltage", 10),
+    "width": (np.linspace(1e-3, 10e-3, 19), 1e3, "TOTAL width 2l (mm)", "influence_width", None),
+}
+
+
+def influence_figure(var, path, base: Strip | None = None, material: Material = NAFION_LI, dpi=110,
+                     values=None):
+    """Three panels (|w|, F^p, |theta|) vs ``var`` for the three models (quadrature fidelity)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from .sweeps import OUTSIDE, sweep
+
+    vals, sc, xlabel, _stem, fig_no = INFLUENCE[var]
+    vals = vals if values is None else np.asarray(values, float)
+    base = Strip() if base is None else base
+    arr = sweep({var: vals}, list(MODELS3), "quadrature", base, material)
+    fig, axs = plt.subplots(1, 3, figsize=(13, 4.0), dpi=dpi)
+    for m in MODELS3:
+        a = arr[arr["model"] == m]
+        x = a[var] * sc
+        out = np.isin(a["regime"], OUTSIDE)
+        inside = ~out
+        for ax, q, qs, fac in ((axs[0], "w", "w_small", 1e3), (axs[1], "F_block", "F_block_small", 1e3),
+                               (axs[2], "theta", None, 1.0)):
+            y = np.abs(a[q]) * fac
+            yi = np.where(inside, y, np.nan)
+            ax.plot(x, yi, "-", color=_COL[m], label=f"{m}")
+            if out.any():
+                yo = np.where(out | np.roll(out, -1) | np.roll(out, 1), y, np.nan)
+                ax.plot(x, yo, ":", color=_COL[m], alpha=0.7)
+            if qs is not None and q == "w":
+                ax.plot(x, np.abs(a[qs]) * fac, "--", color=_COL[m], lw=0.8, alpha=0.6)
+    axs[0].set_ylabel("tip deflection |w| (mm)")
+    axs[0].set_title("(a) deflection: solid arc, dashed small-displ., dotted past quarter turn", fontsize=8)
+    axs[1].set_ylabel(r"blocking force $F^p$ (mN)")
+    axs[1].set_title("(b) blocking force (large displacements)", fontsize=9)
+    axs[2].set_ylabel(r"rotation $|\theta|$ (rad)")
+    axs[2].axhline(np.pi / 2, color="k", lw=0.6, ls="--")
+    axs[2].set_title(r"(c) rotation ($\pi/2$ dashed: quarter turn)", fontsize=9)
+    for ax in axs:
+        ax.set_xlabel(xlabel)
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=8)
+    fixed = {k: v for k, v in (("L", f"{base.length * 100:g} cm"), ("2l", f"{base.width * 1e3:g} mm"),
+                                ("2e", f"{base.thickness * 1e6:g} µm"), ("phi0", f"{base.voltage:g} V"))}
+    var_key = {"length": "L", "width": "2l", "thickness": "2e", "voltage": "phi0"}[var]
+    fixed.pop(var_key)
+    t = f"Influence of {var}" + (f" (paper Fig. {fig_no})" if fig_no else "") + "; fixed " + \
+        ", ".join(f"{k}={v}" for k, v in fixed.items()) + f", E={material.E:.3g} Pa"
+    fig.suptitle(t, fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
+    return path
+
+
+def make_all(out_dir="figures", dpi=110, base: Strip | None = None, material: Material = NAFION_LI,
+             quick=False) -> dict:
+    """Write every figure; returns {"files": [...], "notes": [...]}.  ``quick``: fewer points."""
+    from .profiles import write_all
+
+    os.makedirs(out_dir, exist_ok=True)
+    base = Strip() if base is None else base
+    files, notes = [], []
+    out = write_all(out_dir, strip=base, material=material, dpi=dpi)
+    files += [f for f in out["files"] if f.endswith(".png")]
+    for var, spec in INFLUENCE.items():
+        vals = spec[0][::3] if quick else None
+        p = os.path.join(out_dir, spec[3] + ".png")
+        influence_figure(var, p, base, material, dpi, values=vals)
+        files.append(p)
+    try:
+        from . import bench  # noqa: F401
+        fn = getattr(bench, "speed_accuracy_figure", None)
+    except ImportError:
+        fn = None
+    if fn is None:
+        notes.append("speed_accuracy.png skipped: ipmc_asym.bench.speed_accuracy_figure not available")
+    elif quick:
+        notes.append("speed_accuracy.png skipped in quick mode")
+    else:
+        p = os.path.join(out_dir, "speed_accuracy.png")
+        try:
+            fn(p)
+            files.append(p)
+        except Exception as exc:  # another module's failure must not lose the other figures
+            notes.append(f"speed_accuracy.png failed: {exc.__class__.__name__}: {exc}")
+    return {"files": files, "notes": notes, "layers": out["summaries"]}
+
+
+def register(sub):
+    p = sub.add_parser("figures", help="regenerate the paper's Figs 4-10 (+ speed/accuracy) as PNG")
+    p.add_argument("--out", default="figures", help="output directory (default figures/)")
+    p.add_argument("--dpi", type=int, default=110)
+    p.add_argument("--quick", action="store_true", help="fewer points (for tests)")
+
+
+def run(args) -> int:
+    out = make_all(args.out, args.dpi, quick=args.quick)
+    for f in out["files"]:
+        print("wrote", f)
+    for n in out["notes"]:
+        sys.stderr.write(f"note: {n}\n")
+    return 0

@@ -1,0 +1,258 @@
+"""Profiles through the thickness (seed paper section 6.1, Figs 4-7): ``ipmc-asym profiles``.
+
+The profiles come from the full BVP (:func:`ipmc_asym.bvp.solve`) on its graded mesh, so the
+electrode layers (~1e-3 of the thickness) are resolved.  Distances are measured from the
+face, in micrometres, with ``e`` the HALF thickness (``z = z_bar e``, ``z_bar in [-1, 1]``;
+anode ``z_bar = -1``, cathode ``z_bar = +1``).
+
+Layer widths (definitions used everywhere in the toolkit)
+---------------------------------------------------------
+``depletion`` (anode)
+    distance from the anode face ``z_bar = -1`` to the first point where ``C_bar`` rises
+    through ``1/2`` (half the mean concentration) -- the "zone almost free of cations".
+``accumulation`` (cathode)
+    distance from the cathode face ``z_bar = +1`` to the point where the excess
+    ``C_bar - 1`` has fallen to ``(B1 - 1)/e_N`` (``e_N`` = Euler's number), i.e. the 1/e
+    decay length of the accumulated charge.
+``accumulation_half``
+    same, where ``C_bar - 1`` falls to half its face value ``(B1 - 1)/2`` (less sensitive to
+    the shape of the tail).
+
+Layer rule: stdlib + numpy at import; SciPy (via bvp) and matplotlib are imported lazily.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import os
+
+import numpy as np
+
+from .params import NAFION_LI, Material, Strip
+
+__all__ = ["MODELS3", "QUANTITIES", "profile", "layer_widths", "profile_summary", "write_csv",
+           "plot_profiles", "register", "run", "PAPER_LAYERS"]
+
+MODELS3 = ("constant", "linear", "affine")
+
+#: quantity key -> (BVPResult attribute, axis label)
+QUANTITIES = {
+    "C": ("C", r"$\bar C = C/C_{moy}$"),
+    "phi": ("phi", r"$\bar\varphi = \varphi/\varphi_0$"),
+    "D": ("D", r"$\bar D$ (dimensionless induction)"),
+    "E": ("E", r"$\bar E = -d\bar\varphi/d\bar z$"),
+    "rhoZ": ("rhoZ", r"$\overline{\rho Z} = \bar C - 1$"),
+    "p": ("p", r"$\bar p = \bar C/A_2 - A_3\bar\varphi$ ($B_2=0$)"),
+}
+
+#: the paper's statements (section 6.1), micrometres
+PAPER_LAYERS = {
+    ("constant", "depletion"): 0.2, ("affine", "depletion"): 0.07,
+    ("constant", "accumulation"): 0.2, ("linear", "accumulation"): 2.0, ("affine", "accumulation"): 2.0,
+}
+
+
+def profile(model="constant", strip: Strip | None = None, material: Material = NAFION_LI):
+    """Full-BVP profiles (a :class:`ipmc_asym.bvp.BVPResult`) at ``strip`` (default nominal)."""
+    from .bvp import solve
+
+    strip = Strip() if strip is None else strip
+    res = solve(strip, model, material)
+    if not res.success:
+        raise RuntimeError(f"BVP for the {model} profiles did not converge: {res.message}")
+    return res
+
+
+def _crossing(d, f, level):
+    """First distance ``d`` (increasing) where ``f - level`` changes sign (linear interp.)."""
+    g = f - level
+    s = np.nonzero(np.sign(g[:-1]) != np.sign(g[1:]))[0]
+    if s.size == 0:
+        return float("nan")
+    k = s[0]
+    if g[k + 1] == g[k]:
+        return float(d[k])
+    return float(d[k] + (d[k + 1] - d[k]) * (-g[k]) / (g[k + 1] - g[k]))
+
+
+def layer_widths(res, e: float) -> dict:
+    """Depletion / accumulation widths in micrometres (definitions in the module docstring).
+
+    ``res`` is a BVPResult for a positive voltage, ``e`` the HALF thickness (m).
+    """
+    z, C = np.asarray(res.z), np.asarray(res.C)
+    da = (z + 1.0) * e * 1e6  # from the anode, µm, increasing
+    dep = _crossing(da, C, 0.5)
+    dc = ((1.0 - z) * e * 1e6)[::-1]  # from the cathode, increasing
+    Cc = C[::-1] - 1.0
+    B1m1 = Cc[0]
+    acc = _crossing(dc, Cc, B1m1 / math.e)
+    acc2 = _crossing(dc, Cc, 0.5 * B1m1)
+    return {"depletion_um": dep, "accumulation_um": acc, "accumulation_half_um": acc2}
+
+
+def profile_summary(model="constant", strip: Strip | None = None, material: Material = NAFION_LI,
+                    res=None) -> dict:
+    """Layer widths and face values of the profiles for one model (SI / µm / dimensionless).
+
+    Returns
+    -------
+    dict
+        ``model``, ``B1`` (= C_bar at the cathode), ``C_anode``, ``depletion_um``,
+        ``accumulation_um``, ``accumulation_half_um``, ``D_face`` (D_bar at the faces, equal by
+        electroneutrality), ``D_core`` (|D_bar| max over the central half), ``p_anode``,
+        ``p_cathode``, ``E_anode``, ``E_cathode``, ``I``, ``cathode_charge`` (F B1 C_moy, C/m^3),
+        ``debye_um`` (core Debye length), ``e_um`` (HALF thickness), ``n_nodes``.
+    """
+    strip = Strip() if strip is None else strip
+    if res is None:
+        res = profile(model, strip, material)
+    e = strip.e
+    w = layer_widths(res, e)
+    g = res.groups
+    core = np.abs(res.z) < 0.5
+    out = {
+        "model": res.model,
+        "B1": float(res.B1),
+        "C_anode": float(res.C[0]),
+        **w,
+        "D_face": float(res.D[-1]),
+        "D_core": float(np.max(np.abs(res.D[core]))),
+        "p_anode": float(res.p[0]),
+        "p_cathode": float(res.p[-1]),
+        "E_anode": float(res.E[0]),
+        "E_cathode": float(res.E[-1]),
+        "I": float(res.I),
+        "cathode_charge": float(material.F * res.B1 * g.C_moy),
+        "debye_um": float(g.debye * e * 1e6),
+        "e_um": e * 1e6,
+        "n_nodes": int(res.n_nodes),
+    }
+    return out
+
+
+def write_csv(res, path, e: float):
+    """One row per mesh node: z_bar, z (m), distances from anode/cathode (m), and all profiles."""
+    with open(path, "w", newline="") as fh:
+        wr = csv.writer(fh)
+        wr.writerow(["z_bar", "z_m", "dist_anode_m", "dist_cathode_m", "C_bar", "phi_bar", "D_bar",
+                     "E_bar", "rhoZ_bar", "p_bar"])
+        for i in range(len(res.z)):
+            z = float(res.z[i])
+            wr.writerow([f"{z:.17g}", f"{z * e:.10g}", f"{(z + 1) * e:.10g}", f"{(1 - z) * e:.10g}",
+                         f"{res.C[i]:.12g}", f"{res.phi[i]:.12g}", f"{res.D[i]:.12g}",
+                         f"{res.E[i]:.12g}", f"{res.rhoZ[i]:.12g}", f"{res.p[i]:.12g}"])
+
+
+_COLORS = {"constant": "C0", "linear": "C1", "affine": "C2"}
+
+
+def plot_profiles(results: dict, quantity: str, path, e: float, dpi: int = 110, title: str | None = None):
+    """Full-width panel + zooms at the anode and the cathode (log distance from the face, µm).
+
+    ``results``: model name -> BVPResult; ``e`` HALF thickness (m).
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    attr, label = QUANTITIES[quantity]
+    fig, axs = plt.subplots(1, 3, figsize=(13, 4.0), dpi=dpi)
+    for name, res in results.items():
+        z = np.asarray(res.z)
+        f = np.asarray(getattr(res, attr))
+        c = _COLORS.get(name, None)
+        axs[0].plot(z, f, color=c, label=name)
+        da = (z + 1.0) * e * 1e6
+        m = (da > 0) & (z < 0)
+        axs[1].plot(da[m], f[m], color=c, label=name)
+        dc = (1.0 - z) * e * 1e6
+        m = (dc > 0) & (z > 0)
+        axs[2].plot(dc[m], f[m], color=c, label=name)
+    axs[0].set_xlabel(r"$\bar z = z/e$ ($e$ = HALF thickness = %.4g µm)" % (e * 1e6))
+    axs[0].set_title("full thickness (anode $\\bar z=-1$, cathode $+1$)", fontsize=9)
+    for ax, side in ((axs[1], "anode ($\\bar z=-1$)"), (axs[2], "cathode ($\\bar z=+1$)")):
+        ax.set_xscale("log")
+        ax.set_xlim(1e-4, e * 1e6)
+        ax.set_xlabel(f"distance from the {side.split(' ')[0]} face (µm, log)")
+        ax.set_title(f"zoom at the {side}", fontsize=9)
+    if quantity == "C":
+        axs[2].set_yscale("log")
+    for ax in axs:
+        ax.set_ylabel(label)
+        ax.grid(True, alpha=0.3)
+    axs[0].legend(fontsize=8)
+    fig.suptitle(title or f"{quantity} profile through the thickness (nominal strip, full BVP)", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
+
+
+def compute_all(models=MODELS3, strip: Strip | None = None, material: Material = NAFION_LI):
+    strip = Strip() if strip is None else strip
+    return {m: profile(m, strip, material) for m in models}
+
+
+def write_all(out_dir, models=MODELS3, strip: Strip | None = None, material: Material = NAFION_LI,
+              dpi: int = 110, quantities=tuple(QUANTITIES), results=None) -> dict:
+    """CSV per model + one PNG per quantity; returns {"summaries": [...], "files": [...]}."""
+    strip = Strip() if strip is None else strip
+    os.makedirs(out_dir, exist_ok=True)
+    results = compute_all(models, strip, material) if results is None else results
+    files = []
+    for m, res in results.items():
+        p = os.path.join(out_dir, f"profiles_{m}.csv")
+        write_csv(res, p, strip.e)
+        files.append(p)
+    figno = {"C": 4, "phi": 5, "D": 6, "p": 7}
+    for q in quantities:
+        p = os.path.join(out_dir, f"profile_{q}.png")
+        t = f"{q} profile (paper Fig. {figno[q]})" if q in figno else f"{q} profile"
+        plot_profiles(results, q, p, strip.e, dpi=dpi,
+                      title=f"{t}: L={strip.length*100:g} cm, 2e={strip.thickness*1e6:g} µm, "
+                            f"phi0={strip.voltage:g} V, full BVP")
+        files.append(p)
+    sums = [profile_summary(m, strip, material, res=r) for m, r in results.items()]
+    return {"summaries": sums, "files": files}
+
+
+# ---- CLI -------------------------------------------------------------------------------------
+def register(sub):
+    from .cli import add_strip_options
+
+    p = sub.add_parser("profiles", help="C, phi, D, E, rhoZ, p through the thickness (paper Figs 4-7)")
+    add_strip_options(p)
+    p.add_argument("--model", default="all", choices=list(MODELS3) + ["all"])
+    p.add_argument("--out", default="figures", help="output directory for CSV and PNG (default figures/)")
+    p.add_argument("--json", action="store_true", help="print the layer summary as JSON")
+
+
+def run(args) -> int:
+    import json
+
+    from .cli import material_from_args, strip_from_args
+
+    strip = strip_from_args(args)
+    if strip.voltage <= 0:
+        raise ValueError("profiles: voltage must be > 0 (a negative voltage is the mirror image)")
+    mat = material_from_args(args)
+    models = MODELS3 if args.model == "all" else (args.model,)
+    out = write_all(args.out, models, strip, mat)
+    if args.json:
+        print(json.dumps(out, indent=2))
+        return 0
+    print(f"profiles at L={strip.length:g} m, 2e={strip.thickness:g} m (e={strip.e:g} m), "
+          f"phi0={strip.voltage:g} V; layer widths in µm from the face")
+    print(f"{'model':9s} {'depletion':>10s} {'accum(1/e)':>10s} {'accum(1/2)':>10s} {'B1':>9s} "
+          f"{'Debye':>8s} {'paper dep':>9s} {'paper acc':>9s}")
+    for s in out["summaries"]:
+        pd = PAPER_LAYERS.get((s["model"], "depletion"))
+        pa = PAPER_LAYERS.get((s["model"], "accumulation"))
+        print(f"{s['model']:9s} {s['depletion_um']:10.4g} {s['accumulation_um']:10.4g} "
+              f"{s['accumulation_half_um']:10.4g} {s['B1']:9.4g} {s['debye_um']:8.3g} "
+              f"{(pd if pd is not None else float('nan')):9.3g} {(pa if pa is not None else float('nan')):9.3g}")
+    for f in out["files"]:
+        print("wrote", f)
+    return 0

@@ -1,0 +1,261 @@
+"""Parameter sweeps on a grid (``ipmc-asym sweep``), vectorised end to end.
+
+``sweep({"length": np.linspace(0.01, 0.04, 16)}, model="constant")`` returns a numpy
+structured array with one row per grid point (and per model), SI columns::
+
+    length width thickness voltage modulus  (inputs; width/thickness are TOTAL 2l / 2e)
+    model fidelity I M_A theta w w_small F_block F_block_small regime B1 error valid
+
+``I`` comes from the vectorised :func:`ipmc_asym.moment.moment` (one call per model for the
+whole grid) and the mechanics from the vectorised :func:`ipmc_asym.beam.solve_beam`; nothing
+loops over points in Python except the ``bvp`` fidelity.
+
+CLI spec: ``--vary NAME=START:STOP:N`` (N points, linear) or ``NAME=START:STOP:N:log``;
+NAME in length, width, thickness, voltage, modulus; units as in ``estimate``
+(``1cm``, ``200um``, ``500mV``, ``130MPa``).  Several ``--vary`` make a grid.
+
+Layer rule: stdlib + numpy at import.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import sys
+import time
+
+import numpy as np
+
+from .params import NAFION_LI, Material, Strip
+
+__all__ = ["VARIABLES", "parse_vary", "sweep", "write_csv", "rows_as_dicts", "register", "run"]
+
+VARIABLES = ("length", "width", "thickness", "voltage", "modulus")
+MODELS3 = ("constant", "linear", "affine")
+
+_FLOAT_COLS = ("length", "width", "thickness", "voltage", "modulus", "I", "M_A", "theta", "w", "w_small",
+               "F_block", "F_block_small", "B1", "error")
+DTYPE = np.dtype([(c, "f8") for c in _FLOAT_COLS[:5]] + [("model", "U8"), ("fidelity", "U10")]
+                 + [(c, "f8") for c in _FLOAT_COLS[5:]] + [("regime", "U17"), ("valid", "?")])
+OUTSIDE = ("past-quarter-turn", "multi-turn")
+
+
+def _parse_value(name, text):
+    from .units import parse_length, parse_pressure, parse_voltage
+
+    if name in ("length", "width", "thickness"):
+        return parse_length(name, text)
+    if name == "voltage":
+        return parse_voltage(name, text)
+    return parse_pressure(name, text)
+
+
+def parse_vary(spec: str):
+    """``'length=1cm:4cm:16'`` -> ``("length", array)``; ``':log'`` suffix for log spacing."""
+    if "=" not in spec:
+        raise ValueError(f"--vary must be NAME=START:STOP:N[:log]; got {spec!r}")
+    name, rng = spec.split("=", 1)
+    name = name.strip()
+    if name not in VARIABLES:
+        raise ValueError(f"--vary name must be one of {', '.join(VARIABLES)}; got {name!r}")
+    parts = rng.split(":")
+    log = False
+    if len(parts) == 4 and parts[3].strip().lower() in ("log", "lin"):
+        log = parts[3].strip().lower() == "log"
+        parts = parts[:3]
+    if len(parts) != 3:
+        raise ValueError(f"--vary {name}: expected START:STOP:N[:log]; got {rng!r}")
+    a = _parse_value(name, parts[0])
+    b = _parse_value(name, parts[1])
+    try:
+        n = int(parts[2])
+    except ValueError:
+        raise ValueError(f"--vary {name}: N must be an integer >= 1; got {parts[2]!r}") from None
+    if n < 1:
+        raise ValueError(f"--vary {name}: N must be an integer >= 1; got {n}")
+    if log:
+        if a <= 0 or b <= 0:
+            raise ValueError(f"--vary {name}: log spacing needs START, STOP > 0")
+        vals = np.geomspace(a, b, n)
+    else:
+        vals = np.linspace(a, b, n)
+    if name != "voltage" and np.any(vals <= 0):
+        raise ValueError(f"--vary {name}: values must be > 0")
+    return name, vals
+
+
+def _models(model):
+    if model == "all":
+        return list(MODELS3)
+    if isinstance(model, (list, tuple)):
+        return list(model)
+    return [model]
+
+
+def sweep(vary: dict, model="constant", fidelity="quadrature", base: Strip | None = None,
+          material: Material = NAFION_LI, tol=None, progress: bool | None = None) -> np.ndarray:
+    """Evaluate the strip on the grid spanned by ``vary`` (name -> 1-D values, SI).
+
+    Parameters
+    ----------
+    vary : dict
+        Keys among :data:`VARIABLES`; each value a 1-D array.  The grid is their outer
+        product (first key slowest).  Variables not in ``vary`` take ``base`` / ``material``.
+    model : str, list of str or "all"
+    fidelity : {"leading", "corrected", "quadrature", "bvp"}
+    base : Strip, default nominal
+    material : Material (``modulus`` overrides ``material.E``)
+    tol : float, optional   tolerance of the "small" beam regime (default 1 %)
+
+    Returns
+    -------
+    numpy structured array (dtype :data:`DTYPE`), one row per grid point and model.
+    """
+    from .beam import solve_beam
+    from .moment import check_fidelity, moment
+    from .permittivity import get_model
+
+    check_fidelity(fidelity)
+    base = Strip() if base is None else base
+    for k in vary:
+        if k not in VARIABLES:
+            raise ValueError(f"vary: unknown variable {k!r}; use {', '.join(VARIABLES)}")
+    axes = [np.atleast_1d(np.asarray(v, dtype=float)).ravel() for v in vary.values()]
+    grids = np.meshgrid(*axes, indexing="ij") if axes else []
+    cols = {
+        "length": base.length, "width": base.width, "thickness": base.thickness,
+        "voltage": base.voltage, "modulus": material.E,
+    }
+    for k, g in zip(vary, grids):
+        cols[k] = g.ravel()
+    n = int(np.prod([a.size for a in axes])) if axes else 1
+    for k in cols:
+        cols[k] = np.broadcast_to(np.asarray(cols[k], dtype=float), (n,)).copy()
+    for k in ("length", "width", "thickness", "modulus"):
+        if np.any(~np.isfinite(cols[k])) or np.any(cols[k] <= 0):
+            raise ValueError(f"{k} must be finite and > 0")
+    mats = material
+    C_moy = mats.C_moy
+    e = 0.5 * cols["thickness"]
+    l = 0.5 * cols["width"]
+    A5 = 6.0 * l * e * e * mats.F * np.abs(cols["voltage"]) * C_moy
+    EI = cols["modulus"] * 4.0 * l * e ** 3 / 3.0
+    out_parts = []
+    models = _models(model)
+    show = (n * len(models) > 20000 or fidelity == "bvp") if progress is None else progress
+    for m in models:
+        perm = get_model(m)
+        r = moment(cols["thickness"], cols["voltage"], perm, fidelity, material=mats,
+                   progress=(show if fidelity == "bvp" else False))
+        I = np.asarray(r.I, dtype=float).reshape(n)
+        M = A5 * I
+        with np.errstate(all="ignore"):
+            b = solve_beam(M, cols["length"], EI, tol=tol)
+        arr = np.empty(n, dtype=DTYPE)
+        for k in ("length", "width", "thickness", "voltage", "modulus"):
+            arr[k] = cols[k]
+        arr["model"] = perm.name
+        arr["fidelity"] = fidelity
+        arr["I"] = I
+        arr["M_A"] = M
+        for k in ("theta", "w", "w_small", "F_block", "F_block_small"):
+            arr[k] = np.broadcast_to(np.asarray(getattr(b, k), dtype=float), (n,))
+        arr["regime"] = np.broadcast_to(np.asarray(b.regime), (n,))
+        arr["B1"] = np.asarray(r.B1).reshape(n)
+        arr["error"] = np.asarray(r.error).reshape(n)
+        arr["valid"] = np.asarray(r.valid).reshape(n)
+        out_parts.append(arr)
+        if show and fidelity != "bvp":
+            _bar(len(out_parts), len(models))
+    if show and fidelity != "bvp":
+        sys.stderr.write("\n")
+    return np.concatenate(out_parts)
+
+
+def _bar(k, n, label="sweep"):
+    frac = k / n
+    sys.stderr.write(f"\r{label} [{'#' * int(30 * frac):<30s}] {k}/{n} models")
+    sys.stderr.flush()
+
+
+def rows_as_dicts(arr: np.ndarray) -> list[dict]:
+    """JSON-ready rows (NaN -> None)."""
+    out = []
+    names = arr.dtype.names
+    for rec in arr:
+        d = {}
+        for k in names:
+            v = rec[k]
+            if isinstance(v, (np.floating, float)):
+                v = float(v)
+                d[k] = v if np.isfinite(v) else None
+            elif isinstance(v, (np.bool_, bool)):
+                d[k] = bool(v)
+            else:
+                d[k] = str(v)
+        out.append(d)
+    return out
+
+
+def write_csv(arr: np.ndarray, path):
+    """CSV with SI columns (header = field names)."""
+    fh = sys.stdout if path in (None, "-") else open(path, "w", newline="")
+    try:
+        wr = csv.writer(fh)
+        wr.writerow(arr.dtype.names)
+        for rec in arr:
+            wr.writerow([f"{v:.10g}" if isinstance(v, (np.floating, float)) else
+                         (str(bool(v)) if isinstance(v, np.bool_) else str(v)) for v in rec.tolist()])
+    finally:
+        if fh is not sys.stdout:
+            fh.close()
+
+
+# ---- CLI -------------------------------------------------------------------------------------
+def register(sub):
+    from .cli import add_strip_options
+
+    p = sub.add_parser("sweep", help="evaluate the strip on a grid of parameters (vectorised)")
+    p.add_argument("--vary", action="append", default=[], metavar="NAME=START:STOP:N[:log]",
+                   help="length, width, thickness (TOTAL), voltage or modulus; repeat for a grid")
+    add_strip_options(p)
+    p.add_argument("--model", default="constant", choices=list(MODELS3) + ["all"])
+    p.add_argument("--fidelity", default="quadrature", choices=["leading", "corrected", "quadrature", "bvp"])
+    p.add_argument("--tol", type=float, default=None, help="tolerance of the 'small' beam regime (1%%)")
+    p.add_argument("--out", default=None, help="CSV file (SI columns); default: stdout unless --json")
+    p.add_argument("--json", action="store_true", help='print {"rows": [...], "fits": [...]}')
+    p.add_argument("--no-progress", action="store_true")
+
+
+def run(args) -> int:
+    from .cli import material_from_args, strip_from_args
+    from .fits import sweep_fits
+
+    if not args.vary:
+        raise ValueError("sweep needs at least one --vary NAME=START:STOP:N (e.g. length=1cm:4cm:16)")
+    vary = {}
+    for s in args.vary:
+        k, v = parse_vary(s)
+        if k in vary:
+            raise ValueError(f"--vary {k} given twice")
+        vary[k] = v
+    base = strip_from_args(args)
+    mat = material_from_args(args)
+    t0 = time.perf_counter()
+    arr = sweep(vary, args.model, args.fidelity, base, mat, args.tol,
+                progress=False if args.no_progress else None)
+    dt = time.perf_counter() - t0
+    fits = sweep_fits(arr, list(vary)) if len(vary) == 1 else []
+    if args.out:
+        write_csv(arr, args.out)
+        sys.stderr.write(f"sweep: {arr.size} rows in {dt:.3g} s -> {args.out}\n")
+    if args.json:
+        print(json.dumps({"rows": rows_as_dicts(arr), "fits": fits, "seconds": dt}, indent=1))
+    elif not args.out:
+        write_csv(arr, "-")
+    if not args.json and fits:
+        for f in fits:
+            sys.stderr.write(
+                f"fit [{f['model']}] |{f['quantity']}| ~ {f['prefactor']:.4g} * {f['variable']}^"
+                f"{f['exponent']:.4g} (r={f['r']:.5f}, n={f['n']}, left out {f['n_left_out']})\n")
+    return 0

@@ -1,0 +1,98 @@
+"""The command line as a user runs it: exit codes, JSON keys, units, one-line errors."""
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+from ipmc_asym.bvp import moment_integral_bvp
+from ipmc_asym.cli import main
+from ipmc_asym.params import NAFION_LI, Strip
+from ipmc_asym.units import parse_length, parse_voltage
+
+KEYS = {"model", "fidelity", "C_moy", "A0", "A1", "A2", "A3", "A5", "B1", "I", "M_A", "theta", "w", "w_small",
+        "F_block", "F_block_small", "error_estimate", "seconds"}
+
+
+def run(*args):
+    return subprocess.run([sys.executable, "-m", "ipmc_asym", *args], capture_output=True, text=True, timeout=300)
+
+
+@pytest.mark.parametrize("fid", ["leading", "corrected", "quadrature", "bvp"])
+def test_estimate_json_all_models(fid, capsys):
+    assert main(["estimate", "--fidelity", fid, "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["inputs"]["thickness_total"] == 200e-6 and out["inputs"]["half_thickness_e"] == 100e-6
+    assert [r["model"] for r in out["results"]] == ["constant", "linear", "affine"]
+    for r in out["results"]:
+        assert KEYS <= set(r)
+        assert r["C_moy"] == 3082.0
+        ref = moment_integral_bvp(200e-6, 1.0, r["model"])
+        tol = {"leading": 5e-2, "corrected": 1e-8, "quadrature": 1e-8, "bvp": 1e-8}[fid]
+        assert abs(r["I"] / ref - 1) < tol
+        # paper's signs: positive voltage bends towards negative z
+        assert r["M_A"] > 0 and r["theta"] < 0 and r["w"] < 0 and r["F_block"] > 0
+
+
+def test_estimate_units_and_negative_voltage(capsys):
+    assert main(["estimate", "--model", "constant", "--thickness", "0.2mm", "--length", "2 cm",
+                 "--voltage=-1V", "--json"]) == 0
+    r = json.loads(capsys.readouterr().out)["results"][0]
+    assert r["I"] < 0 and r["w"] > 0
+
+
+def test_table_says_which_thickness(capsys):
+    assert main(["estimate"]) == 0
+    out = capsys.readouterr().out
+    assert "total thickness 2e = 200 µm" in out and "half thickness e = 100 µm" in out
+
+
+@pytest.mark.parametrize("args,word", [
+    (["--thickness=-3um"], "thickness"),
+    (["--thickness", "0"], "thickness"),
+    (["--voltage", "nan"], "voltage"),
+    (["--model", "quadratic"], "model"),
+    (["--fidelity", "exact"], "fidelity"),
+    (["--c-moy", "lots"], "c-moy"),
+    (["--length", "3 furlongs"], "length"),
+])
+def test_bad_input_exit_2_one_line(args, word):
+    p = run("estimate", *args)
+    assert p.returncode == 2
+    assert "Traceback" not in p.stderr
+    assert len(p.stderr.strip().splitlines()) == 1 and word in p.stderr
+
+
+def test_zero_voltage_gives_zero_deflection(capsys):
+    assert main(["estimate", "--voltage", "0", "--json"]) == 0
+    for r in json.loads(capsys.readouterr().out)["results"]:
+        assert r["I"] == 0 and r["w"] == 0 and r["theta"] == 0 and r["F_block"] == 0
+
+
+def test_units_parse():
+    assert parse_length("x", "200um") == pytest.approx(200e-6)
+    assert parse_length("x", "200µm") == pytest.approx(200e-6)
+    assert parse_length("x", "2 cm") == pytest.approx(0.02)
+    assert parse_length("x", "0.02") == 0.02
+    assert parse_voltage("x", "500mV") == pytest.approx(0.5)
+    with pytest.raises(ValueError, match="x"):
+        parse_length("x", "2 parsecs")
+
+
+@pytest.mark.parametrize("kw,word", [(dict(phi4=1.0), "phi4"), (dict(phi4=0.0), "phi4"), (dict(E=-1), "modulus"),
+                                     (dict(c_moy="magic"), "c_moy"), (dict(T=float("nan")), "temperature")])
+def test_material_validation(kw, word):
+    with pytest.raises(ValueError, match=word):
+        NAFION_LI.with_(**kw)
+
+
+@pytest.mark.parametrize("kw,word", [(dict(length=0), "length"), (dict(width=-1), "width"),
+                                     (dict(thickness=float("inf")), "thickness"), (dict(voltage="x"), "voltage")])
+def test_strip_validation(kw, word):
+    with pytest.raises(ValueError, match=word):
+        Strip(**kw)
+
+
+def test_derive_check_cli():
+    assert main(["derive", "--check"]) == 0

@@ -1,0 +1,71 @@
+"""The derivation reproduces the committed kernels; SymPy expressions agree with the kernels."""
+
+import math
+
+import mpmath as mp
+import numpy as np
+import pytest
+import sympy as sp
+
+from derivations import codegen, model as M, scaling
+from ipmc_asym.kernels import _generated as G
+from ipmc_asym.kernels.quadrature import layer_functions
+
+
+def test_generated_file_is_up_to_date():
+    """Regenerate into a temp dir: any difference with the committed file fails."""
+    assert codegen.check() == 0
+
+
+def test_generated_header():
+    text = codegen.TARGET.read_text()
+    assert "GENERATED" in text and "DO NOT EDIT" in text and f"SymPy {sp.__version__}" in text
+
+
+def test_first_integral_and_b1_limits():
+    assert M.check_first_integral()
+    lims = M.b1_limits()
+    assert sp.simplify(lims["constant"] - M.A2 / (1 - sp.exp(-M.A2))) == 0
+
+
+rng = np.random.default_rng(1)
+
+
+@pytest.mark.parametrize("i", range(8))
+def test_b1_kernel_matches_sympy_root(i):
+    A2 = float(10 ** rng.uniform(-3, 2.8))
+    rho = float(rng.choice([0.0, 1.0, rng.uniform(0, 1)]))
+    eq = M.electroneutrality_equation().subs({M.A0: 1 - rho, M.A1: rho, M.A2: A2})
+    roots = [complex(r) for r in sp.Poly(eq, M.B1).nroots(n=30)]
+    pos = [r.real for r in roots if abs(r.imag) < 1e-12 and r.real > 0]
+    assert G.b1_exact(A2, rho) == pytest.approx(max(pos), rel=1e-11)
+
+
+@pytest.mark.parametrize("i", range(10))
+def test_w_and_dhat_kernels_match_sympy(i):
+    w, _ = M.w_layer()
+    wf = w.subs({M.exprel(M.y): M.EXPREL_DEF, M.e2rel(M.y): M.E2REL_DEF})
+    y = float(rng.uniform(-30, 6))
+    rho = float(rng.uniform(0, 1))
+    ref = complex(wf.subs({M.y: sp.Float(y, 40), M.rho: sp.Float(rho, 40)}).evalf(30)).real
+    assert G.w_layer(y, rho) == pytest.approx(ref, rel=1e-12)
+    d = M.dhat_stable().subs({M.exprel(M.Y): M.EXPREL_DEF.subs(M.y, M.Y), M.e2rel(M.Y): M.E2REL_DEF.subs(M.y, M.Y)})
+    refd = complex(d.subs({M.Y: sp.Float(y, 40), M.rho: sp.Float(rho, 40)}).evalf(30)).real
+    assert G.dhat(y, rho) == pytest.approx(refd, rel=1e-12)
+
+
+def test_linear_model_exact_polylogs_against_quadrature():
+    for Y in (-38.0, -5.0, -0.2, 0.4, 0.69):
+        W0, W1, _ = layer_functions(Y, 0.0)
+        assert G.w0_linear_exact(Y) == pytest.approx(W0, rel=1e-13)
+        assert G.w1_linear_exact(Y) == pytest.approx(W1, rel=1e-13)
+
+
+def test_depletion_constants_linear_are_zetas():
+    """rho = 0: K0 = zeta(2), K1 = zeta(3) exactly (W0 -> -Li2(1), W1 -> -Li3(1))."""
+    assert G.K0_LINEAR == pytest.approx(math.pi**2 / 6, rel=1e-14)
+    assert G.K1_LINEAR == pytest.approx(float(mp.zeta(3)), rel=1e-14)
+
+
+def test_factor_three_between_sections():
+    assert scaling.factor_three() == {"theta": 3, "w_small": 3, "F_block": 3}
