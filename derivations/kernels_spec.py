@@ -57,8 +57,48 @@ def base_kernels():
     return ks
 
 
+#: exact rho = A1/(A0 + A1) of the paper's models (eps0 = 5e-6, eps_moy - eps0 = 1e-3 F/m)
+MODEL_RHO = {"constant": sp.Integer(1), "linear": sp.Integer(0), "affine": sp.Rational(5, 1005)}
+
+
+def model_kernels():
+    """The same expressions with rho fixed per model (fewer operations on the hot path)."""
+    A2, A3, Y, B1 = M.A2, M.A3, M.Y, M.B1
+    q, a, b, c = M.b1_quadratic_rho()
+    qv = -expm1(-A2)
+    (W0c, W0a, W1c, W1a, Dc, cm), J1, J2 = M.moment_assembly()
+    ks = []
+    for name, r in MODEL_RHO.items():
+        ar, br, cr = (sp.simplify(v.subs(M.rho, r)) for v in (a, b, c))
+        if ar == 0:  # constant model: linear equation b B1 + c = 0
+            root = -cr / br
+        elif cr == 0:  # linear model: B1 (a B1 + b) = 0, positive root
+            root = -br / ar
+        else:  # b < 0 for rho < 1/2: no cancellation in (-b + sqrt(disc)) / (2a)
+            assert r < sp.Rational(1, 2)
+            root = (-br + sp.sqrt(br**2 - 4 * ar * cr)) / (2 * ar)
+        root = sp.simplify(root).subs(q, qv)
+        ks.append(Kernel(f"b1_{name}", (A2,), (root,), f"Exact B1, {name} model (rho = {r}).",
+                         "derivations.model:b1_quadratic_rho"))
+        dh = sp.simplify(M.dhat_stable().subs(M.rho, r))
+        if r == 0:
+            dh = sp.Abs(expm1(Y))  # |Y| exprel(Y) = |e^Y - 1|
+        ks.append(Kernel(f"dhat_{name}", (Y,), (dh,), f"Dhat(Y) = sqrt(2 Hhat(Y)), {name} model.",
+                         "derivations.model:dhat_stable"))
+        # the same Dhat from C = B1 directly (no exp): sqrt(2 Hhat(C)), fine when C - 1 is not small
+        Cs = sp.Symbol("C", positive=True)
+        Hc = M.H_of_C(Cs).subs({M.A0: 1 - r, M.A1: r})
+        ks.append(Kernel(f"dhat_from_c_{name}", (Cs, Y), (sp.sqrt(2 * Hc).subs(sp.log(Cs), Y),),
+                         f"Dhat = sqrt(2 Hhat(C)) with C = e^Y given (use when |Y| > 1/2), {name} model.",
+                         "derivations.model:H_of_C"))
+        ks.append(Kernel(f"assemble_j_{name}", (A2, A3, B1, cm, Dc, W0c, W0a, W1c, W1a),
+                         (J1.subs(M.rho, r), sp.expand(J2.subs(M.rho, r))),
+                         f"(J1, J2), {name} model.", "derivations.model:moment_assembly"))
+    return ks
+
+
 def all_kernels():
-    kernels = list(base_kernels())
+    kernels = list(base_kernels()) + model_kernels()
     from . import closed_forms
 
     ck, constants, tables = closed_forms.kernels()

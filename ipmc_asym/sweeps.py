@@ -145,9 +145,13 @@ def sweep(vary: dict, model="constant", fidelity="quadrature", base: Strip | Non
     show = (n * len(models) > 20000 or fidelity == "bvp") if progress is None else progress
     for m in models:
         perm = get_model(m)
-        r = moment(cols["thickness"], cols["voltage"], perm, fidelity, material=mats,
+        # I depends on (thickness, voltage) only: evaluate each distinct pair once
+        tv = np.stack([cols["thickness"], cols["voltage"]], axis=1)
+        uniq, inv = np.unique(tv, axis=0, return_inverse=True)
+        inv = np.asarray(inv).reshape(-1)
+        r = moment(uniq[:, 0], uniq[:, 1], perm, fidelity, material=mats,
                    progress=(show if fidelity == "bvp" else False))
-        I = np.asarray(r.I, dtype=float).reshape(n)
+        I = np.asarray(r.I, dtype=float)[inv]
         M = A5 * I
         with np.errstate(all="ignore"):
             b = solve_beam(M, cols["length"], EI, tol=tol)
@@ -161,9 +165,9 @@ def sweep(vary: dict, model="constant", fidelity="quadrature", base: Strip | Non
         for k in ("theta", "w", "w_small", "F_block", "F_block_small"):
             arr[k] = np.broadcast_to(np.asarray(getattr(b, k), dtype=float), (n,))
         arr["regime"] = np.broadcast_to(np.asarray(b.regime), (n,))
-        arr["B1"] = np.asarray(r.B1).reshape(n)
-        arr["error"] = np.asarray(r.error).reshape(n)
-        arr["valid"] = np.asarray(r.valid).reshape(n)
+        arr["B1"] = np.asarray(r.B1)[inv]
+        arr["error"] = np.asarray(r.error)[inv]
+        arr["valid"] = np.asarray(r.valid)[inv]
         out_parts.append(arr)
         if show and fidelity != "bvp":
             _bar(len(out_parts), len(models))

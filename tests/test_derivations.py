@@ -69,3 +69,8 @@ def test_depletion_constants_linear_are_zetas():
 
 def test_factor_three_between_sections():
     assert scaling.factor_three() == {"theta": 3, "w_small": 3, "F_block": 3}
+
+
+def test_linear_exact_solution_and_anode_statement():
+    Cz, b1, statement = M.linear_exact_solution()
+    assert "zeta(2)" in statement and "never in z" in statement

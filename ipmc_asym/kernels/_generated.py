@@ -188,6 +188,56 @@ def assemble_j(A2, A3, rho, B1, c_minus, Dhat_c, W0c, W0a, W1c, W1a):
 
 
 @jit
+def assemble_j_affine(A2, A3, B1, c_minus, Dhat_c, W0c, W0a, W1c, W1a):
+    """(J1, J2), affine model.
+
+    Derived in ``derivations.model:moment_assembly``.
+    """
+    t0 = (1.0/(A2))
+    return (t0*(-A3*(W0a - W0c) + 2.0*Dhat_c), A3*W1a*t0 - A3*W1c*t0 - 200.0/201.0*B1*t0 + (200.0/201.0)*c_minus*t0 - 1.0/201.0)
+
+
+@jit
+def assemble_j_constant(A2, A3, B1, c_minus, Dhat_c, W0c, W0a, W1c, W1a):
+    """(J1, J2), constant model.
+
+    Derived in ``derivations.model:moment_assembly``.
+    """
+    t0 = (1.0/(A2))
+    return (t0*(-A3*(W0a - W0c) + 2.0*Dhat_c), A3*W1a*t0 - A3*W1c*t0 - 1.0)
+
+
+@jit
+def assemble_j_linear(A2, A3, B1, c_minus, Dhat_c, W0c, W0a, W1c, W1a):
+    """(J1, J2), linear model.
+
+    Derived in ``derivations.model:moment_assembly``.
+    """
+    t0 = (1.0/(A2))
+    return (t0*(-A3*(W0a - W0c) + 2.0*Dhat_c), t0*(A3*W1a - A3*W1c - B1 + c_minus))
+
+
+@jit
+def b1_affine(A2):
+    """Exact B1, affine model (rho = 1/201).
+
+    Derived in ``derivations.model:b1_quadratic_rho``.
+    """
+    t0 = math.expm1(-A2)
+    t1 = t0 + 2.0
+    return -1.0/200.0*(-199.0*t0 + math.sqrt(-t0)*math.sqrt(400.0*A2*t1 - 39601.0*t0))/(t0*t1)
+
+
+@jit
+def b1_constant(A2):
+    """Exact B1, constant model (rho = 1).
+
+    Derived in ``derivations.model:b1_quadratic_rho``.
+    """
+    return -A2/math.expm1(-A2)
+
+
+@jit
 def b1_exact(A2, rho):
     """Exact B1 from electroneutrality H(ln B1) = H(ln B1 - A2) (all A2 > 0, rho in [0, 1]).
 
@@ -202,6 +252,15 @@ def b1_exact(A2, rho):
     t6 = math.sqrt(t0*(t0*t2*t2 + t3*t4*t5))
     t7 = t0*t2
     return ((-t5/(t0*t2 - t6)) if (t7 <= 0.0) else ((t6 + t7)/(t0*t3*t4)))
+
+
+@jit
+def b1_linear(A2):
+    """Exact B1, linear model (rho = 0).
+
+    Derived in ``derivations.model:b1_quadratic_rho``.
+    """
+    return 2.0/(math.expm1(-A2) + 2.0)
 
 
 @jit
@@ -244,6 +303,61 @@ def dhat(Y, rho):
     Derived in ``derivations.model:dhat_stable``.
     """
     return math.sqrt(rho*e2rel(Y) - (rho - 1.0)*exprel(Y)*exprel(Y))*abs(Y)
+
+
+@jit
+def dhat_affine(Y):
+    """Dhat(Y) = sqrt(2 Hhat(Y)), affine model.
+
+    Derived in ``derivations.model:dhat_stable``.
+    """
+    return (1.0/201.0)*math.sqrt(201.0)*math.sqrt(e2rel(Y) + 200.0*exprel(Y)*exprel(Y))*abs(Y)
+
+
+@jit
+def dhat_constant(Y):
+    """Dhat(Y) = sqrt(2 Hhat(Y)), constant model.
+
+    Derived in ``derivations.model:dhat_stable``.
+    """
+    return math.sqrt(e2rel(Y))*abs(Y)
+
+
+@jit
+def dhat_from_c_affine(C, Y):
+    """Dhat = sqrt(2 Hhat(C)) with C = e^Y given (use when |Y| > 1/2), affine model.
+
+    Derived in ``derivations.model:H_of_C``.
+    """
+    t0 = C - 1.0
+    return (1.0/201.0)*math.sqrt(402.0)*math.sqrt(-Y + 100.0*t0*t0 + t0)
+
+
+@jit
+def dhat_from_c_constant(C, Y):
+    """Dhat = sqrt(2 Hhat(C)) with C = e^Y given (use when |Y| > 1/2), constant model.
+
+    Derived in ``derivations.model:H_of_C``.
+    """
+    return math.sqrt(2.0)*math.sqrt(C - Y - 1.0)
+
+
+@jit
+def dhat_from_c_linear(C, Y):
+    """Dhat = sqrt(2 Hhat(C)) with C = e^Y given (use when |Y| > 1/2), linear model.
+
+    Derived in ``derivations.model:H_of_C``.
+    """
+    return abs(C - 1.0)
+
+
+@jit
+def dhat_linear(Y):
+    """Dhat(Y) = sqrt(2 Hhat(Y)), linear model.
+
+    Derived in ``derivations.model:dhat_stable``.
+    """
+    return abs(math.expm1(Y))
 
 
 @jit

@@ -73,6 +73,9 @@ def layer_closed(Y, model_id, need_w1):
 def moment_closed(lam, A2, A3, rho, model_id, order):
     """``I`` at order 1 (``leading``: lam J1) or 2 (``corrected``: lam J1 + lam^2 J2).
 
+    ``rho`` must be the model's own (``A1/(A0+A1)``: 1, 0, 5/1005); the per-model kernels
+    have it built in and the caller (:func:`ipmc_asym.moment.moment`) guarantees it.
+
     Returns
     -------
     I, error, B1, core : floats
@@ -81,14 +84,29 @@ def moment_closed(lam, A2, A3, rho, model_id, order):
         functions.  ``core`` (the neutral core length) is estimated from the depletion
         width ``lam * sqrt(2 (|Ya| - 1))`` and ``~ 10 lam`` per layer.
     """
-    B1 = G.b1_exact(A2, rho)
+    em = math.exp(-A2)
+    if model_id == 0:
+        B1 = G.b1_constant(A2)
+    elif model_id == 1:
+        B1 = G.b1_linear(A2)
+    else:
+        B1 = G.b1_affine(A2)
     Yc = math.log(B1)
     Ya = Yc - A2
-    cm = B1 * math.exp(-A2)
-    need = True  # J2 is needed for the error estimate at order 1 as well
-    W0c, W1c = layer_closed(Yc, model_id, need)
-    W0a, W1a = layer_closed(Ya, model_id, need)
-    J1, J2 = G.assemble_j(A2, A3, rho, B1, cm, G.dhat(Yc, rho), W0c, W0a, W1c, W1a)
+    cm = B1 * em
+    # J2 is needed for the error estimate at order 1 as well
+    W0c, W1c = layer_closed(Yc, model_id, True)
+    W0a, W1a = layer_closed(Ya, model_id, True)
+    big = Yc > 0.5  # C - 1 not small: Dhat straight from C = B1 (no exp, no cancellation)
+    if model_id == 0:
+        dh = G.dhat_from_c_constant(B1, Yc) if big else G.dhat_constant(Yc)
+        J1, J2 = G.assemble_j_constant(A2, A3, B1, cm, dh, W0c, W0a, W1c, W1a)
+    elif model_id == 1:
+        dh = G.dhat_from_c_linear(B1, Yc) if big else G.dhat_linear(Yc)
+        J1, J2 = G.assemble_j_linear(A2, A3, B1, cm, dh, W0c, W0a, W1c, W1a)
+    else:
+        dh = G.dhat_from_c_affine(B1, Yc) if big else G.dhat_affine(Yc)
+        J1, J2 = G.assemble_j_affine(A2, A3, B1, cm, dh, W0c, W0a, W1c, W1a)
     if order == 1:
         I = lam * J1
         err = abs(lam * J2 / J1) + TRUNCATION

@@ -34,6 +34,9 @@ def exprel(y):
     return math.expm1(y) / y
 
 
+_E2REL_TAYLOR = np.array([2.0 / math.factorial(k + 2) for k in range(15)])
+
+
 @jit
 def e2rel(y):
     """``2 (e^y - 1 - y) / y^2``, accurate for all real ``y <= 700``.
@@ -42,15 +45,11 @@ def e2rel(y):
     ``e^y - 1 - y``; elsewhere ``expm1(y) - y`` has no cancellation.
     """
     if abs(y) < 0.5:
-        # 2 * sum_{k>=0} y^k / (k+2)!   (18 terms: error < 0.5^18/20! ~ 1e-24)
-        s = 0.0
-        term = 1.0 / 2.0  # y^0 / 2!
-        k = 0
-        while k < 18:
-            s += term
-            term *= y / (k + 3)
-            k += 1
-        return 2.0 * s
+        # 2 * sum_{k>=0} y^k / (k+2)!  by Horner (15 terms: error < 0.5^15/17! ~ 1e-19)
+        acc = _E2REL_TAYLOR[14]
+        for k in range(13, -1, -1):
+            acc = acc * y + _E2REL_TAYLOR[k]
+        return acc
     if y > 700.0:
         return math.inf
     return 2.0 * (math.expm1(y) - y) / (y * y)

@@ -1,0 +1,48 @@
+import math
+
+import numpy as np
+import pytest
+
+from ipmc_asym.params import Strip
+from ipmc_asym.profiles import _crossing, layer_widths, profile_summary
+
+
+def test_crossing_linear_interp():
+    d = np.array([0.0, 1.0, 2.0])
+    assert _crossing(d, np.array([0.0, 0.4, 1.0]), 0.5) == pytest.approx(1.0 + 0.1 / 0.6)
+
+
+def test_layer_widths_on_synthetic_exponential_profile():
+    # C = 1 + (B1-1) exp(-(1-z)/lam) near the cathode: 1/e width = lam*e exactly
+    class R:
+        pass
+    r = R()
+    r.z = np.linspace(-1, 1, 200001)
+    lam, B1 = 0.01, 3.0
+    r.C = 1 + (B1 - 1) * np.exp(-(1 - r.z) / lam) - 0.9 * np.exp(-(r.z + 1) / lam)
+    w = layer_widths(r, 100e-6)
+    assert w["accumulation_um"] == pytest.approx(lam * 100, rel=1e-4)
+    assert w["accumulation_half_um"] == pytest.approx(lam * 100 * math.log(2), rel=1e-4)
+    # depletion: 1 - 0.9 exp(-d/lam) = 1/2 -> d = lam ln(1.8)
+    assert w["depletion_um"] == pytest.approx(lam * 100 * math.log(1.8), rel=1e-3)
+
+
+def test_profile_summary_constant_vs_closed_facts():
+    s = profile_summary("constant")
+    # B1 = A2 for the constant model (paper section 5), cathode value is C_bar(1)
+    assert s["B1"] == pytest.approx(96487.0 / (8.31 * 300.0), rel=1e-6)
+    # depletion width ~ Debye * sqrt(2 (A2 - ln A2 - 1)) (Mott-Schottky estimate), within 30 %
+    A2 = s["B1"]
+    est = s["debye_um"] * math.sqrt(2 * (A2 - math.log(A2) - 1))
+    assert 0.7 < s["depletion_um"] / est < 1.3
+    assert 0.1 < s["depletion_um"] < 0.5
+    assert s["accumulation_um"] < 0.05
+    assert s["D_core"] < 1e-10
+
+
+def test_linear_accumulation_is_z0():
+    # linear model: C-1 = (B1-1) sinh(z/z0)/sinh(1/z0) -> 1/e width = z0 e (paper section 5)
+    s = profile_summary("linear", Strip())
+    assert s["B1"] == pytest.approx(2.0, rel=1e-6)
+    z0_um = s["debye_um"]
+    assert s["accumulation_um"] == pytest.approx(z0_um, rel=0.02)

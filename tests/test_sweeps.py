@@ -1,0 +1,74 @@
+import numpy as np
+import pytest
+
+from ipmc_asym.estimate import evaluate
+from ipmc_asym.fits import fit_power_law, sweep_fits
+from ipmc_asym.params import Strip
+from ipmc_asym.sweeps import parse_vary, sweep
+
+
+def test_parse_vary():
+    k, v = parse_vary("length=1cm:4cm:16")
+    assert k == "length" and v.size == 16 and v[0] == pytest.approx(0.01) and v[-1] == pytest.approx(0.04)
+    k, v = parse_vary("thickness=10um:1mm:3:log")
+    assert np.allclose(v, [1e-5, 1e-4, 1e-3])
+    for bad in ("foo=1:2:3", "length=1cm:2cm", "length=1cm:2cm:x", "length"):
+        with pytest.raises(ValueError):
+            parse_vary(bad)
+
+
+@pytest.mark.parametrize("model", ["constant", "affine"])
+def test_sweep_rows_match_evaluate(model):
+    arr = sweep({"length": [0.01, 0.03], "voltage": [0.5, 2.0]}, model=model)
+    assert arr.size == 4
+    for rec in arr:
+        s = Strip(length=float(rec["length"]), voltage=float(rec["voltage"]))
+        ev = evaluate(s, model)
+        for k in ("I", "M_A", "theta", "w", "w_small", "F_block_small"):
+            assert rec[k] == pytest.approx(ev[k], rel=1e-12)
+        if ev["F_block"] is not None:
+            assert rec["F_block"] == pytest.approx(ev["F_block"], rel=1e-10)
+        assert rec["regime"] == ev["regime"]
+
+
+def test_sweep_modulus_and_all_models():
+    arr = sweep({"modulus": [1e8, 2e8]}, model="all")
+    assert arr.size == 6 and set(arr["model"]) == {"constant", "linear", "affine"}
+    c = arr[arr["model"] == "constant"]
+    assert c["theta"][0] / c["theta"][1] == pytest.approx(2.0)
+
+
+def test_fit_power_law_synthetic():
+    x = np.geomspace(1, 10, 20)
+    f = fit_power_law(x, -3.5 * x ** 1.7)
+    assert f["exponent"] == pytest.approx(1.7, abs=1e-12)
+    assert f["prefactor"] == pytest.approx(3.5, rel=1e-12)
+    assert f["r"] == pytest.approx(1.0, abs=1e-12)
+    f = fit_power_law(x, x ** 2, mask=x < 5)
+    assert f["n_left_out"] == int(np.sum(x >= 5))
+    y = x ** 1.2 * (1 + 0.05 * np.sin(7 * x))
+    assert fit_power_law(x, y)["r"] < 1.0
+
+
+def test_small_displacement_exponents_exact_and_quarter_turn_left_out():
+    arr = sweep({"length": np.linspace(0.01, 0.04, 16)}, model="affine")
+    fits = {f["quantity"]: f for f in sweep_fits(arr, ["length"])}
+    assert fits["w_small"]["exponent"] == pytest.approx(2.0, abs=1e-10)
+    assert fits["F_block_small"]["exponent"] == pytest.approx(-1.0, abs=1e-10)
+    assert fits["theta"]["exponent"] == pytest.approx(1.0, abs=1e-10)
+    n_out = int(np.sum(np.abs(arr["theta"]) > np.pi / 2))
+    assert n_out > 0 and fits["w"]["n_left_out"] == n_out
+    assert 1.7 < fits["w"]["exponent"] < 2.0
+
+
+def test_cli_sweep_json(capsys):
+    import json
+
+    from ipmc_asym.cli import main
+
+    rc = main(["sweep", "--vary", "length=1cm:3cm:3", "--json", "--model", "linear"])
+    assert rc == 0
+    d = json.loads(capsys.readouterr().out)
+    assert len(d["rows"]) == 3 and {"length", "I", "w", "F_block", "regime"} <= set(d["rows"][0])
+    assert any(f["quantity"] == "w_small" for f in d["fits"])
+    assert main(["sweep", "--vary", "bogus=1:2:3"]) == 2
