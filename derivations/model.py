@@ -197,8 +197,9 @@ def linear_exact_solution():
     statement = (
         "linear model at the anode: eps = A0 C -> A0 B1 e^{-A2} ~ 1e-16 A0, while D stays "
         "finite (D(-1) = z0 (1 - C(-1))): E = D/eps ~ e^{A2} at the face and ln C ~ ln(s + C(-1)) "
-        "with s the distance in units of z0, so the potential drops by O(1) across a sub-layer "
-        "of width ~ z0 e^{-A2} (~1e-19 e). The layer integrals stay finite: in y = ln C the "
+        "with s the distance in units of z0, so phi = (ln B1 - ln C)/A2 falls from 1 to ~0 "
+        "logarithmically in s, from s ~ e^{-A2} (~1e-17, i.e. ~1e-19 e) to s ~ 1 (half the drop "
+        "within s ~ e^{-A2/2}). The layer integrals stay finite: in y = ln C the "
         "integrand w = y e^y/(e^y - 1) is smooth and W0(-inf) = -zeta(2), W1(-inf) = -zeta(3); "
         "the kernels integrate in y, never in z."
     )
