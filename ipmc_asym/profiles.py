@@ -10,6 +10,10 @@ Layer widths (definitions used everywhere in the toolkit)
 ``depletion`` (anode)
     distance from the anode face ``z_bar = -1`` to the first point where ``C_bar`` rises
     through ``1/2`` (half the mean concentration) -- the "zone almost free of cations".
+``devoid`` (anode)
+    distance from the anode face to where ``C_bar`` rises through ``0.01``: the paper's
+    "zone presque totalement depourvue de cations" (section 6.1).  This is the width compared
+    with the paper's 0.2 um (constant) and 0.07 um (affine).
 ``accumulation`` (cathode)
     distance from the cathode face ``z_bar = +1`` to the point where the excess
     ``C_bar - 1`` has fallen to ``(B1 - 1)/e_N`` (``e_N`` = Euler's number), i.e. the 1/e
@@ -84,12 +88,13 @@ def layer_widths(res, e: float) -> dict:
     z, C = np.asarray(res.z), np.asarray(res.C)
     da = (z + 1.0) * e * 1e6  # from the anode, µm, increasing
     dep = _crossing(da, C, 0.5)
+    devoid = _crossing(da, C, 0.01)
     dc = ((1.0 - z) * e * 1e6)[::-1]  # from the cathode, increasing
     Cc = C[::-1] - 1.0
     B1m1 = Cc[0]
     acc = _crossing(dc, Cc, B1m1 / math.e)
     acc2 = _crossing(dc, Cc, 0.5 * B1m1)
-    return {"depletion_um": dep, "accumulation_um": acc, "accumulation_half_um": acc2}
+    return {"depletion_um": dep, "devoid_um": devoid, "accumulation_um": acc, "accumulation_half_um": acc2}
 
 
 def profile_summary(model="constant", strip: Strip | None = None, material: Material = NAFION_LI,
@@ -99,7 +104,7 @@ def profile_summary(model="constant", strip: Strip | None = None, material: Mate
     Returns
     -------
     dict
-        ``model``, ``B1`` (= C_bar at the cathode), ``C_anode``, ``depletion_um``,
+        ``model``, ``B1`` (= C_bar at the cathode), ``C_anode``, ``depletion_um``, ``devoid_um``,
         ``accumulation_um``, ``accumulation_half_um``, ``D_face`` (D_bar at the faces, equal by
         electroneutrality), ``D_core`` (|D_bar| max over the central half), ``p_anode``,
         ``p_cathode``, ``E_anode``, ``E_cathode``, ``I``, ``cathode_charge`` (F B1 C_moy, C/m^3),
@@ -245,12 +250,12 @@ def run(args) -> int:
         return 0
     print(f"profiles at L={strip.length:g} m, 2e={strip.thickness:g} m (e={strip.e:g} m), "
           f"phi0={strip.voltage:g} V; layer widths in µm from the face")
-    print(f"{'model':9s} {'depletion':>10s} {'accum(1/e)':>10s} {'accum(1/2)':>10s} {'B1':>9s} "
+    print(f"{'model':9s} {'devoid':>8s} {'depletion':>10s} {'accum(1/e)':>10s} {'accum(1/2)':>10s} {'B1':>9s} "
           f"{'Debye':>8s} {'paper dep':>9s} {'paper acc':>9s}")
     for s in out["summaries"]:
         pd = PAPER_LAYERS.get((s["model"], "depletion"))
         pa = PAPER_LAYERS.get((s["model"], "accumulation"))
-        print(f"{s['model']:9s} {s['depletion_um']:10.4g} {s['accumulation_um']:10.4g} "
+        print(f"{s['model']:9s} {s['devoid_um']:8.4g} {s['depletion_um']:10.4g} {s['accumulation_um']:10.4g} "
               f"{s['accumulation_half_um']:10.4g} {s['B1']:9.4g} {s['debye_um']:8.3g} "
               f"{(pd if pd is not None else float('nan')):9.3g} {(pa if pa is not None else float('nan')):9.3g}")
     for f in out["files"]:

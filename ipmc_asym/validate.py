@@ -94,12 +94,17 @@ def claims(material: Material = NAFION_LI, strip: Strip | None = None) -> list[d
     for mm, kind, val in (("constant", "depletion", 0.2), ("affine", "depletion", 0.07),
                           ("constant", "accumulation", 0.2), ("linear", "accumulation", 2.0),
                           ("affine", "accumulation", 2.0)):
-        ours = sums[mm][f"{kind}_um"]
-        extra = f" (half-excess width {sums[mm]['accumulation_half_um']:.3g} um)" if kind == "accumulation" else ""
+        if kind == "depletion":  # the paper: "zone presque totalement depourvue de cations"
+            ours = sums[mm]["devoid_um"]
+            extra = (f" (C_bar < 0.01 from the anode; where C_bar reaches 1/2: "
+                     f"{sums[mm]['depletion_um']:.3g} um)")
+        else:
+            ours = sums[mm]["accumulation_um"]
+            extra = (f" (C_bar-1 down to (B1-1)/e from the cathode; half-excess width "
+                     f"{sums[mm]['accumulation_half_um']:.3g} um)")
         ok = 0.5 <= ours / val <= 2.0
         rows.append(_row(f"{kind} layer width, {mm} model", "§6.1", f"{val} um",
-                         f"{ours:.3g} um{extra}; depletion = C_bar<1/2 from anode, accumulation = C_bar-1 "
-                         "down to (B1-1)/e from cathode", _v(ok), f"layer_{kind}_{mm}"))
+                         f"{ours:.3g} um{extra}", _v(ok), f"layer_{kind}_{mm}"))
     b = {mm: sums[mm]["B1"] for mm in MODELS3}
     rr = b["constant"] / b["linear"], b["constant"] / b["affine"]
     rows.append(_row("cathode concentration 20x larger for constant than linear/affine", "§6.1", "x20",
