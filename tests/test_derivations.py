@@ -74,3 +74,60 @@ def test_factor_three_between_sections():
 def test_linear_exact_solution_and_anode_statement():
     Cz, b1, statement = M.linear_exact_solution()
     assert "zeta(2)" in statement and "never in z" in statement
+
+
+# ---- every generated kernel against its SymPy expression at random points -------------------
+_DOMAINS = {  # argument name -> sampler (the physical range of each argument)
+    "A2": lambda r: float(10 ** r.uniform(-3, 2.8)),
+    "A3": lambda r: float(r.uniform(0.1, 0.5)),
+    "rho": lambda r: float(r.uniform(0, 1)),
+    "B1": lambda r: float(r.uniform(1.01, 40)),
+    "c_minus": lambda r: float(r.uniform(0, 1e-3)),
+    "Dhat_c": lambda r: float(r.uniform(0, 10)),
+    "W0c": lambda r: float(r.uniform(0, 5)),
+    "W0a": lambda r: float(r.uniform(-50, 0)),
+    "W1c": lambda r: float(r.uniform(0, 5)),
+    "W1a": lambda r: float(r.uniform(-300, 0)),
+    "y": lambda r: float(r.uniform(-30, 6)),
+    "C": lambda r: float(r.uniform(1.7, 40)),
+}
+_Y_DOMAIN = {"depletion": (-200.0, -31.0), "accumulation": (9.0, 30.0), "dhat_from_c": None}
+
+
+@__import__("functools").lru_cache(maxsize=1)
+def _kernel_cases():
+    from derivations import kernels_spec
+
+    kernels, constants, _ = kernels_spec.all_kernels()
+    return kernels, constants
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_all_generated_kernels_match_sympy(seed):
+    kernels, constants = _kernel_cases()
+    r = np.random.default_rng(100 + seed)
+    subs_const = {sp.Symbol(k): sp.Float(float(v), 30) for k, v in constants.items()}
+    special = {"exprel": lambda x: mp.expm1(x) / x, "e2rel": lambda x: 2 * (mp.expm1(x) - x) / x**2,
+               "li2": lambda x: mp.polylog(2, x), "li3": lambda x: mp.polylog(3, x),
+               "expm1": mp.expm1}
+    for k in kernels:
+        fn = getattr(G, k.name)
+        vals = {}
+        for a in k.args:
+            name = str(a)
+            if name == "Y":
+                lo, hi = next((v for p, v in _Y_DOMAIN.items() if k.name.startswith(p) and v), (-30.0, 6.0))
+                vals[a] = float(r.uniform(lo, hi))
+            else:
+                vals[a] = _DOMAINS[name](r)
+        if k.name.startswith("dhat_from_c"):  # C = e^Y by contract
+            vals[k.args[1]] = math.log(vals[k.args[0]])
+        got = fn(*[vals[a] for a in k.args])
+        got = got if isinstance(got, tuple) else (got,)
+        for out, g in zip(k.outputs, got):
+            ex = out.subs(subs_const)
+            f = sp.lambdify(k.args, ex, modules=[special, "mpmath"])
+            with mp.workdps(30):
+                ref = complex(f(*[mp.mpf(vals[a]) for a in k.args]))
+            assert abs(ref.imag) < 1e-20 * max(1.0, abs(ref.real))
+            assert g == pytest.approx(ref.real, rel=1e-11, abs=1e-13), (k.name, vals)
