@@ -93,6 +93,19 @@ def w_series(c, rho, n):
     return s_mul(eh, s_invsqrt(Q))
 
 
+def sqrtq_series(rho, n):
+    """Taylor coefficients of sqrt(Qhat(y)) at y = 0 (Dhat(Y) = |Y| sqrt(Qhat(Y)))."""
+    exprel = [1 / mp.factorial(k + 1) for k in range(n)]
+    e2rel = [2 / mp.factorial(k + 2) for k in range(n)]
+    Q = [(1 - rho) * v for v in s_mul(exprel, exprel)]
+    Q = [Q[k] + rho * e2rel[k] for k in range(n)]
+    return s_mul(Q, s_invsqrt(Q))
+
+
+#: terms of the sqrt(Qhat) series used for |Y| <= 1/2 (radius >= 6: error < 12^-16)
+N_SQRTQ = 16
+
+
 def w_value(y, rho):
     y = mp.mpf(y)
     if abs(y) < mp.mpf("1e-6"):  # series: avoids 0/0 at working precision
@@ -266,6 +279,7 @@ def kernels():
         consts[f"W0INF_{name.upper()}"] = W0inf
         consts[f"W1INF_{name.upper()}"] = W1inf
     tables["_kmin"], tables["_kmax"] = K_MIN, K_MAX
+    tables["_sqrtq"] = {name: sqrtq_series(RHO[name], N_SQRTQ) for name in RHO}
     accY = sp.Symbol("Y")
     W0i, W1i = sp.Symbol("W0INF_CONSTANT"), sp.Symbol("W1INF_CONSTANT")
     ks.append(Kernel(

@@ -121,6 +121,10 @@ def render_module(kernels, constants: dict, tables: dict | None = None) -> str:
     if tables:
         consts += "\n# Taylor patches about Y = 2k, k = K_MIN..K_MAX: rows = patches, columns = powers of (Y - 2k)\n"
         consts += f"K_MIN = {tables['_kmin']}\nK_MAX = {tables['_kmax']}\n"
+        consts += "\n# Taylor coefficients of sqrt(Qhat(Y)) at Y = 0 (Dhat = |Y| sqrt(Qhat)), |Y| <= 1/2\n"
+        for name in sorted(tables["_sqrtq"]):
+            vals = ", ".join(repr(float(v)) for v in tables["_sqrtq"][name])
+            consts += f"SQRTQ_{name.upper()} = np.array([{vals}])\n"
         for name in sorted(k for k in tables if not k.startswith("_")):
             w0, w1 = tables[name]
             consts += "\n" + _table(f"PATCH_W0_{name.upper()}", w0) + "\n"

@@ -77,8 +77,10 @@ def model_kernels():
         else:  # b < 0 for rho < 1/2: no cancellation in (-b + sqrt(disc)) / (2a)
             assert r < sp.Rational(1, 2)
             root = (-br + sp.sqrt(br**2 - 4 * ar * cr)) / (2 * ar)
-        root = sp.simplify(root).subs(q, qv)
-        ks.append(Kernel(f"b1_{name}", (A2,), (root,), f"Exact B1, {name} model (rho = {r}).",
+        em1 = sp.Symbol("em1")  # expm1(-A2), computed once by the caller (also gives e^{-A2})
+        root = (sp.simplify(root) if ar == 0 or cr == 0 else root).subs(q, -em1)
+        ks.append(Kernel(f"b1_{name}", (A2, em1), (root,),
+                         f"Exact B1, {name} model (rho = {r}); em1 = expm1(-A2).",
                          "derivations.model:b1_quadratic_rho"))
         dh = sp.simplify(M.dhat_stable().subs(M.rho, r))
         if r == 0:

@@ -110,6 +110,17 @@ def groups_arrays(thickness, voltage, perm: Permittivity, material: Material):
     return lam, A2, A3, rho, np.sign(v)
 
 
+@jit
+def _core_error(core, lam):
+    """Relative error of the neutral-core assumption, ~4 exp(-core/lam).
+
+    Skips exp() where it would underflow: glibc's underflow path is ~10x slower and this
+    sits on the hot path of every sweep.
+    """
+    x = max(core, 0.0) / lam
+    return 4.0 * math.exp(-x) if x < 700.0 else 0.0
+
+
 @jit_parallel
 def _sweep_quadrature(lam, A2, A3, rho, sign, I, err, B1, core):
     for i in prange(lam.size):
@@ -122,7 +133,7 @@ def _sweep_quadrature(lam, A2, A3, rho, sign, I, err, B1, core):
         Ii, J1, J2, b1, c = moment_quadrature(lam[i], A2[i], A3, rho)
         I[i] = sign[i] * Ii
         # neglected core interaction: exponentially small in core/lambda (see docs)
-        err[i] = 4.0 * math.exp(-max(c, 0.0) / lam[i]) + 1e-14
+        err[i] = _core_error(c, lam[i]) + 1e-14
         B1[i] = b1
         core[i] = c
 
@@ -138,7 +149,7 @@ def _sweep_closed(lam, A2, A3, rho, model_id, order, sign, I, err, B1, core):
             continue
         Ii, e_i, b1, c = moment_closed(lam[i], A2[i], A3, rho, model_id, order)
         I[i] = sign[i] * Ii
-        err[i] = e_i + 4.0 * math.exp(-max(c, 0.0) / lam[i])
+        err[i] = e_i + _core_error(c, lam[i])
         B1[i] = b1
         core[i] = c
 

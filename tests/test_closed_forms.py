@@ -23,7 +23,7 @@ def test_patches_and_asymptotics_match_quadrature(mid):
     if mid == 0:
         Ys = np.concatenate([Ys, np.linspace(2, 8.9, 50)])
     for Y in Ys:
-        a, b = layer_closed(Y, mid, True)
+        a, b = layer_closed(Y, mid, 2)
         c, d, _ = layer_functions(Y, RHO[mid])
         assert abs(a - c) <= 1e-11 * max(abs(c), 1e-300)
         assert abs(b - d) <= 1e-10 * max(abs(d), 1e-300)

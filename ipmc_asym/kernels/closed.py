@@ -45,8 +45,38 @@ def _patch_tables(model_id):
 
 
 @jit
+def _poly(c, x):
+    acc = c[c.shape[0] - 1]
+    for k in range(c.shape[0] - 2, -1, -1):
+        acc = acc * x + c[k]
+    return acc
+
+
+@jit
+def _horner_n(tab, row, h, n):
+    """The first ``n`` terms only (an estimate, for error bars)."""
+    acc = tab[row, n - 1]
+    for k in range(n - 2, -1, -1):
+        acc = acc * h + tab[row, k]
+    return acc
+
+
+#: terms of the patches used at order 1 (``leading``), whose own error lam J2/J1 is
+#: >~1e-5 anyway: W0 to ~(1/6)^9 ~ 1e-7 (the patches' ratio to the radius is <= 1/6), and
+#: W1, which only feeds the error estimate, to ~(1/6)^5 ~ 1e-4
+N_W0_LEADING = 9
+N_W1_ESTIMATE = 5
+#: truncation of W0 at order 1 (added to the error estimate)
+TRUNCATION_LEADING = 1e-6
+
+
+@jit
 def layer_closed(Y, model_id, need_w1):
-    """``(W0(Y), W1(Y))`` from the closed forms (W1 = 0 when ``need_w1`` is False)."""
+    """``(W0(Y), W1(Y))`` from the closed forms.
+
+    ``need_w1``: 2 = full accuracy for both; 1 = the order-1 (``leading``) accuracy: W0 to
+    ~1e-7 and W1 to ~1e-4 (for the error estimate only).
+    """
     if Y < 2.0 * _KMIN - 1.0:
         if model_id == 0:
             return G.depletion_constant(Y)
@@ -64,9 +94,9 @@ def layer_closed(Y, model_id, need_w1):
     h = Y - 2.0 * k
     t0, t1 = _patch_tables(model_id)
     row = k - _KMIN
-    w0 = _horner(t0, row, h)
-    w1 = _horner(t1, row, h) if need_w1 else 0.0
-    return w0, w1
+    if need_w1 == 2:
+        return _horner(t0, row, h), _horner(t1, row, h)
+    return _horner_n(t0, row, h, N_W0_LEADING), _horner_n(t1, row, h, N_W1_ESTIMATE)
 
 
 @jit
@@ -84,32 +114,36 @@ def moment_closed(lam, A2, A3, rho, model_id, order):
         functions.  ``core`` (the neutral core length) is estimated from the depletion
         width ``lam * sqrt(2 (|Ya| - 1))`` and ``~ 10 lam`` per layer.
     """
-    em = math.exp(-A2)
+    em1 = math.expm1(-A2)
+    em = 1.0 + em1  # e^{-A2}: absolute error 1e-16, all that B1 - B1 e^{-A2} needs
     if model_id == 0:
-        B1 = G.b1_constant(A2)
+        B1 = G.b1_constant(A2, em1)
     elif model_id == 1:
-        B1 = G.b1_linear(A2)
+        B1 = G.b1_linear(A2, em1)
     else:
-        B1 = G.b1_affine(A2)
+        B1 = G.b1_affine(A2, em1)
     Yc = math.log(B1)
     Ya = Yc - A2
     cm = B1 * em
-    # J2 is needed for the error estimate at order 1 as well
-    W0c, W1c = layer_closed(Yc, model_id, True)
-    W0a, W1a = layer_closed(Ya, model_id, True)
-    big = Yc > 0.5  # C - 1 not small: Dhat straight from C = B1 (no exp, no cancellation)
+    # at order 1, J2 only feeds the error estimate: W1 to ~1e-6 is enough
+    acc = 2 if order == 2 else 1
+    W0c, W1c = layer_closed(Yc, model_id, acc)
+    W0a, W1a = layer_closed(Ya, model_id, acc)
+    # Dhat: straight from C = B1 when C - 1 is not small (no exp, no cancellation), else the
+    # Taylor series of sqrt(Qhat) at 0 (no exp either)
+    big = Yc > 0.5
     if model_id == 0:
-        dh = G.dhat_from_c_constant(B1, Yc) if big else G.dhat_constant(Yc)
+        dh = G.dhat_from_c_constant(B1, Yc) if big else Yc * _poly(G.SQRTQ_CONSTANT, Yc)
         J1, J2 = G.assemble_j_constant(A2, A3, B1, cm, dh, W0c, W0a, W1c, W1a)
     elif model_id == 1:
-        dh = G.dhat_from_c_linear(B1, Yc) if big else G.dhat_linear(Yc)
+        dh = G.dhat_from_c_linear(B1, Yc) if big else Yc * _poly(G.SQRTQ_LINEAR, Yc)
         J1, J2 = G.assemble_j_linear(A2, A3, B1, cm, dh, W0c, W0a, W1c, W1a)
     else:
-        dh = G.dhat_from_c_affine(B1, Yc) if big else G.dhat_affine(Yc)
+        dh = G.dhat_from_c_affine(B1, Yc) if big else Yc * _poly(G.SQRTQ_AFFINE, Yc)
         J1, J2 = G.assemble_j_affine(A2, A3, B1, cm, dh, W0c, W0a, W1c, W1a)
     if order == 1:
         I = lam * J1
-        err = abs(lam * J2 / J1) + TRUNCATION
+        err = abs(lam * J2 / J1) + TRUNCATION_LEADING
     else:
         I = lam * J1 + lam * lam * J2
         err = TRUNCATION * (1.0 + abs(lam * J2 / J1))
