@@ -8,9 +8,36 @@ instead of compiling.
 
 from __future__ import annotations
 
+import hashlib
+import os
+from pathlib import Path
+
 import numba as nb
 
-__all__ = ["jit", "jit_parallel", "prange"]
+__all__ = ["jit", "jit_parallel", "prange", "CACHE_DIR"]
+
+
+def _cache_dir() -> str:
+    """Numba's on-disk cache, keyed by a hash of this package's sources.
+
+    Numba invalidates a cached function when ITS file changes, not when a function it
+    calls from another module does (a sweep driver in moment.py inlines the kernels of
+    kernels/*.py).  Keying the whole cache on the package's sources makes any edit or
+    upgrade start from a clean cache.  ``NUMBA_CACHE_DIR``, if set, wins.
+    """
+    if os.environ.get("NUMBA_CACHE_DIR"):
+        return os.environ["NUMBA_CACHE_DIR"]
+    here = Path(__file__).resolve().parent
+    h = hashlib.sha256()
+    for p in sorted(here.rglob("*.py")):
+        h.update(p.relative_to(here).as_posix().encode())
+        h.update(p.read_bytes())
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return os.path.join(base, "ipmc_asym", f"numba-{nb.__version__}-{h.hexdigest()[:16]}")
+
+
+CACHE_DIR = _cache_dir()
+nb.config.CACHE_DIR = CACHE_DIR
 
 prange = nb.prange
 

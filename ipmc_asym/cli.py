@@ -127,12 +127,11 @@ def _register_estimate(sub):
 def _first_run_notice():
     """Numba compiles on the first run after install: say so instead of hanging silently."""
     import os
-    from pathlib import Path
 
-    here = Path(__file__).parent / "kernels"
-    cached = any(p.suffix in (".nbi", ".nbc") for d in (here / "__pycache__",) if d.is_dir() for p in d.iterdir())
-    if not cached and not os.environ.get("NUMBA_CACHE_DIR"):
-        sys.stderr.write("ipmc-asym: compiling the Numba kernels (first run only, ~10-30 s)...\n")
+    from ._jit import CACHE_DIR
+
+    if not (os.path.isdir(CACHE_DIR) and any(f.endswith(".nbi") for _, _, fs in os.walk(CACHE_DIR) for f in fs)):
+        sys.stderr.write("ipmc-asym: compiling the Numba kernels (first run after install, ~10-30 s)...\n")
 
 
 def _run_estimate(args):
