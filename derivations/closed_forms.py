@@ -250,7 +250,7 @@ def kernels():
     from sympy.codegen.cfunctions import expm1
 
     ks, consts = [], {}
-    Y, y = M.Y, M.y
+    Y = M.Y
     # linear exact (polylogs) -- independent check of the patches
     W0l, W1l = linear_exact()
     li2, li3 = sp.Function("li2"), sp.Function("li3")

@@ -10,7 +10,7 @@ from .codegen import Kernel
 
 
 def base_kernels():
-    A2, A3, rho, Y, y, B1, lam = M.A2, M.A3, M.rho, M.Y, M.y, M.B1, M.lam
+    A2, A3, rho, Y, y, B1 = M.A2, M.A3, M.rho, M.Y, M.y, M.B1
     q, a, b, c = M.b1_quadratic_rho()
     qv = -expm1(-A2)
     disc = b**2 - 4 * a * c
@@ -65,7 +65,6 @@ def model_kernels():
     """The same expressions with rho fixed per model (fewer operations on the hot path)."""
     A2, A3, Y, B1 = M.A2, M.A3, M.Y, M.B1
     q, a, b, c = M.b1_quadratic_rho()
-    qv = -expm1(-A2)
     (W0c, W0a, W1c, W1a, Dc, cm), J1, J2 = M.moment_assembly()
     ks = []
     for name, r in MODEL_RHO.items():

@@ -33,6 +33,7 @@ import tempfile
 import time
 
 import numpy as np
+from .jsonio import dumps as _jdumps
 
 __all__ = ["run_bench", "sample_points", "plot_speed_accuracy", "format_table", "TARGETS", "register", "run"]
 
@@ -376,7 +377,7 @@ def run(args) -> int:
     if args.figure:
         res["figure"] = plot_speed_accuracy(res, args.figure)
     if args.json:
-        print(json.dumps(res, indent=2))
+        print(_jdumps(res, indent=2))
     else:
         print(format_table(res))
         if args.figure:

@@ -10,8 +10,8 @@ from __future__ import annotations
 
 import argparse
 import importlib
-import json
 import sys
+from .jsonio import dumps as _jdumps
 
 __all__ = ["main", "UsageError"]
 
@@ -39,36 +39,34 @@ class _Parser(argparse.ArgumentParser):
         raise SystemExit(2)
 
 
-def _len(name):
-    from .units import parse_length
+def _positive(name, kind, example):
+    """argparse type: a quantity of ``kind`` ("length", "pressure") with units, > 0."""
+    from . import units
+
+    parse = {"length": units.parse_length, "pressure": units.parse_pressure}[kind]
 
     def f(text):
-        v = parse_length(name, text)
+        v = parse(name, text)
         if v <= 0:
-            raise argparse.ArgumentTypeError(f"{name} must be > 0 (e.g. 200um, 2cm); got {text!r}")
+            raise argparse.ArgumentTypeError(f"{name} must be > 0 (e.g. {example}); got {text!r}")
         return v
 
     f.__name__ = name
     return f
+
+
+def _len(name):
+    return _positive(name, "length", "200um, 2cm")
+
+
+def _pos(name):
+    return _positive(name, "pressure", "130MPa")
 
 
 def _volt(text):
     from .units import parse_voltage
 
     return parse_voltage("voltage", text)
-
-
-def _pos(name):
-    from .units import parse_pressure
-
-    def f(text):
-        v = parse_pressure(name, text)
-        if v <= 0:
-            raise argparse.ArgumentTypeError(f"{name} must be > 0; got {text!r}")
-        return v
-
-    f.__name__ = name
-    return f
 
 
 def _wrap(conv):
@@ -149,7 +147,7 @@ def _run_estimate(args):
         "I_p": strip.I_p, "material": material.name,
     }
     if args.json:
-        print(json.dumps({"inputs": inputs, "results": rows}, indent=2))
+        print(_jdumps({"inputs": inputs, "results": rows}, indent=2))
         return 0
     from .units import fmt_length
 

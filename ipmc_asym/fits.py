@@ -59,6 +59,8 @@ def fit_power_law(x, y, mask=None) -> dict:
     out = {"exponent": float("nan"), "prefactor": float("nan"), "r": float("nan"), "n": n,
            "n_left_out": int(x.size - n)}
     if n < 2:
+        out["note"] = (f"only {n} usable point(s) (others past a quarter turn, zero or non-finite): "
+                       "no fit")
         return out
     lx, ly = np.log(x[keep]), np.log(y[keep])
     A = np.vstack([lx, np.ones_like(lx)]).T

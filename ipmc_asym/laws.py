@@ -8,9 +8,9 @@ the range where it holds is stated.
 
 from __future__ import annotations
 
-import json
 
 import numpy as np
+from .jsonio import dumps as _jdumps
 
 __all__ = ["local_exponents", "law_table", "law_ranges", "register", "run"]
 
@@ -109,7 +109,7 @@ def run(args):
     for m in models:
         data["models"][m] = {"laws": law_table(m), "ranges": law_ranges(m)}
     if args.json:
-        print(json.dumps(data, indent=2))
+        print(_jdumps(data, indent=2))
         return 0
     print("Leading-order scaling laws (SI; e = HALF thickness, l = HALF width; M_A = A5 I).")
     print(f"Prefactors of theta, w_p, F^p from sections 3-4 are {factor} x the paper's section 6.2 ones;"

@@ -31,7 +31,7 @@ import numpy as np
 from ._jit import jit, jit_parallel, prange
 from .kernels.closed import MODEL_IDS, moment_closed
 from .kernels.quadrature import moment_quadrature
-from .params import NAFION_LI, Material, check_finite
+from .params import NAFION_LI, Material
 from .permittivity import Permittivity, get_model
 
 __all__ = ["FIDELITIES", "MomentResult", "moment_integral", "moment", "groups_arrays", "check_fidelity"]

@@ -34,6 +34,7 @@ import os
 import numpy as np
 
 from .params import NAFION_LI, Material, Strip
+from .jsonio import dumps as _jdumps
 
 __all__ = ["MODELS3", "QUANTITIES", "profile", "layer_widths", "profile_summary", "write_csv",
            "plot_profiles", "register", "run", "PAPER_LAYERS"]
@@ -235,7 +236,6 @@ def register(sub):
 
 
 def run(args) -> int:
-    import json
 
     from .cli import material_from_args, strip_from_args
 
@@ -246,7 +246,7 @@ def run(args) -> int:
     models = MODELS3 if args.model == "all" else (args.model,)
     out = write_all(args.out, models, strip, mat)
     if args.json:
-        print(json.dumps(out, indent=2))
+        print(_jdumps(out, indent=2))
         return 0
     print(f"profiles at L={strip.length:g} m, 2e={strip.thickness:g} m (e={strip.e:g} m), "
           f"phi0={strip.voltage:g} V; layer widths in µm from the face")

@@ -57,12 +57,12 @@ Module-level imports are stdlib + numpy only.
 
 from __future__ import annotations
 
-import json
 import math
 import os
 import sys
 
 import numpy as np
+from .jsonio import dumps as _jdumps
 
 __all__ = ["run_scene", "load_scene", "OUTPUTS", "LADDER", "register", "run"]
 
@@ -449,7 +449,7 @@ def run(args) -> int:
     """Run ``ipmc-asym scene``."""
     res = run_scene(args.file)
     if args.json:
-        print(json.dumps(res, indent=2))
+        print(_jdumps(res, indent=2))
         return 0
     print(f"scene {res['scene']!r}: model {res['model']}, tolerance {res['tolerance']:g}, "
           f"{len(res['points'])} point(s), swept: {', '.join(res['swept']) or 'nothing'}")

@@ -20,13 +20,13 @@ Layer rule: stdlib + numpy at import.
 from __future__ import annotations
 
 import csv
-import json
 import sys
 import time
 
 import numpy as np
 
 from .params import NAFION_LI, Material, Strip
+from .jsonio import dumps as _jdumps
 
 __all__ = ["VARIABLES", "parse_vary", "sweep", "write_csv", "rows_as_dicts", "register", "run"]
 
@@ -254,7 +254,7 @@ def run(args) -> int:
         write_csv(arr, args.out)
         sys.stderr.write(f"sweep: {arr.size} rows in {dt:.3g} s -> {args.out}\n")
     if args.json:
-        print(json.dumps({"rows": rows_as_dicts(arr), "fits": fits, "seconds": dt}, indent=1))
+        print(_jdumps({"rows": rows_as_dicts(arr), "fits": fits, "seconds": dt}, indent=1))
     elif not args.out:
         write_csv(arr, "-")
     if not args.json and fits:

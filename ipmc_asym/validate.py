@@ -12,12 +12,12 @@ Runs in a few seconds.  Layer rule: stdlib + numpy at import.
 
 from __future__ import annotations
 
-import json
 import math
 
 import numpy as np
 
 from .params import NAFION_LI, Material, Strip
+from .jsonio import dumps as _jdumps
 
 __all__ = ["claims", "to_markdown", "register", "run", "VERDICTS"]
 
@@ -269,7 +269,7 @@ def run(args) -> int:
         with open(args.out, "w") as fh:
             fh.write(to_markdown(rows))
     if args.json:
-        print(json.dumps({"claims": [{k: r[k] for k in ("claim", "section", "paper", "ours", "verdict", "key")}
+        print(_jdumps({"claims": [{k: r[k] for k in ("claim", "section", "paper", "ours", "verdict", "key")}
                                      for r in rows]}, indent=2))
     else:
         for r in rows:

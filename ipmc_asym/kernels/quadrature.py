@@ -38,7 +38,6 @@ def _layer(Y, rho, X, Wt, S):
     sgn = 1.0 if Y >= 0.0 else -1.0
     T = abs(Y)
     f = np.empty(n)
-    g = np.empty(n)
     W0 = 0.0
     W1 = 0.0
     width = 0.0
