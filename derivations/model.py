@@ -168,6 +168,13 @@ def table_of_values():
     # the paper's D(+-1) holds for the paper's approximations: e^{-A2} -> 0 and
     # A0 (B1-2) B1 = 2 A1 (A2 - B1) (its own B1 equation); check at the linear/const limits
     lin = sp.simplify((Dm**2 - paper_D**2).subs(A1, 0).subs(B1, 2).subs(sp.exp(-A2), 0))
+    # the paper's D(+-1) is exactly our anode value with C(-1) -> 0 outside the logarithm
+    # (ln C(-1) = ln B1 - A2 kept): H(C(-1)) -> A0/2 + A1 (A2 - ln B1 - 1)
+    cm_ = sp.Symbol("c_m", positive=True)
+    Hm = A0 * (cm_ - 1) ** 2 / 2 + A1 * (cm_ - 1 - (sp.log(B1) - A2))
+    assert sp.simplify(2 * Hm.subs(cm_, 0) / A2 - paper_D**2) == 0
+    # and the paper's E(-1) = D/A1, E(1) = D/(A0 B1 + A1) are D/eps at the faces
+    assert sp.simplify((A0 * C_p + A1) - (A0 * B1 + A1)) == 0
     rows = {
         "C": (C_m, C_c, C_p),
         "phi": (1, sp.log(B1) / A2, 0),
@@ -175,6 +182,7 @@ def table_of_values():
         "rhoZ": (C_m - 1, 0, B1 - 1),
         "p (B2=0)": (C_m / A2 - A3, 1 / A2 - A3 * sp.log(B1) / A2, B1 / A2),
         "D": (Dm, 0, sp.sqrt(D2(C_p))),
+        "E": (Dm / (A0 * C_m + A1), 0, sp.sqrt(D2(C_p)) / (A0 * B1 + A1)),
     }
     return rows, {"paper_D_linear_limit_residual": lin}
 

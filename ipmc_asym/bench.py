@@ -35,7 +35,7 @@ import time
 import numpy as np
 from .jsonio import dumps as _jdumps
 
-__all__ = ["run_bench", "sample_points", "plot_speed_accuracy", "format_table", "TARGETS", "register", "run"]
+__all__ = ["run_bench", "sample_points", "plot_speed_accuracy", "speed_accuracy_figure", "format_table", "TARGETS", "register", "run"]
 
 MODELS = ("constant", "linear", "affine")
 FAST = ("leading", "corrected", "quadrature")
@@ -155,6 +155,36 @@ def _compile_times(fidelity_group: str):
     return out[0], out[1]
 
 
+#: issue target: a quick estimate in a fresh process, Numba cache warm
+STARTUP_TARGET_S = 1.5
+
+
+def startup_time(repeats: int = 3) -> dict:
+    """Wall time of ``ipmc-asym estimate --fidelity leading`` in a fresh process (cache warm).
+
+    One untimed run first fills the cache; the best of ``repeats`` timed runs is reported,
+    with the heavy modules that process imported (must not include SymPy, SciPy's
+    ``integrate`` or matplotlib).
+    """
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    env = dict(os.environ)
+    env["PYTHONPATH"] = root + (os.pathsep + env["PYTHONPATH"] if env.get("PYTHONPATH") else "")
+    code = ("import sys; from ipmc_asym.cli import main; rc = main(['estimate', '--fidelity', 'leading']); "
+            "print('MODULES', ','.join(m for m in ('sympy', 'scipy.integrate', 'matplotlib') if m in sys.modules))")
+    cmd = [sys.executable, "-c", code]
+    subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=600)  # warm the cache
+    best, heavy = float("inf"), ""
+    for _ in range(max(1, int(repeats))):
+        t0 = time.perf_counter()
+        p = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=600)
+        best = min(best, time.perf_counter() - t0)
+        if p.returncode != 0:
+            raise RuntimeError(f"bench: estimate subprocess failed: {p.stderr.strip().splitlines()[-1:]}")
+        heavy = p.stdout.strip().splitlines()[-1].split(" ", 1)[-1] if "MODULES" in p.stdout else "?"
+    return {"estimate_leading_wall_s": best, "target_s": STARTUP_TARGET_S, "pass": best <= STARTUP_TARGET_S,
+            "heavy_modules_imported": [m for m in heavy.split(",") if m.strip() and m != "MODULES"]}
+
+
 def _bvp_sample(model, th, v):
     """BVP solve times and ``I`` on the sample; points where it fails are dropped."""
     from .bvp import solve
@@ -214,6 +244,7 @@ def run_bench(points: int = 10**6, bvp_points: int = 5, repeats: int = 3, seed: 
     ths, vs = sample_points(max(int(bvp_points), 1), seed + 1)
     threads = max(1, min(int(threads), numba.config.NUMBA_NUM_THREADS))
     comp = {}
+    startup = startup_time() if compile_times else None
     if compile_times:
         closed = _compile_times("leading")
         quad = _compile_times("quadrature")
@@ -260,7 +291,8 @@ def run_bench(points: int = 10**6, bvp_points: int = 5, repeats: int = 3, seed: 
         "points": points, "bvp_points": int(bvp_points), "threads": threads, "repeats": int(repeats),
         "ranges": {"thickness_m": list(THICKNESS_RANGE), "voltage_V": list(VOLTAGE_RANGE),
                    "distribution": "log-uniform", "layout": layout},
-        "targets": TARGETS, "compile": comp, "results": rows, "all_pass": bool(all(checks)),
+        "targets": TARGETS, "compile": comp, "startup": startup, "results": rows,
+        "all_pass": bool(all(checks) and (startup is None or startup["pass"])),
     }
 
 
@@ -303,8 +335,19 @@ def format_table(res: dict) -> str:
         for f, c in res["compile"].items():
             lines.append(f"  {f:10s} compile {c['compile_s']:.2f} s   cached load {c['cached_load_s']:.3f} s"
                          + (f"   (same driver as {c['shared_with']})" if "shared_with" in c else ""))
+    st = res.get("startup")
+    if st:
+        lines.append(f"start-up: `ipmc-asym estimate --fidelity leading` in a fresh process, cache warm: "
+                     f"{st['estimate_leading_wall_s']:.2f} s (target {st['target_s']} s: "
+                     f"{'pass' if st['pass'] else 'FAIL'}); heavy modules imported: "
+                     f"{', '.join(st['heavy_modules_imported']) or 'none'}")
     lines.append(f"all targets: {'pass' if res['all_pass'] else 'FAIL (see table)'}")
     return "\n".join(lines)
+
+
+def speed_accuracy_figure(path="figures/speed_accuracy.png", points: int = 10**6, bvp_points: int = 3) -> str:
+    """Run a (smaller) benchmark without the compile subprocesses and draw its figure."""
+    return plot_speed_accuracy(run_bench(points, bvp_points, compile_times=False), path)
 
 
 def plot_speed_accuracy(res: dict, path="figures/speed_accuracy.png") -> str:

@@ -63,6 +63,16 @@ def _pos(name):
     return _positive(name, "pressure", "130MPa")
 
 
+def _tol(text):
+    try:
+        v = float(text)
+    except ValueError:
+        raise ValueError(f"--tol must be a number in (0, 1); got {text!r}") from None
+    if not 0.0 < v < 1.0:
+        raise ValueError(f"--tol must be a number in (0, 1); got {text!r}")
+    return v
+
+
 def _volt(text):
     from .units import parse_voltage
 
@@ -117,8 +127,9 @@ def _register_estimate(sub):
     add_strip_options(p)
     p.add_argument("--model", default="all", choices=["constant", "linear", "affine", "all"])
     p.add_argument("--fidelity", default="quadrature", choices=["leading", "corrected", "quadrature", "bvp"])
-    p.add_argument("--tol", type=float, default=None,
-                   help="tolerance for calling a displacement 'small' (default 1%%)")
+    p.add_argument("--tol", type=_wrap(_tol), default=None,
+                   help="relative tolerance: warn when the error estimate exceeds it; also the threshold "
+                        "for calling a displacement 'small' (default 1%%)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
 
 

@@ -30,6 +30,10 @@ def evaluate(strip: Strip, model="constant", fidelity="quadrature", material: Ma
              tol: float | None = None) -> dict:
     """One result row (SI units) for one strip and one permittivity model.
 
+    ``tol`` (relative) is the accuracy the caller needs: it decides whether the small-
+    displacement formulas count as "small" (``regime``), and a warning is added when the
+    fidelity's error estimate exceeds it.
+
     Returns
     -------
     dict
@@ -49,6 +53,11 @@ def evaluate(strip: Strip, model="constant", fidelity="quadrature", material: Ma
     EI = material.E * strip.I_p
     beam = solve_beam(M_A, strip.length, EI, tol=tol, e=strip.e)
     warnings = list(beam.warnings)
+    if tol is not None and float(r.error) > tol:
+        warnings.append(
+            f"error estimate {float(r.error):.2g} of fidelity {fidelity!r} exceeds --tol {tol:g}: "
+            "use a higher fidelity (corrected, quadrature, bvp)"
+        )
     if not bool(r.valid):
         warnings.append(
             f"fidelity {fidelity!r} outside its validity here (error estimate {float(r.error):.2g}, "
