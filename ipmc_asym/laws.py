@@ -97,7 +97,7 @@ def register(sub):
     p = sub.add_parser("laws", help="analytic scaling laws (leading order) and where they hold")
     p.add_argument("--model", default="all", choices=["constant", "linear", "affine", "all"])
     p.add_argument("--json", action="store_true")
-    p.add_argument("--latex", action="store_true", help="print the formulas as LaTeX")
+    p.add_argument("--latex", action="store_true", help="print LaTeX for every quantity (default: for I only)")
 
 
 def run(args):
@@ -118,8 +118,9 @@ def run(args):
         print(f"\n== {m} ==")
         for r in data["models"][m]["laws"]:
             ex = "  ".join(f"{k}^{v}" for k, v in r["exponents"].items())
-            f = r["latex"] if args.latex else r["formula"]
-            print(f"  [{r['regime']}] {r['quantity']:8s} ~ {ex:38s} = {f}")
+            print(f"  [{r['regime']}] {r['quantity']:8s} ~ {ex:38s} = {r['formula']}")
+            if args.latex or r["quantity"] == "I":
+                print(f"      LaTeX: {r['quantity'].replace('_', ' ')} = {r['latex']}")
         rg = data["models"][m]["ranges"]
         ep, ee = rg["exponent_phi0"], rg["exponent_e"]
         print(f"  local d ln I/d ln phi0 over 1 mV-10 V (2e = 200 um): {ep['min']:+.3f} .. {ep['max']:+.3f} "
