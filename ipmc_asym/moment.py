@@ -272,7 +272,8 @@ def _progress(n, label):
     return update
 
 
-def moment_integral(thickness, voltage, model="constant", fidelity="quadrature", *, material=None, **material_kw):
+def moment_integral(thickness, voltage, model="constant", fidelity="quadrature", *, material=None,
+                    on_invalid="warn", **material_kw):
     """Moment integral ``I = int_{-1}^{1} p_bar z_bar dz_bar`` (dimensionless).
 
     Parameters
@@ -284,6 +285,10 @@ def moment_integral(thickness, voltage, model="constant", fidelity="quadrature",
     model : {"constant", "linear", "affine"}, Permittivity or callable
     fidelity : {"leading", "corrected", "quadrature", "bvp"}
     material : Material, optional; ``**material_kw`` override fields of the preset.
+    on_invalid : {"warn", "raise", "ignore"}
+        What to do where the fidelity is outside its validity (error estimate above
+        ``VALIDITY_LIMIT`` or overlapping layers): a ``RuntimeWarning`` (default), a
+        ``ValueError``, or nothing (use :func:`moment` to get the flags and estimates).
 
     Returns
     -------
@@ -291,5 +296,17 @@ def moment_integral(thickness, voltage, model="constant", fidelity="quadrature",
         ``I`` with the broadcast shape of the inputs (a float for scalar inputs).
         ``M_A = A5 I`` with ``A5 = 6 l e^2 F |phi0| C_moy``.
     """
+    if on_invalid not in ("warn", "raise", "ignore"):
+        raise ValueError(f"on_invalid must be one of warn, raise, ignore; got {on_invalid!r}")
     r = moment(thickness, voltage, model, fidelity, material=material, **material_kw)
+    bad = ~np.asarray(r.valid)
+    if on_invalid != "ignore" and np.any(bad):
+        msg = (f"fidelity {fidelity!r} is outside its validity at {int(bad.sum())} of {bad.size} point(s) "
+               f"(error estimate up to {float(np.max(np.where(bad, r.error, 0))):.2g} > {VALIDITY_LIMIT:g}, "
+               f"or electrode layers overlapping); use a higher fidelity ('bvp' where layers overlap)")
+        if on_invalid == "raise":
+            raise ValueError(msg)
+        import warnings
+
+        warnings.warn(msg, RuntimeWarning, stacklevel=2)
     return float(r.I) if r.I.ndim == 0 else r.I

@@ -109,3 +109,13 @@ def test_c_moy_choice_changes_result():
     a = moment_integral(200e-6, 1.0, c_moy="paper")
     b = moment_integral(200e-6, 1.0, c_moy="formula")
     assert a != b and math.isfinite(b)
+
+
+def test_outside_validity_is_never_silent():
+    """1 um total thickness at 20 V: the layers fill the strip; leading must say so."""
+    with pytest.warns(RuntimeWarning, match="outside its validity"):
+        moment_integral(1e-6, 20.0, "linear", "leading")
+    with pytest.raises(ValueError, match="outside its validity"):
+        moment_integral(1e-6, 20.0, "linear", "leading", on_invalid="raise")
+    r = moment(1e-6, 20.0, "linear", "leading")
+    assert not bool(r.valid) and float(r.error) > 1e-2
