@@ -121,37 +121,40 @@ def _core_error(core, lam):
     return 4.0 * math.exp(-x) if x < 700.0 else 0.0
 
 
+@jit
+def _point(lam, A2, A3, rho, model_id, order):
+    """(I for |phi0|, error, B1, core) of one point; ``order`` 0 = quadrature.
+
+    Zero volts: no field, I = 0 exactly (the odd extension; no 0/0).
+    """
+    if A2 == 0.0:
+        return 0.0, 0.0, 1.0, 2.0
+    if order == 0:
+        Ii, J1, J2, b1, c = moment_quadrature(lam, A2, A3, rho)
+        e_i = 1e-14
+    else:
+        Ii, e_i, b1, c = moment_closed(lam, A2, A3, rho, model_id, order)
+    # neglected core interaction: exponentially small in core/lambda
+    return Ii, e_i + _core_error(c, lam), b1, c
+
+
 @jit_parallel
+def _sweep(lam, A2, A3, rho, model_id, order, sign, I, err, B1, core):
+    """The one sweep driver (prange): ``order`` 1 leading, 2 corrected, 0 quadrature."""
+    for i in prange(lam.size):
+        Ii, e_i, b1, c = _point(lam[i], A2[i], A3, rho, model_id, order)
+        I[i] = sign[i] * Ii
+        err[i] = e_i
+        B1[i] = b1
+        core[i] = c
+
+
 def _sweep_quadrature(lam, A2, A3, rho, sign, I, err, B1, core):
-    for i in prange(lam.size):
-        if A2[i] == 0.0:
-            I[i] = 0.0
-            err[i] = 0.0
-            B1[i] = 1.0
-            core[i] = 2.0
-            continue
-        Ii, J1, J2, b1, c = moment_quadrature(lam[i], A2[i], A3, rho)
-        I[i] = sign[i] * Ii
-        # neglected core interaction: exponentially small in core/lambda (see docs)
-        err[i] = _core_error(c, lam[i]) + 1e-14
-        B1[i] = b1
-        core[i] = c
+    _sweep(lam, A2, A3, rho, -1, 0, sign, I, err, B1, core)
 
 
-@jit_parallel
 def _sweep_closed(lam, A2, A3, rho, model_id, order, sign, I, err, B1, core):
-    for i in prange(lam.size):
-        if A2[i] == 0.0:
-            I[i] = 0.0
-            err[i] = 0.0
-            B1[i] = 1.0
-            core[i] = 2.0
-            continue
-        Ii, e_i, b1, c = moment_closed(lam[i], A2[i], A3, rho, model_id, order)
-        I[i] = sign[i] * Ii
-        err[i] = e_i + _core_error(c, lam[i])
-        B1[i] = b1
-        core[i] = c
+    _sweep(lam, A2, A3, rho, model_id, order, sign, I, err, B1, core)
 
 
 def moment(thickness, voltage, model="constant", fidelity="quadrature", *, material: Material | None = None,
