@@ -362,7 +362,7 @@ def run_scene(scene) -> dict:
         el = [float(x) for x in err]
         vals["I"] = I
         if "I" in outputs:
-            out["I"] = {"values": I.tolist(), "unit": "1", "fidelity": fl, "error_estimate": el}
+            out["I"] = {"values": I.tolist(), "unit": "dimensionless", "fidelity": fl, "error_estimate": el}
         M = _groups_A5(pts, material, model) * I
         vals["moment"] = M
         if "moment" in outputs:
@@ -466,7 +466,7 @@ def run(args) -> int:
             continue
         for i, v in enumerate(o["values"]):
             beam = f", beam {o['beam'][i]}" if "beam" in o else ""
-            print(f"  {k}[{i}] = {v:.6g} {o['unit']}  ({o['fidelity'][i]}, rel. err <= "
+            print(f"  {k}[{i}] = {v:.6g} {'' if o['unit'] == 'dimensionless' else o['unit']}  ({o['fidelity'][i]}, rel. err <= "
                   f"{o['error_estimate'][i]:.2g}{beam})")
     sys.stdout.flush()
     return 0
