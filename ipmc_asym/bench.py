@@ -33,6 +33,7 @@ import tempfile
 import time
 
 import numpy as np
+
 from .jsonio import dumps as _jdumps
 
 __all__ = ["run_bench", "sample_points", "plot_speed_accuracy", "speed_accuracy_figure", "format_table", "TARGETS", "register", "run"]

@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import sys
+
 from .jsonio import dumps as _jdumps
 
 __all__ = ["main", "UsageError"]

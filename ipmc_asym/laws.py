@@ -8,8 +8,8 @@ the range where it holds is stated.
 
 from __future__ import annotations
 
-
 import numpy as np
+
 from .jsonio import dumps as _jdumps
 
 __all__ = ["local_exponents", "law_table", "law_ranges", "register", "run"]
@@ -40,6 +40,7 @@ def local_exponents(model, var, n=241, thickness=200e-6, voltage=1.0):
 def law_table(model=None):
     """Leading-order laws from the derivation: list of dict rows (SymPy objects stringified)."""
     import sympy as sp
+
     from derivations import scaling
 
     rows = []

@@ -33,8 +33,8 @@ import os
 
 import numpy as np
 
-from .params import NAFION_LI, Material, Strip
 from .jsonio import dumps as _jdumps
+from .params import NAFION_LI, Material, Strip
 
 __all__ = ["MODELS3", "QUANTITIES", "profile", "layer_widths", "profile_summary", "write_csv",
            "plot_profiles", "register", "run", "PAPER_LAYERS"]

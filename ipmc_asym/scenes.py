@@ -62,6 +62,7 @@ import os
 import sys
 
 import numpy as np
+
 from .jsonio import dumps as _jdumps
 
 __all__ = ["run_scene", "load_scene", "OUTPUTS", "LADDER", "register", "run"]
@@ -338,8 +339,12 @@ def run_scene(scene) -> dict:
         Unknown section/key, wrong type, impossible value or unreadable file (the message
         names the key).
     """
-    from .beam import (blocking_force_error, blocking_force_large, small_displacement_error,
-                       tip_position)
+    from .beam import (
+        blocking_force_error,
+        blocking_force_large,
+        small_displacement_error,
+        tip_position,
+    )
 
     if not isinstance(scene, dict):
         scene = load_scene(scene)

@@ -25,8 +25,8 @@ import time
 
 import numpy as np
 
-from .params import NAFION_LI, Material, Strip
 from .jsonio import dumps as _jdumps
+from .params import NAFION_LI, Material, Strip
 
 __all__ = ["VARIABLES", "parse_vary", "sweep", "write_csv", "rows_as_dicts", "register", "run"]
 

@@ -16,8 +16,8 @@ import math
 
 import numpy as np
 
-from .params import NAFION_LI, Material, Strip
 from .jsonio import dumps as _jdumps
+from .params import NAFION_LI, Material, Strip
 
 __all__ = ["claims", "to_markdown", "register", "run", "VERDICTS"]
 
