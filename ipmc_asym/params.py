@@ -35,6 +35,8 @@ __all__ = [
     "check_positive",
     "check_finite",
     "make_groups",
+    "moment_scale",
+    "second_moment",
 ]
 
 #: The value the paper states (section 4) and uses; the formula with the quoted data gives
@@ -163,13 +165,34 @@ class Strip:
     @property
     def I_p(self) -> float:
         """Second moment of area ``4 l e^3 / 3`` (paper section 3), m^4."""
-        return 4.0 * self.l * self.e**3 / 3.0
+        return float(second_moment(self.width, self.thickness))
 
     def with_(self, **kw) -> "Strip":
         return replace(self, **kw)
 
 
 NOMINAL_STRIP = Strip()
+
+
+def moment_scale(width, thickness, voltage, F, C_moy):
+    """``A5 = 6 l e^2 F |phi0| C_moy`` (N m): ``M_A = A5 I`` (paper sections 3-4).
+
+    Vectorised; ``width``, ``thickness`` are TOTAL (2l, 2e).
+    """
+    import numpy as np
+
+    l = 0.5 * np.asarray(width, dtype=float)  # noqa: E741
+    e = 0.5 * np.asarray(thickness, dtype=float)
+    return 6.0 * l * e * e * F * np.abs(np.asarray(voltage, dtype=float)) * C_moy
+
+
+def second_moment(width, thickness):
+    """``I_p = 4 l e^3 / 3`` (m^4) from TOTAL width and thickness (vectorised)."""
+    import numpy as np
+
+    l = 0.5 * np.asarray(width, dtype=float)  # noqa: E741
+    e = 0.5 * np.asarray(thickness, dtype=float)
+    return 4.0 * l * e**3 / 3.0
 
 
 @dataclass(frozen=True)
@@ -238,7 +261,7 @@ def make_groups(strip: Strip, material: Material, eps0: float, deps: float) -> G
         A1=phi * eps0 / den,
         A2=m.F * phi / (m.R * m.T),
         A3=-m.rho2 * m.Z3 / (cm * m.F),
-        A5=6.0 * l * e * e * m.F * phi * cm,
+        A5=float(moment_scale(strip.width, strip.thickness, phi, m.F, cm)),
         sign=sign,
         e=e,
         l=l,

@@ -288,9 +288,9 @@ def _plan_moment(pts, model, material, tol):
 
 
 def _groups_A5(pts, material, model):
-    e = 0.5 * pts["thickness"]
-    l = 0.5 * pts["width"]
-    return 6.0 * l * e * e * material.F * np.abs(pts["voltage"]) * material.C_moy
+    from .params import moment_scale
+
+    return moment_scale(pts["width"], pts["thickness"], pts["voltage"], material.F, material.C_moy)
 
 
 def _layer_width(z, C, side, thr=0.01):

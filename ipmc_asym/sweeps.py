@@ -26,7 +26,7 @@ import time
 import numpy as np
 
 from .jsonio import dumps as _jdumps
-from .params import NAFION_LI, Material, Strip
+from .params import NAFION_LI, Material, Strip, moment_scale, second_moment
 
 __all__ = ["VARIABLES", "parse_vary", "sweep", "write_csv", "rows_as_dicts", "register", "run"]
 
@@ -136,10 +136,8 @@ def sweep(vary: dict, model="constant", fidelity="quadrature", base: Strip | Non
             raise ValueError(f"{k} must be finite and > 0")
     mats = material
     C_moy = mats.C_moy
-    e = 0.5 * cols["thickness"]
-    l = 0.5 * cols["width"]
-    A5 = 6.0 * l * e * e * mats.F * np.abs(cols["voltage"]) * C_moy
-    EI = cols["modulus"] * 4.0 * l * e ** 3 / 3.0
+    A5 = moment_scale(cols["width"], cols["thickness"], cols["voltage"], mats.F, C_moy)
+    EI = cols["modulus"] * second_moment(cols["width"], cols["thickness"])
     out_parts = []
     models = _models(model)
     show = (n * len(models) > 20000 or fidelity == "bvp") if progress is None else progress
