@@ -373,7 +373,9 @@ def run_scene(scene) -> dict:
         if "moment" in outputs:
             out["moment"] = {"values": M.tolist(), "unit": "N m", "fidelity": fl, "error_estimate": el}
         L = pts["length"]
-        EI = material.E * (4.0 / 3.0) * (0.5 * pts["width"]) * (0.5 * pts["thickness"]) ** 3
+        from .params import second_moment
+
+        EI = material.E * second_moment(pts["width"], pts["thickness"])
         if "rotation" in outputs:
             th = -M * L / EI
             vals["rotation"] = th
