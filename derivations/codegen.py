@@ -56,6 +56,8 @@ class _Printer(PythonCodePrinter):
 
     def _print_Pow(self, expr, rational=False):
         base, exp = expr.as_base_exp()
+        if base.is_Number and exp.is_Rational:  # e.g. sqrt(402): a literal, not a call
+            return repr(float(expr.evalf(25)))
         if exp == sp.S.Half:
             return f"math.sqrt({self._print(base)})"
         if exp == -sp.S.Half:

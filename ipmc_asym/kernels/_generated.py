@@ -178,7 +178,7 @@ def accumulation_constant(Y):
 
     Derived in ``derivations.closed_forms:accumulation``.
     """
-    t0 = math.sqrt(2.0)*math.exp(-1.0/2.0*Y)
+    t0 = 1.4142135623730951*math.exp(-1.0/2.0*Y)
     return (W0INF_CONSTANT - t0*(Y + 2.0), -W0INF_CONSTANT*t0 + W1INF_CONSTANT)
 
 
@@ -273,10 +273,10 @@ def depletion_affine(Y):
 
     Derived in ``derivations.closed_forms:depletion_forms``.
     """
-    t0 = math.sqrt(4422.0)
-    t1 = math.sqrt(402.0)
+    t0 = 66.4981202741852
+    t1 = 20.049937655763422
     t2 = math.sqrt(99.0 - Y)
-    return (-K0_AFFINE + (1.0/603.0)*Y*t1*t2 - 66.0/67.0*t0 + (22.0/67.0)*t1*t2, (1.0/67.0)*K0_AFFINE*t0 - 1.0/201.0*K0_AFFINE*t1*t2 - K1_AFFINE - 1.0/1206.0*Y*Y - 22.0/67.0*Y - 132.0/67.0*math.sqrt(11.0)*t2 + 4356.0/67.0)
+    return (-K0_AFFINE + (1.0/603.0)*Y*t1*t2 - 66.0/67.0*t0 + (22.0/67.0)*t1*t2, (1.0/67.0)*K0_AFFINE*t0 - 1.0/201.0*K0_AFFINE*t1*t2 - K1_AFFINE - 1.0/1206.0*Y*Y - 22.0/67.0*Y - 132.0/67.0*3.3166247903554*t2 + 4356.0/67.0)
 
 
 @jit
@@ -285,7 +285,7 @@ def depletion_constant(Y):
 
     Derived in ``derivations.closed_forms:depletion_forms``.
     """
-    t0 = math.sqrt(2.0)
+    t0 = 1.4142135623730951
     t1 = Y + 1.0
     t2 = math.sqrt(-t1)
     return (-K0_CONSTANT + (1.0/3.0)*t0*t2*(Y - 2.0), -K0_CONSTANT*t0*t2 - K1_CONSTANT + Y - 1.0/6.0*t1*t1 + 1.0)
@@ -315,7 +315,7 @@ def dhat_affine(Y):
 
     Derived in ``derivations.model:dhat_stable``.
     """
-    return (1.0/201.0)*math.sqrt(201.0)*math.sqrt(e2rel(Y) + 200.0*exprel(Y)*exprel(Y))*abs(Y)
+    return (1.0/201.0)*14.177446878757825*math.sqrt(e2rel(Y) + 200.0*exprel(Y)*exprel(Y))*abs(Y)
 
 
 @jit
@@ -334,7 +334,7 @@ def dhat_from_c_affine(C, Y):
     Derived in ``derivations.model:H_of_C``.
     """
     t0 = C - 1.0
-    return (1.0/201.0)*math.sqrt(402.0)*math.sqrt(-Y + 100.0*t0*t0 + t0)
+    return (1.0/201.0)*20.049937655763422*math.sqrt(-Y + 100.0*t0*t0 + t0)
 
 
 @jit
@@ -343,7 +343,7 @@ def dhat_from_c_constant(C, Y):
 
     Derived in ``derivations.model:H_of_C``.
     """
-    return math.sqrt(2.0)*math.sqrt(C - Y - 1.0)
+    return 1.4142135623730951*math.sqrt(C - Y - 1.0)
 
 
 @jit

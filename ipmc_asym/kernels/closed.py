@@ -114,8 +114,12 @@ def moment_closed(lam, A2, A3, rho, model_id, order):
         functions.  ``core`` (the neutral core length) is estimated from the depletion
         width ``lam * sqrt(2 (|Ya| - 1))`` and ``~ 10 lam`` per layer.
     """
-    em1 = math.expm1(-A2)
-    em = 1.0 + em1  # e^{-A2}: absolute error 1e-16, all that B1 - B1 e^{-A2} needs
+    if A2 > 1.0:  # e^{-A2} - 1 <= -0.63: no cancellation, and exp is cheaper than expm1
+        em = math.exp(-A2)
+        em1 = em - 1.0
+    else:
+        em1 = math.expm1(-A2)
+        em = 1.0 + em1
     if model_id == 0:
         B1 = G.b1_constant(A2, em1)
     elif model_id == 1:
