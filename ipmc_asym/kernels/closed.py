@@ -20,19 +20,8 @@ MODEL_IDS = {"constant": 0, "linear": 1, "affine": 2}
 #: asymptotic pieces (O(T e^{-T}) at T = 31); checked against the quadrature in the tests.
 TRUNCATION = 1e-11
 
-_W0 = (G.PATCH_W0_CONSTANT, G.PATCH_W0_LINEAR, G.PATCH_W0_AFFINE)
-_W1 = (G.PATCH_W1_CONSTANT, G.PATCH_W1_LINEAR, G.PATCH_W1_AFFINE)
 _KMIN = G.K_MIN
 _KMAX = G.K_MAX
-
-
-@jit
-def _horner(tab, row, h):
-    n = tab.shape[1]
-    acc = tab[row, n - 1]
-    for k in range(n - 2, -1, -1):
-        acc = acc * h + tab[row, k]
-    return acc
 
 
 @jit
@@ -54,7 +43,7 @@ def _poly(c, x):
 
 @jit
 def _horner_n(tab, row, h, n):
-    """The first ``n`` terms only (an estimate, for error bars)."""
+    """Polynomial in ``h`` with the first ``n`` coefficients of ``tab[row]`` (Horner)."""
     acc = tab[row, n - 1]
     for k in range(n - 2, -1, -1):
         acc = acc * h + tab[row, k]
@@ -95,7 +84,7 @@ def layer_closed(Y, model_id, need_w1):
     t0, t1 = _patch_tables(model_id)
     row = k - _KMIN
     if need_w1 == 2:
-        return _horner(t0, row, h), _horner(t1, row, h)
+        return _horner_n(t0, row, h, t0.shape[1]), _horner_n(t1, row, h, t1.shape[1])
     return _horner_n(t0, row, h, N_W0_LEADING), _horner_n(t1, row, h, N_W1_ESTIMATE)
 
 
