@@ -96,22 +96,18 @@ def _time_driver(fidelity, model, th, v, threads, repeats):
     """Best-of-``repeats`` seconds per point of the sweep driver with ``threads`` threads."""
     import numba
 
-    from .kernels.closed import MODEL_IDS
-    from .moment import _ORDER, _sweep_closed, _sweep_quadrature, groups_arrays
+    from .moment import _ORDER, _sweep, closed_model_id, groups_arrays
     from .params import NAFION_LI
     from .permittivity import get_model
 
-    lam, A2, A3, rho, sign = groups_arrays(th, v, get_model(model), NAFION_LI)
+    perm = get_model(model)
+    lam, A2, A3, rho, sign = groups_arrays(th, v, perm, NAFION_LI)
     lam, A2, sign = (np.ascontiguousarray(a, dtype=float) for a in (lam, A2, sign))
     outs = [np.empty(lam.size) for _ in range(4)]
-    if fidelity == "quadrature":
-        def call():
-            _sweep_quadrature(lam, A2, A3, rho, sign, *outs)
-    else:
-        mid, order = MODEL_IDS[model], _ORDER[fidelity]
+    mid, order = closed_model_id(perm, fidelity), _ORDER[fidelity]
 
-        def call():
-            _sweep_closed(lam, A2, A3, rho, mid, order, sign, *outs)
+    def call():
+        _sweep(lam, A2, A3, rho, mid, order, sign, *outs)
 
     old = numba.get_num_threads()
     numba.set_num_threads(max(1, min(int(threads), numba.config.NUMBA_NUM_THREADS)))

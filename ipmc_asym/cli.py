@@ -210,20 +210,15 @@ def build_parser():
     sub = ap.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
     handlers = {}
-    wanted = sys.argv[1] if len(sys.argv) > 1 else None
     for name, modname in COMMANDS.items():
         if name in _LOCAL:
             reg, run = _LOCAL[name]
         else:
-            try:
-                mod = importlib.import_module(modname)
-            except ImportError:
-                continue  # not built yet
-            # commands other than the one asked for register without importing heavy stuff
+            # command modules import only stdlib + numpy at module level (fast start-up)
+            mod = importlib.import_module(modname)
             reg, run = mod.register, mod.run
         reg(sub)
         handlers[name] = run
-    del wanted
     return ap, handlers
 
 

@@ -37,7 +37,8 @@ from .permittivity import Permittivity, get_model
 __all__ = ["FIDELITIES", "MomentResult", "moment_integral", "moment", "groups_arrays", "check_fidelity"]
 
 FIDELITIES = ("leading", "corrected", "quadrature", "bvp")
-_ORDER = {"leading": 1, "corrected": 2}
+#: order argument of the sweep driver: 1 leading, 2 corrected, 0 quadrature
+_ORDER = {"leading": 1, "corrected": 2, "quadrature": 0}
 
 #: error estimate beyond which a closed form / quadrature is declared outside its validity
 VALIDITY_LIMIT = 1e-2
@@ -88,7 +89,7 @@ def _material(material, kw) -> Material:
 
 
 def groups_arrays(thickness, voltage, perm: Permittivity, material: Material):
-    """Vectorised groups: ``(lam, A2, A3, rho, sign, A5_per_l)`` broadcast to one shape.
+    """Vectorised groups: ``(lam, A2, A3, rho, sign)``, arrays broadcast to one shape.
 
     ``lam = sqrt(eps_core R T / (e^2 phi4 F^2 C_moy))`` does not depend on the voltage.
     """
@@ -149,13 +150,6 @@ def _sweep(lam, A2, A3, rho, model_id, order, sign, I, err, B1, core):
         core[i] = c
 
 
-def _sweep_quadrature(lam, A2, A3, rho, sign, I, err, B1, core):
-    _sweep(lam, A2, A3, rho, -1, 0, sign, I, err, B1, core)
-
-
-def _sweep_closed(lam, A2, A3, rho, model_id, order, sign, I, err, B1, core):
-    _sweep(lam, A2, A3, rho, model_id, order, sign, I, err, B1, core)
-
 
 def moment(thickness, voltage, model="constant", fidelity="quadrature", *, material: Material | None = None,
            progress: bool | None = None, **material_kw) -> MomentResult:
@@ -202,17 +196,8 @@ def moment(thickness, voltage, model="constant", fidelity="quadrature", *, mater
     else:
         fl = [np.ascontiguousarray(a).reshape(-1) for a in (lam, A2, sign)]
         outs = [np.empty(lam.size) for _ in range(4)]
-        if fidelity == "quadrature":
-            _sweep_quadrature(fl[0], fl[1], A3, rho, fl[2], *outs)
-        else:
-            mid = MODEL_IDS.get(perm.name, -1) if (perm.eps0, perm.deps) == _paper_values(perm.name) else -1
-            if mid < 0:
-                raise ValueError(
-                    f"closed forms ({fidelity!r}) are derived for the paper's constant, linear and affine "
-                    f"models only; use fidelity 'quadrature' or 'bvp' for {perm.name!r} with "
-                    f"eps0={perm.eps0:g}, eps_moy-eps0={perm.deps:g} F/m"
-                )
-            _sweep_closed(fl[0], fl[1], A3, rho, mid, _ORDER[fidelity], fl[2], *outs)
+        mid = closed_model_id(perm, fidelity)
+        _sweep(fl[0], fl[1], A3, rho, mid, _ORDER[fidelity], fl[2], *outs)
         for dst, src in zip((I, err, B1, core), outs):
             dst[...] = src.reshape(shape)
     valid = (err < VALIDITY_LIMIT) & (core > 0)
@@ -220,11 +205,23 @@ def moment(thickness, voltage, model="constant", fidelity="quadrature", *, mater
                         fidelity=fidelity, model=perm.name)
 
 
-def _paper_values(name):
+def closed_model_id(perm: Permittivity, fidelity: str) -> int:
+    """Model id of the closed-form kernels (-1 for ``quadrature``, which takes any rho).
+
+    The closed forms are derived for the paper's three (eps0, eps_moy - eps0) pairs only.
+    """
+    if fidelity == "quadrature":
+        return -1
     from .permittivity import MODELS
 
-    p = MODELS.get(name)
-    return (p.eps0, p.deps) if p is not None else None
+    paper = MODELS.get(perm.name)
+    if paper is None or (perm.eps0, perm.deps) != (paper.eps0, paper.deps):
+        raise ValueError(
+            f"closed forms ({fidelity!r}) are derived for the paper's constant, linear and affine "
+            f"models only; use fidelity 'quadrature' or 'bvp' for {perm.name!r} with "
+            f"eps0={perm.eps0:g}, eps_moy-eps0={perm.deps:g} F/m"
+        )
+    return MODEL_IDS[perm.name]
 
 
 def _bvp_loop(thickness, voltage, perm, mat, I, err, B1, core, progress):
