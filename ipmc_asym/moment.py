@@ -31,7 +31,7 @@ import numpy as np
 from ._jit import jit, jit_parallel, prange
 from .kernels.closed import MODEL_IDS, moment_closed
 from .kernels.quadrature import moment_quadrature
-from .params import NAFION_LI, Material
+from .params import NAFION_LI, Material, debye_length
 from .permittivity import Permittivity, get_model
 
 __all__ = ["FIDELITIES", "MomentResult", "moment_integral", "moment", "groups_arrays", "check_fidelity"]
@@ -102,9 +102,8 @@ def groups_arrays(thickness, voltage, perm: Permittivity, material: Material):
     th, v = np.broadcast_arrays(th, v)
     m = material
     cm = m.C_moy
-    e = 0.5 * th
     eps_core = perm.eps0 + perm.deps
-    lam = np.sqrt(eps_core * m.R * m.T / (e * e * m.phi4 * m.F * m.F * cm))
+    lam = debye_length(th, eps_core, m)
     A2 = m.F * np.abs(v) / (m.R * m.T)
     A3 = -m.rho2 * m.Z3 / (cm * m.F)
     rho = perm.eps0 / eps_core

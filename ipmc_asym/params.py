@@ -36,6 +36,7 @@ __all__ = [
     "check_finite",
     "make_groups",
     "moment_scale",
+    "debye_length",
     "second_moment",
 ]
 
@@ -186,6 +187,19 @@ def moment_scale(width, thickness, voltage, F, C_moy):
     return 6.0 * l * e * e * F * np.abs(np.asarray(voltage, dtype=float)) * C_moy
 
 
+def debye_length(thickness, eps_core, material: "Material"):
+    """Core Debye length over ``e``: ``lambda = sqrt(eps_core R T / (e^2 phi4 F^2 C_moy))``.
+
+    Equal to ``sqrt((A0 + A1)/A2)`` but defined at zero volts too (all three groups scale
+    with ``|phi0|``).  Vectorised; ``thickness`` is TOTAL (2e).
+    """
+    import numpy as np
+
+    m = material
+    e = 0.5 * np.asarray(thickness, dtype=float)
+    return np.sqrt(eps_core * m.R * m.T / (e * e * m.phi4 * m.F * m.F * m.C_moy))
+
+
 def second_moment(width, thickness):
     """``I_p = 4 l e^3 / 3`` (m^4) from TOTAL width and thickness (vectorised)."""
     import numpy as np
@@ -266,5 +280,5 @@ def make_groups(strip: Strip, material: Material, eps0: float, deps: float) -> G
         e=e,
         l=l,
         phi0=float(strip.voltage),
-        extra={"debye": math.sqrt((eps0 + deps) * m.R * m.T / (den * m.F))},
+        extra={"debye": float(debye_length(strip.thickness, eps0 + deps, m))},
     )
