@@ -18,7 +18,7 @@ import numpy as np
 
 from .params import NAFION_LI, Material, Strip
 
-__all__ = ["fit_power_law", "sweep_fits", "RANGES", "scaling_fits", "variation_table", "QUANTITIES",
+__all__ = ["fit_power_law", "local_exponent", "sweep_fits", "RANGES", "scaling_fits", "variation_table", "QUANTITIES",
            "linear_r"]
 
 #: quantity keys fitted (sweep columns)
@@ -71,6 +71,11 @@ def fit_power_law(x, y, mask=None) -> dict:
     if sx > 0 and sy > 1e-12 * max(1.0, np.max(np.abs(ly))):
         out["r"] = float(np.mean((lx - lx.mean()) * (ly - ly.mean())) / (sx * sy))
     return out
+
+
+def local_exponent(x, y):
+    """Local power-law exponent ``d ln|y| / d ln x`` at each point (central differences)."""
+    return np.gradient(np.log(np.abs(np.asarray(y, float))), np.log(np.asarray(x, float)))
 
 
 def linear_r(x, y, mask=None) -> float:

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .fits import local_exponent
 from .jsonio import dumps as _jdumps
 
 __all__ = ["local_exponents", "law_table", "law_ranges", "register", "run"]
@@ -34,7 +35,7 @@ def local_exponents(model, var, n=241, thickness=200e-6, voltage=1.0):
         I = moment(x, voltage, model, "quadrature").I
     else:
         raise ValueError(f"var must be 'voltage' or 'thickness'; got {var!r}")
-    return x, np.gradient(np.log(np.abs(I)), np.log(x))
+    return x, local_exponent(x, I)
 
 
 def law_table(model=None):

@@ -35,15 +35,10 @@ def _v(ok):
     return "reproduced" if ok else "differs"
 
 
-def _local_exponents(x, y):
-    lx, ly = np.log(x), np.log(np.abs(y))
-    return np.diff(ly) / np.diff(lx)
-
-
 def claims(material: Material = NAFION_LI, strip: Strip | None = None) -> list[dict]:
     """All claim rows (list of dicts)."""
     from .estimate import evaluate
-    from .fits import fit_power_law, linear_r
+    from .fits import fit_power_law, linear_r, local_exponent
     from .moment import moment
     from .profiles import profile_summary
     from .sweeps import OUTSIDE, sweep
@@ -116,15 +111,15 @@ def claims(material: Material = NAFION_LI, strip: Strip | None = None) -> list[d
                      _v(all(sums[mm]["D_core"] < 1e-6 for mm in MODELS3)), "core_neutral"))
     # ---- I vs e and phi0 -----------------------------------------------------------------
     th = np.geomspace(10e-6, 4e-3, 25)
-    ex = {}
+    ex, B1s = {}, {}
     for mm in MODELS3:
         r = moment(th, s.voltage, mm, "quadrature", material=m)
-        ex[mm] = _local_exponents(th, r.I)
+        ex[mm] = local_exponent(th, r.I)
+        B1s[mm] = r.B1
     rows.append(_row("I proportional to 1/e (leading order)", "§6.2", "I ~ e^-1",
                      "local d lnI/d ln(2e) over 2e=10um-4mm: " + ", ".join(
                          f"{mm} {ex[mm].min():.4f}..{ex[mm].max():.4f}" for mm in MODELS3),
                      _v(all(abs(ex[mm] + 1).max() < 0.1 for mm in MODELS3)), "I_e"))
-    B1s = {mm: moment(th, s.voltage, mm, "quadrature", material=m).B1 for mm in MODELS3}
     rows.append(_row("cathode charge F B1 C_moy independent of e", "§6.2", "independent of e",
                      "relative spread of B1 over 2e=10um-4mm: " + ", ".join(
                          f"{mm} {np.ptp(B1s[mm]) / np.mean(B1s[mm]):.1e}" for mm in MODELS3) +
@@ -132,8 +127,8 @@ def claims(material: Material = NAFION_LI, strip: Strip | None = None) -> list[d
                      _v(all(np.ptp(B1s[mm]) / np.mean(B1s[mm]) < 1e-6 for mm in MODELS3)), "charge_e"))
     v = np.geomspace(1e-3, 10.0, 41)
     rc = moment(s.thickness, v, "constant", "quadrature", material=m)
-    lx = _local_exponents(v, rc.I)
-    hi = v[1:] >= 3.0
+    lx = local_exponent(v, rc.I)
+    hi = v >= 3.0
     rows.append(_row("constant model: I ~ phi0^(1/2) approximately", "§6.2", "exponent 1/2",
                      f"local d lnI/d ln phi0 over 1 mV-10 V: {lx.min():.3f}..{lx.max():.3f} (~0 below 0.1 V, "
                      f"negative near 1 V, {lx[hi].min():.2f}..{lx[hi].max():.2f} for 3-10 V); "
