@@ -20,14 +20,14 @@ __all__ = ["jit", "jit_parallel", "prange", "CACHE_DIR"]
 def hashed_sources() -> list:
     """The modules that define jitted functions (and what they inline)."""
     here = Path(__file__).resolve().parent
-    return sorted([here / "_jit.py", here / "moment.py", *(here / "kernels").glob("*.py")])
+    return sorted([here / "_jit.py", here / "integral.py", *(here / "kernels").glob("*.py")])
 
 
 def _cache_dir() -> str:
     """Numba's on-disk cache, keyed by a hash of this package's sources.
 
     Numba invalidates a cached function when ITS file changes, not when a function it
-    calls from another module does (a sweep driver in moment.py inlines the kernels of
+    calls from another module does (a sweep driver in integral.py inlines the kernels of
     kernels/*.py).  Keying the whole cache on the sources of every module with jitted code
     makes any edit or upgrade start from a clean cache.  ``NUMBA_CACHE_DIR``, if set, wins.
     """

@@ -96,7 +96,7 @@ def _time_driver(fidelity, model, th, v, threads, repeats):
     """Best-of-``repeats`` seconds per point of the sweep driver with ``threads`` threads."""
     import numba
 
-    from .moment import _ORDER, _sweep, closed_model_id, groups_arrays
+    from .integral import _ORDER, _sweep, closed_model_id, groups_arrays
     from .params import NAFION_LI
     from .permittivity import get_model
 
@@ -126,7 +126,7 @@ def _time_driver(fidelity, model, th, v, threads, repeats):
 _COMPILE_SNIPPET = """
 import json, time
 t0 = time.perf_counter()
-from ipmc_asym.moment import moment
+from ipmc_asym.integral import moment
 t1 = time.perf_counter()
 moment(2e-4, 1.0, "constant", {fid!r})
 t2 = time.perf_counter()
@@ -234,7 +234,7 @@ def run_bench(points: int = 10**6, bvp_points: int = 5, repeats: int = 3, seed: 
     """
     import numba
 
-    from .moment import moment
+    from .integral import moment
 
     points = int(points)
     th, v = sample_points(points, seed, layout)

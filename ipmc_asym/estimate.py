@@ -11,7 +11,7 @@ import time
 
 import numpy as np
 
-from .moment import check_fidelity, moment
+from .integral import check_fidelity, moment
 from .params import NAFION_LI, Material, Strip
 from .permittivity import MODELS, get_model
 

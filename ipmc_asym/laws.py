@@ -25,7 +25,7 @@ def local_exponents(model, var, n=241, thickness=200e-6, voltage=1.0):
 
     Returns (x, exponent) arrays; ``x`` is the voltage (V) or the TOTAL thickness (m).
     """
-    from .moment import moment
+    from .integral import moment
 
     if var == "voltage":
         x = np.logspace(-3, 1, n)

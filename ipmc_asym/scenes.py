@@ -76,7 +76,7 @@ _MATERIAL = {"preset", "E", "modulus", "c_moy", "phi4", "Z3", "rho3", "rho2", "T
 _SWEEP = {"thickness", "voltage", "length", "width"}
 _RANGE = {"start", "stop", "n", "log"}
 _DEFAULTS = {"length": 0.02, "width": 5e-3, "thickness": 200e-6}
-_BVP_ERROR = 1e-9  # stated accuracy of the BVP path (ipmc_asym.moment)
+_BVP_ERROR = 1e-9  # stated accuracy of the BVP path (ipmc_asym.integral)
 
 
 def _toml_loads(text: str) -> dict:
@@ -262,7 +262,7 @@ def _parse(scene: dict):
 
 def _plan_moment(pts, model, material, tol):
     """I, error estimate and fidelity per point, escalating until the estimate meets tol."""
-    from .moment import moment
+    from .integral import moment
 
     th, v = pts["thickness"], pts["voltage"]
     n = th.size

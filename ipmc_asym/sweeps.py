@@ -6,7 +6,7 @@ structured array with one row per grid point (and per model), SI columns::
     length width thickness voltage modulus  (inputs; width/thickness are TOTAL 2l / 2e)
     model fidelity I M_A theta w w_small F_block F_block_small regime B1 error valid
 
-``I`` comes from the vectorised :func:`ipmc_asym.moment.moment` (one call per model for the
+``I`` comes from the vectorised :func:`ipmc_asym.integral.moment` (one call per model for the
 whole grid) and the mechanics from the vectorised :func:`ipmc_asym.beam.solve_beam`; nothing
 loops over points in Python except the ``bvp`` fidelity.
 
@@ -112,7 +112,7 @@ def sweep(vary: dict, model="constant", fidelity="quadrature", base: Strip | Non
     numpy structured array (dtype :data:`DTYPE`), one row per grid point and model.
     """
     from .beam import solve_beam
-    from .moment import check_fidelity, moment
+    from .integral import check_fidelity, moment
     from .permittivity import get_model
 
     check_fidelity(fidelity)

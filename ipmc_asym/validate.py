@@ -39,7 +39,7 @@ def claims(material: Material = NAFION_LI, strip: Strip | None = None) -> list[d
     """All claim rows (list of dicts)."""
     from .estimate import evaluate
     from .fits import fit_power_law, linear_r, local_exponent
-    from .moment import moment
+    from .integral import moment
     from .profiles import profile_summary
     from .sweeps import OUTSIDE, sweep
 

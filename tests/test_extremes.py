@@ -11,7 +11,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from ipmc_asym.bvp import solve
-from ipmc_asym.moment import moment
+from ipmc_asym.integral import moment
 from ipmc_asym.params import Strip
 
 MODELS = ("constant", "linear", "affine")

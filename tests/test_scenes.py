@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from ipmc_asym.beam import blocking_force_large, tip_position
-from ipmc_asym.moment import moment
+from ipmc_asym.integral import moment
 from ipmc_asym.params import NAFION_LI
 from ipmc_asym.scenes import LADDER, run_scene
 

@@ -93,7 +93,7 @@ def moment_closed(lam, A2, A3, rho, model_id, order):
     """``I`` at order 1 (``leading``: lam J1) or 2 (``corrected``: lam J1 + lam^2 J2).
 
     ``rho`` must be the model's own (``A1/(A0+A1)``: 1, 0, 5/1005); the per-model kernels
-    have it built in and the caller (:func:`ipmc_asym.moment.moment`) guarantees it.
+    have it built in and the caller (:func:`ipmc_asym.integral.moment`) guarantees it.
 
     Returns
     -------

@@ -7,7 +7,7 @@ import pytest
 
 from ipmc_asym import moment_integral
 from ipmc_asym.bvp import moment_integral_bvp
-from ipmc_asym.moment import moment
+from ipmc_asym.integral import moment
 
 MODELS = ("constant", "linear", "affine")
 GRID = [(t, v) for t in (10e-6, 200e-6, 4e-3) for v in (1e-3, 0.1, 10.0)]
