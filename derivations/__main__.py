@@ -17,6 +17,8 @@ def main(argv=None) -> int:
         from . import model
 
         model.main()
+        if not args.check:  # printing never rewrites the kernels (e.g. inside site-packages)
+            return 0
     if args.check:
         return codegen.check()
     path = codegen.write()

@@ -31,7 +31,7 @@ import mpmath as mp
 import sympy as sp
 
 from . import model as M
-from .codegen import Kernel
+from .kernel import Kernel
 
 mp.mp.dps = 24
 

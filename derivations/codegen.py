@@ -8,7 +8,6 @@ difference with the committed file.
 
 from __future__ import annotations
 
-import dataclasses
 import difflib
 import sys
 import tempfile
@@ -17,22 +16,15 @@ from pathlib import Path
 import sympy as sp
 from sympy.printing.pycode import PythonCodePrinter
 
+from . import kernels_spec
+from .kernel import Kernel
+
 ROOT = Path(__file__).resolve().parents[1]
 TARGET = ROOT / "ipmc_asym" / "kernels" / "_generated.py"
 PINNED_SYMPY = "1.14.0"
 
 #: functions implemented in ipmc_asym/kernels/special.py
 SPECIAL = ("exprel", "e2rel", "li2", "li3")
-
-
-@dataclasses.dataclass
-class Kernel:
-    name: str
-    args: tuple  # sympy symbols
-    outputs: tuple  # sympy expressions (returned as a tuple if more than one)
-    doc: str
-    source: str  # derivation that produced it (module:function)
-    prelude: str = ""  # optional hand-written guard lines (already python), e.g. branches
 
 
 class _Printer(PythonCodePrinter):
@@ -80,8 +72,6 @@ def render_kernel(k: Kernel) -> str:
     lines.append("")
     lines.append(f"    Derived in ``{k.source}``.")
     lines.append('    """')
-    if k.prelude:
-        lines.extend("    " + ln if ln else "" for ln in k.prelude.strip("\n").splitlines())
     for sym, ex in repl:
         lines.append(f"    {sym} = {pr.doprint(ex)}")
     outs = [pr.doprint(e) for e in reduced]
@@ -138,8 +128,6 @@ def render_module(kernels, constants: dict, tables: dict | None = None) -> str:
 
 
 def build_source() -> str:
-    from . import kernels_spec
-
     kernels, constants, tables = kernels_spec.all_kernels()
     return render_module(kernels, constants, tables)
 

@@ -5,8 +5,9 @@ from __future__ import annotations
 import sympy as sp
 from sympy.codegen.cfunctions import expm1
 
+from . import closed_forms
 from . import model as M
-from .codegen import Kernel
+from .kernel import Kernel
 
 
 def base_kernels():
@@ -100,8 +101,6 @@ def model_kernels():
 
 def all_kernels():
     kernels = list(base_kernels()) + model_kernels()
-    from . import closed_forms
-
     ck, constants, tables = closed_forms.kernels()
     kernels.extend(ck)
     return kernels, constants, tables

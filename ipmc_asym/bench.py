@@ -19,8 +19,8 @@ Targets (checked side by side in one run, single-threaded): leading <= 50 ns/poi
 corrected <= 200 ns/point, quadrature <= 5 us/point; leading and corrected >= 1e6x and
 quadrature >= 1e4x faster per point than the BVP.
 
-:func:`run_bench` returns one JSON-ready dict; :func:`plot_speed_accuracy` draws
-``figures/speed_accuracy.png``.  Module-level imports are stdlib + numpy only.
+:func:`run_bench` returns one JSON-ready dict; :func:`ipmc_asym.plotting.speed.plot_speed_accuracy`
+draws ``figures/speed_accuracy.png``.  Module-level imports are stdlib + numpy only.
 """
 
 from __future__ import annotations
@@ -34,11 +34,11 @@ import time
 
 import numpy as np
 
-from .jsonio import dumps as _jdumps
+from .registry import model_names
 
-__all__ = ["run_bench", "sample_points", "plot_speed_accuracy", "speed_accuracy_figure", "format_table", "TARGETS", "register", "run"]
+__all__ = ["run_bench", "sample_points", "format_table", "TARGETS", "MODELS", "ERR_FLOOR"]
 
-MODELS = ("constant", "linear", "affine")
+MODELS = model_names()
 FAST = ("leading", "corrected", "quadrature")
 THICKNESS_RANGE = (10e-6, 4e-3)
 VOLTAGE_RANGE = (1e-3, 10.0)
@@ -50,7 +50,7 @@ TARGETS = {
     "quadrature": {"seconds_per_point": 5e-6, "speedup_vs_bvp": 1e4},
 }
 
-_ERR_FLOOR = 1e-16  # relative errors below this are reported as this (log plots)
+ERR_FLOOR = 1e-16  # relative errors below this are reported as this (log plots)
 
 
 def sample_points(n: int, seed: int = 0, layout: str = "random"):
@@ -268,7 +268,7 @@ def run_bench(points: int = 10**6, bvp_points: int = 5, repeats: int = 3, seed: 
             s2, _ = _time_driver(fid, model, th, v, threads, repeats)
             if bt.size:
                 r = moment(sub_th, sub_v, model, fid)
-                rel = np.maximum(np.abs(r.I - bI) / np.abs(bI), _ERR_FLOOR)
+                rel = np.maximum(np.abs(r.I - bI) / np.abs(bI), ERR_FLOOR)
                 emax, emed, est = float(rel.max()), float(np.median(rel)), float(np.max(r.error))
             else:
                 emax = emed = est = None
@@ -340,86 +340,3 @@ def format_table(res: dict) -> str:
                      f"{', '.join(st['heavy_modules_imported']) or 'none'}")
     lines.append(f"all targets: {'pass' if res['all_pass'] else 'FAIL (see table)'}")
     return "\n".join(lines)
-
-
-def speed_accuracy_figure(path="figures/speed_accuracy.png", points: int = 10**6, bvp_points: int = 3) -> str:
-    """Run a (smaller) benchmark without the compile subprocesses and draw its figure."""
-    return plot_speed_accuracy(run_bench(points, bvp_points, compile_times=False), path)
-
-
-def plot_speed_accuracy(res: dict, path="figures/speed_accuracy.png") -> str:
-    """Log time per point (x) vs log relative error against the BVP (y).
-
-    Marker shape = fidelity, colour = model; the BVP is placed at its stated error estimate.
-
-    Returns
-    -------
-    str
-        The path written.
-    """
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    from matplotlib.lines import Line2D
-
-    markers = {"leading": "o", "corrected": "s", "quadrature": "^", "bvp": "D"}
-    colours = {"constant": "tab:blue", "linear": "tab:orange", "affine": "tab:green"}
-    fig, ax = plt.subplots(figsize=(7, 5))
-    for r in res["results"]:
-        x, y = r["seconds_per_point_serial"], r["rel_error_max"]
-        if x is None or y is None:
-            continue
-        ax.scatter([x], [max(y, _ERR_FLOOR)], marker=markers[r["fidelity"]], color=colours[r["model"]],
-                   s=70, edgecolor="k", linewidth=0.6, zorder=3)
-    for f, t in TARGETS.items():
-        ax.axvline(t["seconds_per_point"], color="0.6", ls=":", lw=0.8)
-        ax.text(t["seconds_per_point"], 0.5, f" {f} target", rotation=90, fontsize=7, color="0.4",
-                va="top", transform=ax.get_xaxis_transform())
-    ax.set_xscale("log")
-    ax.set_yscale("log")
-    ax.set_xlabel("time per point, single thread [s]")
-    ax.set_ylabel("max relative error of I vs BVP (BVP: its estimate)")
-    ax.set_title(f"ipmc-asym: speed vs accuracy ({res['points']:.0e} points, "
-                 f"{res['bvp_points']} BVP points/model)")
-    ax.grid(True, which="major", alpha=0.3)
-    h = [Line2D([], [], ls="", marker=m, color="0.3", label=f) for f, m in markers.items()]
-    h += [Line2D([], [], ls="", marker="o", color=c, label=m) for m, c in colours.items()]
-    ax.legend(handles=h, loc="best", fontsize=8, ncol=2)
-    fig.tight_layout()
-    d = os.path.dirname(os.path.abspath(path))
-    os.makedirs(d, exist_ok=True)
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return str(path)
-
-
-def register(sub):
-    """Add the ``bench`` subcommand."""
-    p = sub.add_parser("bench", help="time and accuracy of each fidelity (10^6-point sweep vs BVP)")
-    p.add_argument("--json", action="store_true", help="print one JSON object")
-    p.add_argument("--points", type=int, default=10**6, help="sweep size N (default 10^6)")
-    p.add_argument("--bvp-points", type=int, default=5, help="BVP sample per model (default 5)")
-    p.add_argument("--no-compile", action="store_true", help="skip the compile-time subprocesses")
-    p.add_argument("--layout", default="grid", choices=["grid", "random"],
-                   help="sweep points on a log grid (default) or drawn at random")
-    p.add_argument("--figure", default="figures/speed_accuracy.png",
-                   help="where to draw the speed/accuracy plot ('' for none)")
-
-
-def run(args) -> int:
-    """Run ``ipmc-asym bench``."""
-    if args.points < 1:
-        raise ValueError(f"--points must be >= 1; got {args.points}")
-    if args.bvp_points < 1:
-        raise ValueError(f"--bvp-points must be >= 1; got {args.bvp_points}")
-    res = run_bench(args.points, args.bvp_points, compile_times=not args.no_compile, layout=args.layout)
-    if args.figure:
-        res["figure"] = plot_speed_accuracy(res, args.figure)
-    if args.json:
-        print(_jdumps(res, indent=2))
-    else:
-        print(format_table(res))
-        if args.figure:
-            print(f"figure: {res['figure']}")
-    return 0

@@ -1,6 +1,6 @@
 """Full nonlinear boundary-value problem across the thickness (the numerical cross-check).
 
-Dimensionless model (seed paper sections 4-5, DESIGN.md section 2), ``z`` = ``z/e`` in
+Dimensionless model (paper sections 4-5; docs/design.md), ``z`` = ``z/e`` in
 ``[-1, 1]`` (anode ``z = -1``, cathode ``z = +1``)::
 
     E = -phi'        D = eps E        D' = C - 1        eps = A0 C + A1
@@ -52,6 +52,7 @@ from scipy.integrate import solve_bvp
 
 from .params import NAFION_LI, Groups, Material, Strip, check_finite, check_positive
 from .permittivity import Permittivity, get_model
+from .settings import BVP_MAX_NODES, BVP_TOL
 
 __all__ = ["BVPResult", "solve", "moment_integral_bvp", "b1_guess", "make_mesh"]
 
@@ -595,8 +596,8 @@ def _bc_res(prob, res) -> float:
     return float(np.max(np.abs(prob.bc(res.y[:, 0], res.y[:, -1], res.p))))
 
 
-def solve(strip: Strip, model="constant", material: Material = NAFION_LI, *, tol: float = 1e-10,
-          max_nodes: int = 300000, continuation: bool = True) -> BVPResult:
+def solve(strip: Strip, model="constant", material: Material = NAFION_LI, *, tol: float = BVP_TOL,
+          max_nodes: int = BVP_MAX_NODES, continuation: bool = True) -> BVPResult:
     """Solve the full nonlinear BVP across the thickness and return profiles and ``I``.
 
     Parameters
@@ -714,7 +715,7 @@ def _finish(res, prob, g, g_signed, name, t0, how) -> BVPResult:
 
 
 def moment_integral_bvp(thickness, voltage, model="constant", material: Material = NAFION_LI,
-                        *, tol: float = 1e-10) -> float:
+                        *, tol: float = BVP_TOL) -> float:
     """Moment integral ``I = int p z dz`` from the full BVP (dimensionless, signed).
 
     Parameters

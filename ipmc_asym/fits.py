@@ -17,6 +17,9 @@ from __future__ import annotations
 import numpy as np
 
 from .params import NAFION_LI, Material, Strip
+from .registry import model_names
+from .settings import OUTSIDE_REGIMES
+from .sweeps import sweep
 
 __all__ = ["fit_power_law", "local_exponent", "sweep_fits", "RANGES", "scaling_fits", "variation_table", "QUANTITIES",
            "linear_r"]
@@ -32,12 +35,6 @@ RANGES = {
     "voltage": (0.1, 3.0, 30),
 }
 
-#: the paper's table of variations (exponent of theta, F^p, w in L, l, e)
-PAPER_TABLE = {
-    "theta": {"length": 1, "width": 0, "thickness": -2},
-    "F_block": {"length": -1, "width": 1, "thickness": 1},
-    "w": {"length": 2, "width": 0, "thickness": -2},
-}
 
 
 def fit_power_law(x, y, mask=None) -> dict:
@@ -92,12 +89,10 @@ def linear_r(x, y, mask=None) -> float:
 
 def sweep_fits(arr, variables, quantities=QUANTITIES) -> list[dict]:
     """Power-law fits of each quantity vs each varied variable, per model (1-D sweeps)."""
-    from .sweeps import OUTSIDE
-
     fits = []
     for m in dict.fromkeys(arr["model"].tolist()):
         sub = arr[arr["model"] == m]
-        inside = ~np.isin(sub["regime"], OUTSIDE)
+        inside = ~np.isin(sub["regime"], OUTSIDE_REGIMES)
         for v in variables:
             for q in quantities:
                 mask = inside if q in ("w", "F_block", "theta") else np.ones(sub.size, bool)
@@ -109,11 +104,9 @@ def sweep_fits(arr, variables, quantities=QUANTITIES) -> list[dict]:
     return fits
 
 
-def scaling_fits(models=("constant", "linear", "affine"), ranges=None, fidelity="quadrature",
+def scaling_fits(models=model_names(), ranges=None, fidelity="quadrature",
                  base: Strip | None = None, material: Material = NAFION_LI) -> list[dict]:
     """Fits of w, w_small, F^p (large/small), theta vs L, 2l, 2e, phi0 for each model."""
-    from .sweeps import sweep
-
     ranges = dict(RANGES if ranges is None else ranges)
     out = []
     for var, (a, b, n) in ranges.items():

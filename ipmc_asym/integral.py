@@ -1,6 +1,6 @@
 """The moment integral ``I(e, phi0)`` at every fidelity, for one point or 10^7.
 
-Fidelity ladder (DESIGN.md section 5), named after the asymptotic order:
+Fidelity ladder (docs/design.md; the registry :mod:`ipmc_asym.registry`), named after the asymptotic order:
 
 ``leading``
     ``I ~ lambda J1``: the O(lambda) term of the layer expansion, closed form
@@ -24,30 +24,31 @@ Fidelity ladder (DESIGN.md section 5), named after the asymptotic order:
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
 
 from ._jit import jit, jit_parallel, prange
-from .kernels.closed import MODEL_IDS, moment_closed
+from .kernels.closed import moment_closed
 from .kernels.quadrature import moment_quadrature
-from .params import NAFION_LI, Material, debye_length
-from .permittivity import Permittivity, get_model
+from .params import NAFION_LI, Material, Strip, debye_length
+from .permittivity import MODELS, Permittivity, get_model
+from .progress import progress as _progress_bar
+from .registry import FIDELITIES as _FIDELITY_SPECS
+from .registry import MODELS as _MODEL_SPECS
+from .registry import check_choice, fidelity_names
+from .settings import BVP_STATED_ERROR, VALIDITY_LIMIT
 
 __all__ = ["FIDELITIES", "MomentResult", "moment_integral", "moment", "groups_arrays", "check_fidelity"]
 
-FIDELITIES = ("leading", "corrected", "quadrature", "bvp")
+FIDELITIES = fidelity_names()
 #: order argument of the sweep driver: 1 leading, 2 corrected, 0 quadrature
-_ORDER = {"leading": 1, "corrected": 2, "quadrature": 0}
-
-#: error estimate beyond which a closed form / quadrature is declared outside its validity
-VALIDITY_LIMIT = 1e-2
+_ORDER = {k: f.order for k, f in _FIDELITY_SPECS.items() if f.order >= 0}
 
 
 def check_fidelity(fidelity: str) -> str:
-    if fidelity not in FIDELITIES:
-        raise ValueError(f"fidelity must be one of {', '.join(FIDELITIES)}; got {fidelity!r}")
-    return fidelity
+    return check_choice("fidelity", fidelity, FIDELITIES)
 
 
 @dataclass
@@ -209,10 +210,8 @@ def closed_model_id(perm: Permittivity, fidelity: str) -> int:
 
     The closed forms are derived for the paper's three (eps0, eps_moy - eps0) pairs only.
     """
-    if fidelity == "quadrature":
+    if not _FIDELITY_SPECS[fidelity].closed_form:
         return -1
-    from .permittivity import MODELS
-
     paper = MODELS.get(perm.name)
     if paper is None or (perm.eps0, perm.deps) != (paper.eps0, paper.deps):
         raise ValueError(
@@ -220,18 +219,19 @@ def closed_model_id(perm: Permittivity, fidelity: str) -> int:
             f"models only; use fidelity 'quadrature' or 'bvp' for {perm.name!r} with "
             f"eps0={perm.eps0:g}, eps_moy-eps0={perm.deps:g} F/m"
         )
-    return MODEL_IDS[perm.name]
+    return _MODEL_SPECS[perm.name].id
 
 
 def _bvp_loop(thickness, voltage, perm, mat, I, err, B1, core, progress):
-    from .bvp import solve
-    from .params import Strip
+    from .bvp import (
+        solve,  # deferred: scipy.integrate is heavy (start-up of the closed forms)
+    )
 
     th, v = np.broadcast_arrays(np.asarray(thickness, float), np.asarray(voltage, float))
     n = th.size
     show = (n > 20) if progress is None else progress
-    bar = _progress(n, "BVP") if show else None
-    for k, idx in enumerate(np.ndindex(th.shape)):
+    bar = _progress_bar(n, "BVP", enabled=show)
+    for idx in np.ndindex(th.shape):
         res = solve(Strip(thickness=float(th[idx]), voltage=float(v[idx])), perm, mat)
         if not res.success:
             raise RuntimeError(
@@ -239,36 +239,11 @@ def _bvp_loop(thickness, voltage, perm, mat, I, err, B1, core, progress):
                 f"({res.message}); try a looser tol or fidelity 'quadrature'"
             )
         I[idx] = res.I
-        # solve_bvp tolerance 1e-10 on the residuals; measured I accuracy ~1e-12 (tests/test_bvp.py)
-        err[idx] = 1e-9
+        err[idx] = BVP_STATED_ERROR
         B1[idx] = res.B1 if v[idx] >= 0 else res.B1 * math.exp(res.groups.A2)
         core[idx] = 2.0
-        if bar:
-            bar(k + 1)
-    if bar:
-        bar(None)
-
-
-def _progress(n, label):
-    import sys
-    import time
-
-    t0 = time.perf_counter()
-    last = [0.0]
-
-    def update(k):
-        now = time.perf_counter()
-        if k is None:
-            sys.stderr.write("\n")
-            return
-        if now - last[0] > 0.2 or k == n:
-            last[0] = now
-            frac = k / n
-            bar = "#" * int(30 * frac)
-            sys.stderr.write(f"\r{label} [{bar:<30s}] {k}/{n} {now - t0:6.1f}s")
-            sys.stderr.flush()
-
-    return update
+        bar.update(1)
+    bar.close()
 
 
 def moment_integral(thickness, voltage, model="constant", fidelity="quadrature", *, material=None,
@@ -305,7 +280,5 @@ def moment_integral(thickness, voltage, model="constant", fidelity="quadrature",
                f"or electrode layers overlapping); use a higher fidelity ('bvp' where layers overlap)")
         if on_invalid == "raise":
             raise ValueError(msg)
-        import warnings
-
         warnings.warn(msg, RuntimeWarning, stacklevel=2)
     return float(r.I) if r.I.ndim == 0 else r.I

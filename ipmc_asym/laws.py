@@ -11,13 +11,12 @@ from __future__ import annotations
 import numpy as np
 
 from .fits import local_exponent
-from .jsonio import dumps as _jdumps
+from .integral import moment
+from .settings import LAW_HOLD_TOL
 
-__all__ = ["local_exponents", "law_table", "law_ranges", "register", "run"]
+__all__ = ["local_exponents", "law_table", "law_ranges", "factor_three"]
 
-MODELS = ("constant", "linear", "affine")
-#: a law "holds" where the local exponent is within this of the law's exponent
-HOLD_TOL = 0.05
+HOLD_TOL = LAW_HOLD_TOL
 
 
 def local_exponents(model, var, n=241, thickness=200e-6, voltage=1.0):
@@ -25,8 +24,6 @@ def local_exponents(model, var, n=241, thickness=200e-6, voltage=1.0):
 
     Returns (x, exponent) arrays; ``x`` is the voltage (V) or the TOTAL thickness (m).
     """
-    from .integral import moment
-
     if var == "voltage":
         x = np.logspace(-3, 1, n)
         I = moment(thickness, x, model, "quadrature").I
@@ -95,42 +92,8 @@ def law_ranges(model):
     return out
 
 
-def register(sub):
-    p = sub.add_parser("laws", help="analytic scaling laws (leading order) and where they hold")
-    p.add_argument("--model", default="all", choices=["constant", "linear", "affine", "all"])
-    p.add_argument("--json", action="store_true")
-    p.add_argument("--latex", action="store_true", help="print LaTeX for every quantity (default: for I only)")
+def factor_three() -> dict:
+    """Ratio of the section 3-4 prefactors of theta, w_p, F^p to the section 6.2 ones (SymPy)."""
+    from derivations import scaling  # deferred: SymPy (start-up)
 
-
-def run(args):
-    models = MODELS if args.model == "all" else (args.model,)
-    from derivations import scaling
-
-    factor = {k: str(v) for k, v in scaling.factor_three().items()}
-    data = {"factor_sections_3_4_over_6_2": factor, "models": {}}
-    for m in models:
-        data["models"][m] = {"laws": law_table(m), "ranges": law_ranges(m)}
-    if args.json:
-        print(_jdumps(data, indent=2))
-        return 0
-    print("Leading-order scaling laws (SI; e = HALF thickness, l = HALF width; M_A = A5 I).")
-    print(f"Prefactors of theta, w_p, F^p from sections 3-4 are {factor} x the paper's section 6.2 ones;"
-          " we use sections 3-4.")
-    for m in models:
-        print(f"\n== {m} ==")
-        for r in data["models"][m]["laws"]:
-            ex = "  ".join(f"{k}^{v}" for k, v in r["exponents"].items())
-            print(f"  [{r['regime']}] {r['quantity']:8s} ~ {ex:38s} = {r['formula']}")
-            if args.latex or r["quantity"] == "I":
-                print(f"      LaTeX: {r['quantity'].replace('_', ' ')} = {r['latex']}")
-        rg = data["models"][m]["ranges"]
-        ep, ee = rg["exponent_phi0"], rg["exponent_e"]
-        print(f"  local d ln I/d ln phi0 over 1 mV-10 V (2e = 200 um): {ep['min']:+.3f} .. {ep['max']:+.3f} "
-              f"({ep['at_1V']:+.3f} at 1 V)")
-        print(f"  local d ln I/d ln e over 2e = 10 um-4 mm (1 V): {ee['min']:+.4f} .. {ee['max']:+.4f} "
-              f"({ee['at_200um']:+.4f} at 200 um)")
-        for k, spans in {**rg["voltage"], **rg["thickness"]}.items():
-            txt = ", ".join(f"{a:.3g}-{b:.3g}" for a, b in spans) or "nowhere in the range"
-            unit = "m (total thickness)" if "e^" in k else "V"
-            print(f"  {k}: holds (|exponent error| < {HOLD_TOL}) for {txt} {unit if spans else ''}")
-    return 0
+    return {k: str(v) for k, v in scaling.factor_three().items()}

@@ -41,7 +41,7 @@ __all__ = [
 ]
 
 #: The value the paper states (section 4) and uses; the formula with the quoted data gives
-#: about 3162 mol/m^3 (DESIGN.md section 3, slip 1).
+#: about 3162 mol/m^3 (docs/design.md, slip 1).
 C_MOY_PAPER = 3082.0
 
 

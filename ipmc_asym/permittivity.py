@@ -1,4 +1,4 @@
-"""Permittivity models ``eps(C)`` (paper section 4, DESIGN.md section 2).
+"""Permittivity models ``eps(C)`` (paper section 4; docs/design.md).
 
 ``eps = eps0 + (eps_moy - eps0) C / C_moy``; in dimensionless form
 ``eps_bar = A0 C_bar + A1``.  The paper writes ``alpha = 1e-3 F/m``; the numbers it quotes
@@ -14,8 +14,9 @@ from dataclasses import dataclass
 from typing import Callable, Optional
 
 from .params import Groups, Material, Strip, check_finite, make_groups
+from .registry import MODELS as _REGISTRY
 
-__all__ = ["MODELS", "Permittivity", "get_model", "model_names"]
+__all__ = ["MODELS", "Permittivity", "get_model"]
 
 
 @dataclass(frozen=True)
@@ -70,16 +71,8 @@ class Permittivity:
         return make_groups(strip, material, max(e0, 0.0), max(em - max(e0, 0.0), 0.0))
 
 
-#: The paper's three models (section 4 table), SI (F/m).
-MODELS = {
-    "constant": Permittivity("constant", eps0=5e-6, deps=0.0),
-    "linear": Permittivity("linear", eps0=0.0, deps=1e-3),
-    "affine": Permittivity("affine", eps0=5e-6, deps=1e-3),
-}
-
-
-def model_names() -> list[str]:
-    return list(MODELS)
+#: The paper's three models (section 4 table), SI (F/m), from the registry.
+MODELS = {name: Permittivity(name, eps0=spec.eps0, deps=spec.deps) for name, spec in _REGISTRY.items()}
 
 
 def get_model(model) -> Permittivity:

@@ -22,24 +22,23 @@ Layer widths (definitions used everywhere in the toolkit)
     same, where ``C_bar - 1`` falls to half its face value ``(B1 - 1)/2`` (less sensitive to
     the shape of the tail).
 
-Layer rule: stdlib + numpy at import; SciPy (via bvp) and matplotlib are imported lazily.
+Layer rule: stdlib + numpy at import; SciPy (via bvp) is imported lazily; figures are drawn by
+:mod:`ipmc_asym.plotting.profiles`.
 """
 
 from __future__ import annotations
 
 import csv
 import math
-import os
 
 import numpy as np
 
-from .jsonio import dumps as _jdumps
+from .fileio import atomic_write
 from .params import NAFION_LI, Material, Strip
+from .registry import model_names
 
-__all__ = ["MODELS3", "QUANTITIES", "profile", "layer_widths", "profile_summary", "write_csv",
-           "plot_profiles", "register", "run", "PAPER_LAYERS"]
-
-MODELS3 = ("constant", "linear", "affine")
+__all__ = ["QUANTITIES", "profile", "layer_widths", "profile_summary", "write_csv",
+           "compute_all", "PAPER_LAYERS"]
 
 #: quantity key -> (BVPResult attribute, axis label)
 QUANTITIES = {
@@ -140,7 +139,7 @@ def profile_summary(model="constant", strip: Strip | None = None, material: Mate
 
 def write_csv(res, path, e: float):
     """One row per mesh node: z_bar, z (m), distances from anode/cathode (m), and all profiles."""
-    with open(path, "w", newline="") as fh:
+    with atomic_write(path) as fh:
         wr = csv.writer(fh)
         wr.writerow(["z_bar", "z_m", "dist_anode_m", "dist_cathode_m", "C_bar", "phi_bar", "D_bar",
                      "E_bar", "rhoZ_bar", "p_bar"])
@@ -151,113 +150,6 @@ def write_csv(res, path, e: float):
                          f"{res.E[i]:.12g}", f"{res.rhoZ[i]:.12g}", f"{res.p[i]:.12g}"])
 
 
-_COLORS = {"constant": "C0", "linear": "C1", "affine": "C2"}
-
-
-def plot_profiles(results: dict, quantity: str, path, e: float, dpi: int = 110, title: str | None = None):
-    """Full-width panel + zooms at the anode and the cathode (log distance from the face, µm).
-
-    ``results``: model name -> BVPResult; ``e`` HALF thickness (m).
-    """
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    attr, label = QUANTITIES[quantity]
-    fig, axs = plt.subplots(1, 3, figsize=(13, 4.0), dpi=dpi)
-    for name, res in results.items():
-        z = np.asarray(res.z)
-        f = np.asarray(getattr(res, attr))
-        c = _COLORS.get(name, None)
-        axs[0].plot(z, f, color=c, label=name)
-        da = (z + 1.0) * e * 1e6
-        m = (da > 0) & (z < 0)
-        axs[1].plot(da[m], f[m], color=c, label=name)
-        dc = (1.0 - z) * e * 1e6
-        m = (dc > 0) & (z > 0)
-        axs[2].plot(dc[m], f[m], color=c, label=name)
-    axs[0].set_xlabel(r"$\bar z = z/e$ ($e$ = HALF thickness = %.4g µm)" % (e * 1e6))
-    axs[0].set_title("full thickness (anode $\\bar z=-1$, cathode $+1$)", fontsize=9)
-    for ax, side in ((axs[1], "anode ($\\bar z=-1$)"), (axs[2], "cathode ($\\bar z=+1$)")):
-        ax.set_xscale("log")
-        ax.set_xlim(1e-4, e * 1e6)
-        ax.set_xlabel(f"distance from the {side.split(' ')[0]} face (µm, log)")
-        ax.set_title(f"zoom at the {side}", fontsize=9)
-    if quantity == "C":
-        axs[2].set_yscale("log")
-    for ax in axs:
-        ax.set_ylabel(label)
-        ax.grid(True, alpha=0.3)
-    axs[0].legend(fontsize=8)
-    fig.suptitle(title or f"{quantity} profile through the thickness (nominal strip, full BVP)", fontsize=10)
-    fig.tight_layout()
-    fig.savefig(path)
-    plt.close(fig)
-
-
-def compute_all(models=MODELS3, strip: Strip | None = None, material: Material = NAFION_LI):
+def compute_all(models=model_names(), strip: Strip | None = None, material: Material = NAFION_LI):
     strip = Strip() if strip is None else strip
     return {m: profile(m, strip, material) for m in models}
-
-
-def write_all(out_dir, models=MODELS3, strip: Strip | None = None, material: Material = NAFION_LI,
-              dpi: int = 110, quantities=tuple(QUANTITIES), results=None) -> dict:
-    """CSV per model + one PNG per quantity; returns {"summaries": [...], "files": [...]}."""
-    strip = Strip() if strip is None else strip
-    os.makedirs(out_dir, exist_ok=True)
-    results = compute_all(models, strip, material) if results is None else results
-    files = []
-    for m, res in results.items():
-        p = os.path.join(out_dir, f"profiles_{m}.csv")
-        write_csv(res, p, strip.e)
-        files.append(p)
-    figno = {"C": 4, "phi": 5, "D": 6, "p": 7}
-    for q in quantities:
-        p = os.path.join(out_dir, f"profile_{q}.png")
-        t = f"{q} profile (paper Fig. {figno[q]})" if q in figno else f"{q} profile"
-        plot_profiles(results, q, p, strip.e, dpi=dpi,
-                      title=f"{t}: L={strip.length*100:g} cm, 2e={strip.thickness*1e6:g} µm, "
-                            f"phi0={strip.voltage:g} V, full BVP")
-        files.append(p)
-    sums = [profile_summary(m, strip, material, res=r) for m, r in results.items()]
-    return {"summaries": sums, "files": files}
-
-
-# ---- CLI -------------------------------------------------------------------------------------
-def register(sub):
-    from .cli import add_strip_options
-
-    p = sub.add_parser("profiles", help="C, phi, D, E, rhoZ, p through the thickness (paper Figs 4-7)")
-    add_strip_options(p)
-    p.add_argument("--model", default="all", choices=list(MODELS3) + ["all"])
-    p.add_argument("--out", default="figures", help="output directory for CSV and PNG (default figures/)")
-    p.add_argument("--json", action="store_true", help="print the layer summary as JSON")
-
-
-def run(args) -> int:
-
-    from .cli import material_from_args, strip_from_args
-
-    strip = strip_from_args(args)
-    if strip.voltage <= 0:
-        raise ValueError("profiles: voltage must be > 0 (a negative voltage is the mirror image)")
-    mat = material_from_args(args)
-    models = MODELS3 if args.model == "all" else (args.model,)
-    out = write_all(args.out, models, strip, mat)
-    if args.json:
-        print(_jdumps(out, indent=2))
-        return 0
-    print(f"profiles at L={strip.length:g} m, 2e={strip.thickness:g} m (e={strip.e:g} m), "
-          f"phi0={strip.voltage:g} V; layer widths in µm from the face")
-    print(f"{'model':9s} {'devoid':>8s} {'depletion':>10s} {'accum(1/e)':>10s} {'accum(1/2)':>10s} {'B1':>9s} "
-          f"{'Debye':>8s} {'paper dep':>9s} {'paper acc':>9s}")
-    for s in out["summaries"]:
-        pd = PAPER_LAYERS.get((s["model"], "depletion"))
-        pa = PAPER_LAYERS.get((s["model"], "accumulation"))
-        print(f"{s['model']:9s} {s['devoid_um']:8.4g} {s['depletion_um']:10.4g} {s['accumulation_um']:10.4g} "
-              f"{s['accumulation_half_um']:10.4g} {s['B1']:9.4g} {s['debye_um']:8.3g} "
-              f"{(pd if pd is not None else float('nan')):9.3g} {(pa if pa is not None else float('nan')):9.3g}")
-    for f in out["files"]:
-        print("wrote", f)
-    return 0

@@ -21,28 +21,31 @@ from __future__ import annotations
 
 import csv
 import sys
-import time
 
 import numpy as np
 
-from .jsonio import dumps as _jdumps
+from .beam import solve_beam
+from .fileio import atomic_write
+from .integral import check_fidelity, moment
 from .params import NAFION_LI, Material, Strip, moment_scale, second_moment
+from .permittivity import get_model
+from .progress import progress as progress_bar
+from .registry import model_names
+from .settings import OUTSIDE_REGIMES
+from .units import parse_length, parse_pressure, parse_voltage
 
-__all__ = ["VARIABLES", "parse_vary", "sweep", "write_csv", "rows_as_dicts", "register", "run"]
+__all__ = ["VARIABLES", "DTYPE", "parse_vary", "sweep", "write_csv", "rows_as_dicts"]
 
 VARIABLES = ("length", "width", "thickness", "voltage", "modulus")
-MODELS3 = ("constant", "linear", "affine")
 
 _FLOAT_COLS = ("length", "width", "thickness", "voltage", "modulus", "I", "M_A", "theta", "w", "w_small",
                "F_block", "F_block_small", "B1", "error")
 DTYPE = np.dtype([(c, "f8") for c in _FLOAT_COLS[:5]] + [("model", "U8"), ("fidelity", "U10")]
                  + [(c, "f8") for c in _FLOAT_COLS[5:]] + [("regime", "U17"), ("valid", "?")])
-OUTSIDE = ("past-quarter-turn", "multi-turn")
+OUTSIDE = OUTSIDE_REGIMES
 
 
 def _parse_value(name, text):
-    from .units import parse_length, parse_pressure, parse_voltage
-
     if name in ("length", "width", "thickness"):
         return parse_length(name, text)
     if name == "voltage":
@@ -86,7 +89,7 @@ def parse_vary(spec: str):
 
 def _models(model):
     if model == "all":
-        return list(MODELS3)
+        return list(model_names())
     if isinstance(model, (list, tuple)):
         return list(model)
     return [model]
@@ -111,10 +114,6 @@ def sweep(vary: dict, model="constant", fidelity="quadrature", base: Strip | Non
     -------
     numpy structured array (dtype :data:`DTYPE`), one row per grid point and model.
     """
-    from .beam import solve_beam
-    from .integral import check_fidelity, moment
-    from .permittivity import get_model
-
     check_fidelity(fidelity)
     base = Strip() if base is None else base
     for k in vary:
@@ -141,6 +140,7 @@ def sweep(vary: dict, model="constant", fidelity="quadrature", base: Strip | Non
     out_parts = []
     models = _models(model)
     show = (n * len(models) > 20000 or fidelity == "bvp") if progress is None else progress
+    bar = progress_bar(len(models), "sweep", enabled=show and fidelity != "bvp", unit="model")
     for m in models:
         perm = get_model(m)
         # I depends on (thickness, voltage) only: evaluate each distinct pair once
@@ -167,17 +167,9 @@ def sweep(vary: dict, model="constant", fidelity="quadrature", base: Strip | Non
         arr["error"] = np.asarray(r.error)[inv]
         arr["valid"] = np.asarray(r.valid)[inv]
         out_parts.append(arr)
-        if show and fidelity != "bvp":
-            _bar(len(out_parts), len(models))
-    if show and fidelity != "bvp":
-        sys.stderr.write("\n")
+        bar.update(1)
+    bar.close()
     return np.concatenate(out_parts)
-
-
-def _bar(k, n, label="sweep"):
-    frac = k / n
-    sys.stderr.write(f"\r{label} [{'#' * int(30 * frac):<30s}] {k}/{n} models")
-    sys.stderr.flush()
 
 
 def rows_as_dicts(arr: np.ndarray) -> list[dict]:
@@ -201,63 +193,15 @@ def rows_as_dicts(arr: np.ndarray) -> list[dict]:
 
 def write_csv(arr: np.ndarray, path):
     """CSV with SI columns (header = field names)."""
-    fh = sys.stdout if path in (None, "-") else open(path, "w", newline="")
-    try:
+    def rows(fh):
         wr = csv.writer(fh)
         wr.writerow(arr.dtype.names)
         for rec in arr:
             wr.writerow([f"{v:.10g}" if isinstance(v, (np.floating, float)) else
                          (str(bool(v)) if isinstance(v, np.bool_) else str(v)) for v in rec.tolist()])
-    finally:
-        if fh is not sys.stdout:
-            fh.close()
 
-
-# ---- CLI -------------------------------------------------------------------------------------
-def register(sub):
-    from .cli import add_strip_options
-
-    p = sub.add_parser("sweep", help="evaluate the strip on a grid of parameters (vectorised)")
-    p.add_argument("--vary", action="append", default=[], metavar="NAME=START:STOP:N[:log]",
-                   help="length, width, thickness (TOTAL), voltage or modulus; repeat for a grid")
-    add_strip_options(p)
-    p.add_argument("--model", default="constant", choices=list(MODELS3) + ["all"])
-    p.add_argument("--fidelity", default="quadrature", choices=["leading", "corrected", "quadrature", "bvp"])
-    p.add_argument("--tol", type=float, default=None, help="tolerance of the 'small' beam regime (1%%)")
-    p.add_argument("--out", default=None, help="CSV file (SI columns); default: stdout unless --json")
-    p.add_argument("--json", action="store_true", help='print {"rows": [...], "fits": [...]}')
-    p.add_argument("--no-progress", action="store_true")
-
-
-def run(args) -> int:
-    from .cli import material_from_args, strip_from_args
-    from .fits import sweep_fits
-
-    if not args.vary:
-        raise ValueError("sweep needs at least one --vary NAME=START:STOP:N (e.g. length=1cm:4cm:16)")
-    vary = {}
-    for s in args.vary:
-        k, v = parse_vary(s)
-        if k in vary:
-            raise ValueError(f"--vary {k} given twice")
-        vary[k] = v
-    base = strip_from_args(args)
-    mat = material_from_args(args)
-    t0 = time.perf_counter()
-    arr = sweep(vary, args.model, args.fidelity, base, mat, args.tol,
-                progress=False if args.no_progress else None)
-    dt = time.perf_counter() - t0
-    fits = sweep_fits(arr, list(vary)) if len(vary) == 1 else []
-    if args.out:
-        write_csv(arr, args.out)
-        sys.stderr.write(f"sweep: {arr.size} rows in {dt:.3g} s -> {args.out}\n")
-    if args.json:
-        print(_jdumps({"rows": rows_as_dicts(arr), "fits": fits, "seconds": dt}, indent=1))
-    elif not args.out:
-        write_csv(arr, "-")
-    if not args.json and fits:
-        for f in fits:
-            sys.stderr.write(
-                f"fit [{f['model']}] |{f['quantity']}| ~ {f['prefactor']:.4g} * {f['variable']}^"
-                f"{f['exponent']:.4g} (r={f['r']:.5f}, n={f['n']}, left out {f['n_left_out']})\n")
-    return 0
+    if path in (None, "-"):
+        rows(sys.stdout)
+    else:
+        with atomic_write(path) as fh:
+            rows(fh)

@@ -16,10 +16,9 @@ import math
 
 import numpy as np
 
-from .jsonio import dumps as _jdumps
 from .params import NAFION_LI, Material, Strip
 
-__all__ = ["claims", "to_markdown", "register", "run", "VERDICTS"]
+__all__ = ["claims", "to_markdown", "VERDICTS"]
 
 VERDICTS = ("reproduced", "differs", "not-reproducible")
 MODELS3 = ("constant", "linear", "affine")
@@ -250,24 +249,3 @@ def to_markdown(rows) -> str:
     n = {v: sum(r["verdict"] == v for r in rows) for v in VERDICTS}
     out += ["", "Summary: " + ", ".join(f"{k}: {v}" for k, v in n.items())]
     return "\n".join(out) + "\n"
-
-
-def register(sub):
-    p = sub.add_parser("validate", help="report: each claim of the paper vs our numbers, with a verdict")
-    p.add_argument("--json", action="store_true", help='print {"claims": [...]}')
-    p.add_argument("--out", default=None, help="write a Markdown report to this file")
-
-
-def run(args) -> int:
-    rows = claims()
-    if args.out:
-        with open(args.out, "w") as fh:
-            fh.write(to_markdown(rows))
-    if args.json:
-        print(_jdumps({"claims": [{k: r[k] for k in ("claim", "section", "paper", "ours", "verdict", "key")}
-                                     for r in rows]}, indent=2))
-    else:
-        for r in rows:
-            print(f"[{r['verdict']:>16s}] {r['section']:>18s}  {r['claim']}\n{'':38s}paper: {r['paper']}\n"
-                  f"{'':38s}ours:  {r['ours']}")
-    return 0

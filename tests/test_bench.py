@@ -4,7 +4,8 @@ import json
 
 import pytest
 
-from ipmc_asym.bench import MODELS, format_table, plot_speed_accuracy, run_bench
+from ipmc_asym.bench import MODELS, format_table, run_bench
+from ipmc_asym.plotting.speed import plot_speed_accuracy
 
 
 @pytest.fixture(scope="module")

@@ -1,6 +1,6 @@
 import numpy as np
 
-from ipmc_asym.figures import make_all
+from ipmc_asym.plotting.figures import make_all
 
 
 def test_figures_produced_and_nontrivial(tmp_path):

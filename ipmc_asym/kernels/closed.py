@@ -12,9 +12,8 @@ import math
 from .._jit import jit
 from . import _generated as G
 
-__all__ = ["MODEL_IDS", "layer_closed", "moment_closed", "TRUNCATION"]
+__all__ = ["layer_closed", "moment_closed", "TRUNCATION"]
 
-MODEL_IDS = {"constant": 0, "linear": 1, "affine": 2}
 
 #: truncation of the patches (18 terms at ratio <= 1/6 of the radius) and of the
 #: asymptotic pieces (O(T e^{-T}) at T = 31); checked against the quadrature in the tests.

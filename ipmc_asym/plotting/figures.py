@@ -7,22 +7,27 @@
   rotation, three models overlaid; points past a quarter turn drawn dotted (outside the model);
 * ``speed_accuracy.png`` if :func:`ipmc_asym.bench.speed_accuracy_figure` exists.
 
-matplotlib is imported lazily (Agg backend).
+All matplotlib code lives in :mod:`ipmc_asym.plotting`.
 """
 
 from __future__ import annotations
 
 import os
-import sys
 
 import numpy as np
 
-from .params import NAFION_LI, Material, Strip
+from ..params import NAFION_LI, Material, Strip
+from ..registry import model_names
+from ..settings import OUTSIDE_REGIMES
+from ..sweeps import sweep
+from . import MODEL_COLOURS, pyplot, savefig
+from .profiles import write_all
+from .speed import speed_accuracy_figure
 
-__all__ = ["influence_figure", "make_all", "register", "run"]
+__all__ = ["influence_figure", "make_all", "INFLUENCE"]
 
-MODELS3 = ("constant", "linear", "affine")
-_COL = {"constant": "C0", "linear": "C1", "affine": "C2"}
+MODELS3 = model_names()
+_COL = MODEL_COLOURS
 
 #: variable -> (values SI, axis scale to display, axis label, file stem, paper fig)
 INFLUENCE = {
@@ -36,13 +41,7 @@ INFLUENCE = {
 def influence_figure(var, path, base: Strip | None = None, material: Material = NAFION_LI, dpi=110,
                      values=None):
     """Three panels (|w|, F^p, |theta|) vs ``var`` for the three models (quadrature fidelity)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from .sweeps import OUTSIDE, sweep
-
+    plt = pyplot()
     vals, sc, xlabel, _stem, fig_no = INFLUENCE[var]
     vals = vals if values is None else np.asarray(values, float)
     base = Strip() if base is None else base
@@ -51,7 +50,7 @@ def influence_figure(var, path, base: Strip | None = None, material: Material = 
     for m in MODELS3:
         a = arr[arr["model"] == m]
         x = a[var] * sc
-        out = np.isin(a["regime"], OUTSIDE)
+        out = np.isin(a["regime"], OUTSIDE_REGIMES)
         inside = ~out
         for ax, q, qs, fac in ((axs[0], "w", "w_small", 1e3), (axs[1], "F_block", "F_block_small", 1e3),
                                (axs[2], "theta", None, 1.0)):
@@ -82,16 +81,12 @@ def influence_figure(var, path, base: Strip | None = None, material: Material = 
         ", ".join(f"{k}={v}" for k, v in fixed.items()) + f", E={material.E:.3g} Pa"
     fig.suptitle(t, fontsize=10)
     fig.tight_layout()
-    fig.savefig(path)
-    plt.close(fig)
-    return path
+    return savefig(fig, path)
 
 
 def make_all(out_dir="figures", dpi=110, base: Strip | None = None, material: Material = NAFION_LI,
              quick=False) -> dict:
     """Write every figure; returns {"files": [...], "notes": [...]}.  ``quick``: fewer points."""
-    from .profiles import write_all
-
     os.makedirs(out_dir, exist_ok=True)
     base = Strip() if base is None else base
     files, notes = [], []
@@ -102,36 +97,8 @@ def make_all(out_dir="figures", dpi=110, base: Strip | None = None, material: Ma
         p = os.path.join(out_dir, spec[3] + ".png")
         influence_figure(var, p, base, material, dpi, values=vals)
         files.append(p)
-    try:
-        from . import bench  # noqa: F401
-        fn = getattr(bench, "speed_accuracy_figure", None)
-    except ImportError:
-        fn = None
-    if fn is None:
-        notes.append("speed_accuracy.png skipped: ipmc_asym.bench.speed_accuracy_figure not available")
-    elif quick:
+    if quick:
         notes.append("speed_accuracy.png skipped in quick mode")
     else:
-        p = os.path.join(out_dir, "speed_accuracy.png")
-        try:
-            fn(p)
-            files.append(p)
-        except Exception as exc:  # another module's failure must not lose the other figures
-            notes.append(f"speed_accuracy.png failed: {exc.__class__.__name__}: {exc}")
+        files.append(speed_accuracy_figure(os.path.join(out_dir, "speed_accuracy.png")))
     return {"files": files, "notes": notes, "layers": out["summaries"]}
-
-
-def register(sub):
-    p = sub.add_parser("figures", help="regenerate the paper's Figs 4-10 (+ speed/accuracy) as PNG")
-    p.add_argument("--out", default="figures", help="output directory (default figures/)")
-    p.add_argument("--dpi", type=int, default=110)
-    p.add_argument("--quick", action="store_true", help="fewer points (for tests)")
-
-
-def run(args) -> int:
-    out = make_all(args.out, args.dpi, quick=args.quick)
-    for f in out["files"]:
-        print("wrote", f)
-    for n in out["notes"]:
-        sys.stderr.write(f"note: {n}\n")
-    return 0

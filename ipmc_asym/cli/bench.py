@@ -1,0 +1,41 @@
+"""``ipmc-asym bench``: time and accuracy of each fidelity, side by side in one run."""
+
+from __future__ import annotations
+
+from ..bench import format_table, run_bench
+from ..fileio import check_output_path
+from ..jsonio import dumps
+from . import SUMMARIES
+from .common import count_type
+
+
+def register(sub):
+    p = sub.add_parser("bench", help=SUMMARIES["bench"])
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument("--points", type=count_type("--points"), default=10**6, help="sweep size N (default 10^6)")
+    p.add_argument("--bvp-points", type=count_type("--bvp-points"), default=5,
+                   help="BVP sample per model (default 5)")
+    p.add_argument("--no-compile", action="store_true", help="skip the compile-time subprocesses")
+    p.add_argument("--layout", default="grid", choices=["grid", "random"],
+                   help="sweep points on a log grid (default) or drawn at random")
+    p.add_argument("--figure", default="figures/speed_accuracy.png",
+                   help="where to draw the speed/accuracy plot ('' for none)")
+
+
+def run(args) -> int:
+    if args.figure:
+        check_output_path(args.figure, "file", "--figure")
+    res = run_bench(args.points, args.bvp_points, compile_times=not args.no_compile, layout=args.layout)
+    if args.figure:
+        from ..plotting.speed import (
+            plot_speed_accuracy,  # deferred: matplotlib (start-up)
+        )
+
+        res["figure"] = plot_speed_accuracy(res, args.figure)
+    if args.json:
+        print(dumps(res, indent=2))
+    else:
+        print(format_table(res))
+        if args.figure:
+            print(f"figure: {res['figure']}")
+    return 0

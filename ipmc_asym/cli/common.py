@@ -1,0 +1,129 @@
+"""What several commands share: one-line errors, option types with units, strip options.
+
+Only the command line imports this module.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+
+from ..params import MATERIALS, NAFION_LI, Strip
+from ..units import parse_length, parse_pressure, parse_voltage
+
+__all__ = ["UsageError", "Parser", "add_strip_options", "material_from_args", "strip_from_args",
+           "arg_type", "count_type", "length_type", "pressure_type", "voltage_type", "tol_type", "first_run_notice"]
+
+
+class UsageError(Exception):
+    """Bad input at the command line (exit status 2)."""
+
+
+class Parser(argparse.ArgumentParser):
+    """argparse with a one-line error and exit status 2."""
+
+    def error(self, message):
+        sys.stderr.write(f"{self.prog}: error: {message}\n")
+        raise SystemExit(2)
+
+
+def arg_type(conv, name="value"):
+    """Wrap a converter raising ``ValueError`` into an argparse type (one-line message)."""
+
+    def f(text):
+        try:
+            return conv(text)
+        except ValueError as exc:
+            raise argparse.ArgumentTypeError(str(exc)) from None
+
+    f.__name__ = name
+    return f
+
+
+def _positive(name, parse, example):
+    def conv(text):
+        v = parse(name, text)
+        if v <= 0:
+            raise ValueError(f"{name} must be > 0 (e.g. {example}); got {text!r}")
+        return v
+
+    return arg_type(conv, name)
+
+
+def length_type(name):
+    return _positive(name, parse_length, "200um, 2cm")
+
+
+def pressure_type(name):
+    return _positive(name, parse_pressure, "130MPa")
+
+
+def voltage_type(name="voltage"):
+    return arg_type(lambda t: parse_voltage(name, t), name)
+
+
+def _tol(text):
+    try:
+        v = float(text)
+    except ValueError:
+        raise ValueError(f"--tol must be a number in (0, 1); got {text!r}") from None
+    if not 0.0 < v < 1.0:
+        raise ValueError(f"--tol must be a number in (0, 1); got {text!r}")
+    return v
+
+
+tol_type = arg_type(_tol, "tol")
+
+
+def count_type(name, minimum=1):
+    """An integer >= ``minimum``, also written ``1e6`` or ``10**6``-style ``1_000_000``."""
+
+    def conv(text):
+        try:
+            v = float(str(text).replace("_", ""))
+        except ValueError:
+            raise ValueError(f"{name} must be an integer >= {minimum} (e.g. 1000000 or 1e6); got {text!r}") from None
+        if not v.is_integer() or v < minimum:
+            raise ValueError(f"{name} must be an integer >= {minimum} (e.g. 1000000 or 1e6); got {text!r}")
+        return int(v)
+
+    return arg_type(conv, name)
+
+
+def add_strip_options(p, *, voltage=True):
+    """The strip/material options shared by several commands (SI or with units)."""
+    p.add_argument("--length", type=length_type("length"), default=0.02, help="strip length L (default 2cm)")
+    p.add_argument("--width", type=length_type("width"), default=5e-3, help="TOTAL width 2l (default 5mm)")
+    p.add_argument("--thickness", type=length_type("thickness"), default=200e-6,
+                   help="TOTAL thickness 2e (default 200um)")
+    if voltage:
+        p.add_argument("--voltage", type=voltage_type(), default=1.0,
+                       help="voltage phi0 (default 1V; sign = direction)")
+    p.add_argument("--modulus", type=pressure_type("modulus"), default=1.3e8,
+                   help="Young's modulus E (default 1.3e8 Pa)")
+    p.add_argument("--c-moy", default="paper", help="C_moy: paper (3082), formula (~3162) or a value in mol/m^3")
+
+
+def material_from_args(args):
+    cm = args.c_moy
+    if cm not in ("paper", "formula"):
+        try:
+            cm = float(cm)
+        except ValueError:
+            raise UsageError(f"--c-moy must be paper, formula or a number > 0 mol/m^3; got {args.c_moy!r}") from None
+    base = MATERIALS.get(getattr(args, "material", "nafion-li"), NAFION_LI)
+    return base.with_(E=args.modulus, c_moy=cm)
+
+
+def strip_from_args(args):
+    return Strip(length=args.length, width=args.width, thickness=args.thickness,
+                 voltage=getattr(args, "voltage", 1.0))
+
+
+def first_run_notice():
+    """Numba compiles on the first run after install: say so instead of hanging silently."""
+    from .._jit import CACHE_DIR
+
+    if not (os.path.isdir(CACHE_DIR) and any(f.endswith(".nbi") for _, _, fs in os.walk(CACHE_DIR) for f in fs)):
+        sys.stderr.write("ipmc-asym: compiling the Numba kernels (first run after install, ~10-30 s)...\n")

@@ -1,0 +1,28 @@
+"""``ipmc-asym figures``: the paper's Figs 4-10 plus the speed/accuracy plot, as PNG."""
+
+from __future__ import annotations
+
+import sys
+
+from ..fileio import check_output_path
+from . import SUMMARIES
+from .common import count_type
+
+
+def register(sub):
+    p = sub.add_parser("figures", help=SUMMARIES["figures"])
+    p.add_argument("--out", default="figures", help="output directory (default figures/)")
+    p.add_argument("--dpi", type=count_type("--dpi", 10), default=110, help="resolution (>= 10, default 110)")
+    p.add_argument("--quick", action="store_true", help="fewer points (for tests)")
+
+
+def run(args) -> int:
+    check_output_path(args.out, "dir")
+    from ..plotting.figures import make_all  # deferred: matplotlib (start-up)
+
+    out = make_all(args.out, args.dpi, quick=args.quick)
+    for f in out["files"]:
+        print("wrote", f)
+    for n in out["notes"]:
+        sys.stderr.write(f"note: {n}\n")
+    return 0

@@ -1,0 +1,46 @@
+"""``ipmc-asym profiles``: C, phi, D, E, rhoZ, p through the thickness (paper Figs 4-7)."""
+
+from __future__ import annotations
+
+from ..fileio import check_output_path
+from ..jsonio import dumps
+from ..profiles import PAPER_LAYERS
+from ..registry import model_choices, model_names
+from . import SUMMARIES
+from .common import add_strip_options, material_from_args, strip_from_args
+
+
+def register(sub):
+    p = sub.add_parser("profiles", help=SUMMARIES["profiles"])
+    add_strip_options(p)
+    p.add_argument("--model", default="all", choices=model_choices(), help="permittivity model (default all)")
+    p.add_argument("--out", default="figures", help="output directory for CSV and PNG (default figures/)")
+    p.add_argument("--json", action="store_true", help="print the layer summary as JSON")
+
+
+def run(args) -> int:
+    strip = strip_from_args(args)
+    if strip.voltage <= 0:
+        raise ValueError("profiles: voltage must be > 0 (a negative voltage is the mirror image)")
+    mat = material_from_args(args)
+    check_output_path(args.out, "dir")
+    from ..plotting.profiles import write_all  # deferred: matplotlib (start-up)
+
+    models = model_names() if args.model == "all" else (args.model,)
+    out = write_all(args.out, models, strip, mat)
+    if args.json:
+        print(dumps(out, indent=2))
+        return 0
+    print(f"profiles at L={strip.length:g} m, total thickness 2e={strip.thickness:g} m (half e={strip.e:g} m), "
+          f"phi0={strip.voltage:g} V; layer widths in µm from the face")
+    print(f"{'model':9s} {'devoid':>8s} {'depletion':>10s} {'accum(1/e)':>10s} {'accum(1/2)':>10s} {'B1':>9s} "
+          f"{'Debye':>8s} {'paper dep':>9s} {'paper acc':>9s}")
+    for s in out["summaries"]:
+        pd = PAPER_LAYERS.get((s["model"], "depletion"))
+        pa = PAPER_LAYERS.get((s["model"], "accumulation"))
+        print(f"{s['model']:9s} {s['devoid_um']:8.4g} {s['depletion_um']:10.4g} {s['accumulation_um']:10.4g} "
+              f"{s['accumulation_half_um']:10.4g} {s['B1']:9.4g} {s['debye_um']:8.3g} "
+              f"{(pd if pd is not None else float('nan')):9.3g} {(pa if pa is not None else float('nan')):9.3g}")
+    for f in out["files"]:
+        print("wrote", f)
+    return 0
