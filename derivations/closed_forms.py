@@ -33,7 +33,9 @@ import sympy as sp
 from . import model as M
 from .kernel import Kernel
 
-mp.mp.dps = 24
+#: working precision (decimal digits) of every number written into the kernels
+DPS = 24
+mp.mp.dps = DPS
 
 RHO = {"constant": mp.mpf(1), "linear": mp.mpf(0), "affine": mp.mpf(5) / 1005}
 MODEL_IDS = {"constant": 0, "linear": 1, "affine": 2}
@@ -246,7 +248,17 @@ def model_tables(name):
 
 
 def kernels():
-    """Kernels and module constants for the closed forms."""
+    """Kernels and module constants for the closed forms.
+
+    The numbers are computed at ``DPS`` digits whatever the global mpmath precision
+    (tests and other modules set their own): the generated file must not depend on import
+    order.
+    """
+    with mp.workdps(DPS):
+        return _kernels()
+
+
+def _kernels():
     from sympy.codegen.cfunctions import expm1
 
     ks, consts = [], {}
