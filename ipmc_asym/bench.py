@@ -36,7 +36,7 @@ import numpy as np
 
 from .registry import model_names
 
-__all__ = ["run_bench", "sample_points", "format_table", "TARGETS", "MODELS", "ERR_FLOOR"]
+__all__ = ["run_bench", "run_sections", "SECTIONS", "sample_points", "format_table", "TARGETS", "MODELS", "ERR_FLOOR"]
 
 MODELS = model_names()
 FAST = ("leading", "corrected", "quadrature")
@@ -202,8 +202,30 @@ def _bvp_sample(model, th, v):
     return np.array(times), np.array(I), np.array(keep, dtype=int)
 
 
+#: further bench sections: name -> "module:function" (imported only when run).  Each function
+#: takes ``quick: bool`` and returns ``{"figures": [{"what", "value", "unit", "target", "pass",
+#: "note"}, ...], ...}``: figures measured side by side in one run, as ratios where a target is
+#: a ratio.  Adding a section is adding one line here.
+SECTIONS: dict[str, str] = {}
+
+
+def run_sections(names=None, quick: bool = False) -> dict:
+    """Run the registered sections ``names`` (default all); ``{name: result}``."""
+    import importlib
+
+    names = list(SECTIONS) if names is None else list(names)
+    out = {}
+    for name in names:
+        if name not in SECTIONS:
+            raise ValueError(f"bench section must be one of {', '.join(SECTIONS) or '(none)'}; got {name!r}")
+        mod, fn = SECTIONS[name].split(":")
+        out[name] = getattr(importlib.import_module(mod), fn)(quick=quick)
+    return out
+
+
 def run_bench(points: int = 10**6, bvp_points: int = 5, repeats: int = 3, seed: int = 0,
-              compile_times: bool = True, threads: int = 2, layout: str = "grid") -> dict:
+              compile_times: bool = True, threads: int = 2, layout: str = "grid",
+              sections=None, quick_sections: bool = False) -> dict:
     """Run the whole benchmark and return a JSON-ready dict.
 
     Parameters
@@ -284,11 +306,13 @@ def run_bench(points: int = 10**6, bvp_points: int = 5, repeats: int = 3, seed: 
                 "pass_speedup": None if speed is None else bool(speed >= tgt["speedup_vs_bvp"]),
             })
     checks = [r[k] for r in rows for k in ("pass_time", "pass_speedup") if r[k] is not None]
+    extra = run_sections(sections, quick_sections)
+    checks += [f["pass"] for sec in extra.values() for f in sec.get("figures", []) if f.get("pass") is not None]
     return {
         "points": points, "bvp_points": int(bvp_points), "threads": threads, "repeats": int(repeats),
         "ranges": {"thickness_m": list(THICKNESS_RANGE), "voltage_V": list(VOLTAGE_RANGE),
                    "distribution": "log-uniform", "layout": layout},
-        "targets": TARGETS, "compile": comp, "startup": startup, "results": rows,
+        "targets": TARGETS, "compile": comp, "startup": startup, "results": rows, "sections": extra,
         "all_pass": bool(all(checks) and (startup is None or startup["pass"])),
     }
 
@@ -338,5 +362,14 @@ def format_table(res: dict) -> str:
                      f"{st['estimate_leading_wall_s']:.2f} s (target {st['target_s']} s: "
                      f"{'pass' if st['pass'] else 'FAIL'}); heavy modules imported: "
                      f"{', '.join(st['heavy_modules_imported']) or 'none'}")
+    for name, sec in res.get("sections", {}).items():
+        lines.append(f"[{name}]")
+        for f in sec.get("figures", []):
+            tgt = f" (target {f['target']})" if f.get("target") is not None else ""
+            ok = "" if f.get("pass") is None else f"  {_pf(f['pass'])}"
+            unit = f" {f['unit']}" if f.get("unit") else ""
+            note = f"  -- {f['note']}" if f.get("note") else ""
+            val = f"{f['value']:.4g}" if isinstance(f.get("value"), (int, float)) else str(f.get("value"))
+            lines.append(f"  {f['what']}: {val}{unit}{tgt}{ok}{note}")
     lines.append(f"all targets: {'pass' if res['all_pass'] else 'FAIL (see table)'}")
     return "\n".join(lines)

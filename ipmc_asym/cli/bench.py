@@ -18,6 +18,9 @@ def register(sub):
     p.add_argument("--no-compile", action="store_true", help="skip the compile-time subprocesses")
     p.add_argument("--layout", default="grid", choices=["grid", "random"],
                    help="sweep points on a log grid (default) or drawn at random")
+    p.add_argument("--section", action="append", default=None, metavar="NAME",
+                   help="run only these further sections (repeatable; default all registered)")
+    p.add_argument("--quick", action="store_true", help="smaller samples in the further sections")
     p.add_argument("--figure", default="figures/speed_accuracy.png",
                    help="where to draw the speed/accuracy plot ('' for none)")
 
@@ -25,7 +28,8 @@ def register(sub):
 def run(args) -> int:
     if args.figure:
         check_output_path(args.figure, "file", "--figure")
-    res = run_bench(args.points, args.bvp_points, compile_times=not args.no_compile, layout=args.layout)
+    res = run_bench(args.points, args.bvp_points, compile_times=not args.no_compile, layout=args.layout,
+                    sections=args.section, quick_sections=args.quick)
     if args.figure:
         from ..plotting.speed import (
             plot_speed_accuracy,  # deferred: matplotlib (start-up)
