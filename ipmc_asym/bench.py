@@ -36,7 +36,7 @@ import numpy as np
 
 from .registry import model_names
 
-__all__ = ["run_bench", "run_sections", "SECTIONS", "sample_points", "format_table", "TARGETS", "MODELS", "ERR_FLOOR"]
+__all__ = ["run_bench", "load_bench", "run_sections", "SECTIONS", "sample_points", "format_table", "TARGETS", "MODELS", "ERR_FLOOR"]
 
 MODELS = model_names()
 FAST = ("leading", "corrected", "quadrature")
@@ -315,6 +315,18 @@ def run_bench(points: int = 10**6, bvp_points: int = 5, repeats: int = 3, seed: 
         "targets": TARGETS, "compile": comp, "startup": startup, "results": rows, "sections": extra,
         "all_pass": bool(all(checks) and (startup is None or startup["pass"])),
     }
+
+
+def load_bench(path) -> dict:
+    """A saved ``ipmc-asym bench --json`` result, checked; one-line ``ValueError`` otherwise."""
+    try:
+        with open(path, encoding="utf-8") as fh:
+            res = json.load(fh)
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise ValueError(f"--bench {path!r}: cannot read a bench JSON file ({exc.__class__.__name__}: {exc})") from None
+    if not isinstance(res, dict) or not isinstance(res.get("results"), list) or "points" not in res:
+        raise ValueError(f"--bench {path!r}: not the output of `ipmc-asym bench --json` (no 'results' list)")
+    return res
 
 
 def _t(x):

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import sys
 
+from ..bench import load_bench
 from ..fileio import check_output_path
 from . import SUMMARIES
 from .common import count_type
@@ -14,13 +15,18 @@ def register(sub):
     p.add_argument("--out", default="figures", help="output directory (default figures/)")
     p.add_argument("--dpi", type=count_type("--dpi", 10), default=110, help="resolution (>= 10, default 110)")
     p.add_argument("--quick", action="store_true", help="fewer points (for tests)")
+    p.add_argument("--bench", default=None, metavar="FILE",
+                   help="draw the speed/accuracy plot from a saved `ipmc-asym bench --json` "
+                        "(default: a quick in-process measurement)")
 
 
 def run(args) -> int:
     check_output_path(args.out, "dir")
+    bench = load_bench(args.bench) if args.bench else None
     from ..plotting.figures import make_all  # deferred: matplotlib (start-up)
 
-    out = make_all(args.out, args.dpi, quick=args.quick)
+    out = make_all(args.out, args.dpi, quick=args.quick, bench=bench,
+                   log=lambda msg: print(f"figures: {msg}", file=sys.stderr, flush=True))
     for f in out["files"]:
         print("wrote", f)
     for n in out["notes"]:

@@ -21,6 +21,7 @@ from ..registry import model_names
 from ..settings import OUTSIDE_REGIMES
 from ..sweeps import sweep
 from . import MODEL_COLOURS, pyplot, savefig
+from ..profiles import compute_all
 from .profiles import write_all
 from .speed import speed_accuracy_figure
 
@@ -85,14 +86,32 @@ def influence_figure(var, path, base: Strip | None = None, material: Material = 
 
 
 def make_all(out_dir="figures", dpi=110, base: Strip | None = None, material: Material = NAFION_LI,
-             quick=False) -> dict:
-    """Write every figure; returns {"files": [...], "notes": [...]}.  ``quick``: fewer points."""
+             quick=False, bench: dict | None = None, log=None) -> dict:
+    """Write every figure; returns {"files": [...], "notes": [...], "layers": [...]}.
+
+    Parameters
+    ----------
+    quick : bool
+        Fewer points, no speed/accuracy figure (tests).
+    bench : dict, optional
+        A saved bench result for the speed/accuracy figure; without it a quick in-process
+        measurement (10^5 points) is drawn.
+    log : callable, optional
+        Called with one progress line per figure (the CLI prints them on stderr).
+    """
+    log = log or (lambda msg: None)
+    n_total = 2 + len(INFLUENCE) + (0 if quick else 1)
+    step = iter(range(1, n_total + 1))
     os.makedirs(out_dir, exist_ok=True)
     base = Strip() if base is None else base
     files, notes = [], []
-    out = write_all(out_dir, strip=base, material=material, dpi=dpi)
+    log(f"[{next(step)}/{n_total}] profiles through the thickness (BVP, 3 models)")
+    results = compute_all(strip=base, material=material)
+    log(f"[{next(step)}/{n_total}] profile figures (Figs 4-7)")
+    out = write_all(out_dir, strip=base, material=material, dpi=dpi, results=results)
     files += [f for f in out["files"] if f.endswith(".png")]
     for var, spec in INFLUENCE.items():
+        log(f"[{next(step)}/{n_total}] influence of {var}")
         vals = spec[0][::3] if quick else None
         p = os.path.join(out_dir, spec[3] + ".png")
         influence_figure(var, p, base, material, dpi, values=vals)
@@ -100,5 +119,7 @@ def make_all(out_dir="figures", dpi=110, base: Strip | None = None, material: Ma
     if quick:
         notes.append("speed_accuracy.png skipped in quick mode")
     else:
-        files.append(speed_accuracy_figure(os.path.join(out_dir, "speed_accuracy.png")))
+        log(f"[{next(step)}/{n_total}] speed/accuracy " + ("(from the saved bench)" if bench else
+                                                         "(quick in-process measurement)"))
+        files.append(speed_accuracy_figure(os.path.join(out_dir, "speed_accuracy.png"), bench=bench))
     return {"files": files, "notes": notes, "layers": out["summaries"]}

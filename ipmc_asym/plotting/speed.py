@@ -8,9 +8,22 @@ from . import pyplot, savefig
 __all__ = ["speed_accuracy_figure", "plot_speed_accuracy"]
 
 
-def speed_accuracy_figure(path="figures/speed_accuracy.png", points: int = 10**6, bvp_points: int = 3) -> str:
-    """Run a (smaller) benchmark without the compile subprocesses and draw its figure."""
-    return plot_speed_accuracy(run_bench(points, bvp_points, compile_times=False), path)
+def speed_accuracy_figure(path="figures/speed_accuracy.png", points: int = 10**5, bvp_points: int = 3,
+                          bench: dict | None = None) -> str:
+    """Draw the speed/accuracy figure from a bench result, or from a quick in-process run.
+
+    Parameters
+    ----------
+    path : str
+    points, bvp_points : int
+        Size of the quick measurement (no compile subprocesses, no further sections) when
+        ``bench`` is not given.
+    bench : dict, optional
+        A saved ``ipmc-asym bench --json`` result (:func:`ipmc_asym.bench.load_bench`).
+    """
+    res = bench if bench is not None else run_bench(points, bvp_points, repeats=1, compile_times=False,
+                                                    sections=[])
+    return plot_speed_accuracy(res, path)
 
 
 def plot_speed_accuracy(res: dict, path="figures/speed_accuracy.png") -> str:
