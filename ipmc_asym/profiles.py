@@ -38,7 +38,12 @@ import numpy as np
 from .fileio import atomic_write
 from .params import NAFION_LI, Material, Strip
 from .registry import model_names
-from .settings import ACCUMULATION_FRACTION, ACCUMULATION_HALF_FRACTION, DEPLETION_LEVEL, DEVOID_LEVEL
+from .settings import (
+    ACCUMULATION_FRACTION,
+    ACCUMULATION_HALF_FRACTION,
+    DEPLETION_LEVEL,
+    DEVOID_LEVEL,
+)
 
 __all__ = ["QUANTITIES", "profile", "layer_widths", "profile_summary", "write_csv",
            "compute_all", "PAPER_LAYERS", "LAYER_WIDTHS"]

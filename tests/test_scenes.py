@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from ipmc_asym.beam import blocking_force_large, tip_position
-from ipmc_asym.integral import moment
 from ipmc_asym.bvp import solve
+from ipmc_asym.integral import moment
 from ipmc_asym.params import NAFION_LI, Strip
 from ipmc_asym.profiles import layer_widths
 from ipmc_asym.scenes import LADDER, run_scene
