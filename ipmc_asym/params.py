@@ -24,6 +24,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field, replace
 
+from .units import parse_pressure
+
 __all__ = [
     "C_MOY_PAPER",
     "Material",
@@ -38,6 +40,8 @@ __all__ = [
     "moment_scale",
     "debye_length",
     "second_moment",
+    "MATERIAL_KEYS",
+    "material_from_spec",
 ]
 
 #: The value the paper states (section 4) and uses; the formula with the quoted data gives
@@ -133,6 +137,83 @@ class Material:
 
 NAFION_LI = Material()
 MATERIALS = {"nafion-li": NAFION_LI}
+
+#: keys of a material specification (scene ``[material]`` table, CLI options)
+MATERIAL_KEYS = ("preset", "E", "modulus", "c_moy", "phi4", "Z3", "rho3", "rho2", "T")
+
+
+def material_from_spec(spec=None, labels=None) -> Material:
+    """The one material parser (scene ``[material]`` tables and the command line).
+
+    Parameters
+    ----------
+    spec : dict or None
+        Any of :data:`MATERIAL_KEYS`: ``preset`` (a key of :data:`MATERIALS`, default
+        ``nafion-li``); ``E`` or ``modulus`` (Pa, number or string with units such as
+        ``"130MPa"``); ``c_moy`` (``"paper"``, ``"formula"``, or a number > 0 in mol/m^3,
+        also as a string); ``phi4``, ``Z3``, ``rho3``, ``rho2``, ``T`` (numbers, SI).
+    labels : dict, optional
+        How to name each key in error messages (e.g. ``{"c_moy": "--c-moy"}``); default
+        ``material.<key>``.
+
+    Returns
+    -------
+    Material
+
+    Raises
+    ------
+    ValueError
+        One line naming the key: unknown key, wrong type, value out of range.
+    """
+    spec = {} if spec is None else spec
+    labels = labels or {}
+
+    def name(k):
+        return labels.get(k, f"material.{k}")
+
+    if not isinstance(spec, dict):
+        raise ValueError(f"material must be a table (section); got {type(spec).__name__}")
+    for k in spec:
+        if k not in MATERIAL_KEYS:
+            raise ValueError(f"unknown key {k!r} in [material]; allowed: {', '.join(sorted(MATERIAL_KEYS))}")
+    preset = spec.get("preset", "nafion-li")
+    if preset not in MATERIALS:
+        raise ValueError(f"{name('preset')} must be one of {', '.join(MATERIALS)}; got {preset!r}")
+    if "E" in spec and "modulus" in spec:
+        raise ValueError(f"{name('E')}: give E or modulus, not both")
+    kw = {}
+    for k in ("E", "modulus"):
+        if k in spec:
+            v = spec[k]
+            if isinstance(v, bool) or not isinstance(v, (int, float, str)):
+                raise ValueError(f"{name(k)} must be a number or a string with units; got {v!r}")
+            E = parse_pressure(name(k), v)
+            if E <= 0:
+                raise ValueError(f"{name(k)} must be > 0 Pa (e.g. 130MPa); got {v!r}")
+            kw["E"] = E
+    for k in ("phi4", "Z3", "rho3", "rho2", "T"):
+        if k in spec:
+            v = spec[k]
+            if isinstance(v, bool) or not isinstance(v, (int, float)):
+                raise ValueError(f"{name(k)} must be a number; got {v!r}")
+            kw[k] = float(v)
+    if "c_moy" in spec:
+        v = spec["c_moy"]
+        bad = f"{name('c_moy')} must be paper, formula or a number > 0 mol/m^3; got {v!r}"
+        if isinstance(v, bool) or not isinstance(v, (int, float, str)):
+            raise ValueError(bad)
+        if isinstance(v, str) and v not in ("paper", "formula"):
+            try:
+                v = float(v)
+            except ValueError:
+                raise ValueError(bad) from None
+        if not isinstance(v, str) and not (math.isfinite(v) and v > 0):
+            raise ValueError(bad)
+        kw["c_moy"] = v
+    try:
+        return MATERIALS[preset].with_(**kw)
+    except ValueError as exc:
+        raise ValueError(f"material: {exc}") from None
 
 
 @dataclass(frozen=True)

@@ -5,22 +5,25 @@ electrode layers (~1e-3 of the thickness) are resolved.  Distances are measured 
 face, in micrometres, with ``e`` the HALF thickness (``z = z_bar e``, ``z_bar in [-1, 1]``;
 anode ``z_bar = -1``, cathode ``z_bar = +1``).
 
-Layer widths (definitions used everywhere in the toolkit)
----------------------------------------------------------
+Layer widths (the toolkit's one set of definitions: :data:`LAYER_WIDTHS`, used by
+``profiles``, ``validate`` and ``scenes``; thresholds in :mod:`ipmc_asym.settings`)
+-----------------------------------------------------------------------------------
 ``depletion`` (anode)
-    distance from the anode face ``z_bar = -1`` to the first point where ``C_bar`` rises
-    through ``1/2`` (half the mean concentration) -- the "zone almost free of cations".
+    distance from the anode face to the first point where ``C_bar`` rises through
+    ``settings.DEPLETION_LEVEL`` (1/2: half the mean concentration).
 ``devoid`` (anode)
-    distance from the anode face to where ``C_bar`` rises through ``0.01``: the paper's
-    "zone presque totalement depourvue de cations" (section 6.1).  This is the width compared
-    with the paper's 0.2 um (constant) and 0.07 um (affine).
+    distance from the anode face to where ``C_bar`` rises through ``settings.DEVOID_LEVEL``
+    (0.01): the paper's "zone presque totalement depourvue de cations" (section 6.1).  This
+    is the width compared with the paper's anode-layer widths.
 ``accumulation`` (cathode)
-    distance from the cathode face ``z_bar = +1`` to the point where the excess
-    ``C_bar - 1`` has fallen to ``(B1 - 1)/e_N`` (``e_N`` = Euler's number), i.e. the 1/e
-    decay length of the accumulated charge.
-``accumulation_half``
-    same, where ``C_bar - 1`` falls to half its face value ``(B1 - 1)/2`` (less sensitive to
-    the shape of the tail).
+    distance from the cathode face to the point where the excess ``C_bar - 1`` has fallen to
+    ``settings.ACCUMULATION_FRACTION`` (1/e) of its face value ``B1 - 1``: the 1/e decay
+    length of the accumulated charge.
+``accumulation_half`` (cathode)
+    same, with ``settings.ACCUMULATION_HALF_FRACTION`` (1/2; less sensitive to the tail).
+
+The anode is the face at the higher potential: ``z_bar = -1`` for a positive voltage,
+``z_bar = +1`` for a negative one (the mirror image).
 
 Layer rule: stdlib + numpy at import; SciPy (via bvp) is imported lazily; figures are drawn by
 :mod:`ipmc_asym.plotting.profiles`.
@@ -29,16 +32,21 @@ Layer rule: stdlib + numpy at import; SciPy (via bvp) is imported lazily; figure
 from __future__ import annotations
 
 import csv
-import math
 
 import numpy as np
 
 from .fileio import atomic_write
 from .params import NAFION_LI, Material, Strip
 from .registry import model_names
+from .settings import (
+    ACCUMULATION_FRACTION,
+    ACCUMULATION_HALF_FRACTION,
+    DEPLETION_LEVEL,
+    DEVOID_LEVEL,
+)
 
 __all__ = ["QUANTITIES", "profile", "layer_widths", "profile_summary", "write_csv",
-           "compute_all", "PAPER_LAYERS"]
+           "compute_all", "PAPER_LAYERS", "LAYER_WIDTHS"]
 
 #: quantity key -> (BVPResult attribute, axis label)
 QUANTITIES = {
@@ -48,6 +56,16 @@ QUANTITIES = {
     "E": ("E", r"$\bar E = -d\bar\varphi/d\bar z$"),
     "rhoZ": ("rhoZ", r"$\overline{\rho Z} = \bar C - 1$"),
     "p": ("p", r"$\bar p = \bar C/A_2 - A_3\bar\varphi$ ($B_2=0$)"),
+}
+
+#: the layer widths: key of :func:`layer_widths` -> (face, what it measures)
+LAYER_WIDTHS = {
+    "depletion_um": ("anode", f"C_bar rises through {DEPLETION_LEVEL:g} from the anode face"),
+    "devoid_um": ("anode", f"C_bar rises through {DEVOID_LEVEL:g} from the anode face"),
+    "accumulation_um": ("cathode", f"C_bar - 1 falls to {ACCUMULATION_FRACTION:.4g} (B1 - 1) from the "
+                                   "cathode face"),
+    "accumulation_half_um": ("cathode", f"C_bar - 1 falls to {ACCUMULATION_HALF_FRACTION:g} (B1 - 1) "
+                                        "from the cathode face"),
 }
 
 #: the paper's statements (section 6.1), micrometres
@@ -81,20 +99,33 @@ def _crossing(d, f, level):
 
 
 def layer_widths(res, e: float) -> dict:
-    """Depletion / accumulation widths in micrometres (definitions in the module docstring).
+    """The layer widths of :data:`LAYER_WIDTHS`, in micrometres, from a BVP profile.
 
-    ``res`` is a BVPResult for a positive voltage, ``e`` the HALF thickness (m).
+    Parameters
+    ----------
+    res : BVPResult (or anything with ``z``, ``C`` arrays of shape (n,), and ``groups.sign``)
+        Profiles on ``z_bar in [-1, 1]``; for a negative voltage (``groups.sign < 0``) the
+        anode is at ``z_bar = +1`` and the profile is mirrored first.
+    e : float
+        HALF thickness (m).
+
+    Returns
+    -------
+    dict
+        ``depletion_um``, ``devoid_um``, ``accumulation_um``, ``accumulation_half_um``
+        (NaN where the level is never crossed).
     """
-    z, C = np.asarray(res.z), np.asarray(res.C)
+    z, C = np.asarray(res.z, dtype=float), np.asarray(res.C, dtype=float)
+    if getattr(getattr(res, "groups", None), "sign", 1.0) < 0:
+        z, C = -z[::-1], C[::-1]
     da = (z + 1.0) * e * 1e6  # from the anode, µm, increasing
-    dep = _crossing(da, C, 0.5)
-    devoid = _crossing(da, C, 0.01)
     dc = ((1.0 - z) * e * 1e6)[::-1]  # from the cathode, increasing
     Cc = C[::-1] - 1.0
     B1m1 = Cc[0]
-    acc = _crossing(dc, Cc, B1m1 / math.e)
-    acc2 = _crossing(dc, Cc, 0.5 * B1m1)
-    return {"depletion_um": dep, "devoid_um": devoid, "accumulation_um": acc, "accumulation_half_um": acc2}
+    return {"depletion_um": _crossing(da, C, DEPLETION_LEVEL),
+            "devoid_um": _crossing(da, C, DEVOID_LEVEL),
+            "accumulation_um": _crossing(dc, Cc, ACCUMULATION_FRACTION * B1m1),
+            "accumulation_half_um": _crossing(dc, Cc, ACCUMULATION_HALF_FRACTION * B1m1)}
 
 
 def profile_summary(model="constant", strip: Strip | None = None, material: Material = NAFION_LI,

@@ -5,6 +5,8 @@ Change a value here and every command, the scene planner, the bench and ``valida
 
 from __future__ import annotations
 
+import math
+
 #: error estimate above which a closed form / quadrature result is outside its validity
 VALIDITY_LIMIT = 1e-2
 
@@ -29,6 +31,8 @@ LAW_HOLD_TOL = 0.05
 #: the concentration thresholds of the layer widths (profiles, validate, scenes)
 DEVOID_LEVEL = 0.01      # C_bar rises through this: the paper's "presque totalement depourvue"
 DEPLETION_LEVEL = 0.5    # C_bar rises through half the mean concentration
+ACCUMULATION_FRACTION = math.exp(-1.0)   # the excess C_bar - 1 falls to 1/e of its face value
+ACCUMULATION_HALF_FRACTION = 0.5         # ... or to half of it
 
 #: sweeps: refuse more rows than this unless --max-rows says otherwise; rows per chunk
 MAX_ROWS = 10**7

@@ -9,7 +9,7 @@ import argparse
 import os
 import sys
 
-from ..params import MATERIALS, NAFION_LI, Strip
+from ..params import Strip, material_from_spec
 from ..units import parse_length, parse_pressure, parse_voltage
 
 __all__ = ["UsageError", "Parser", "add_strip_options", "material_from_args", "strip_from_args",
@@ -106,14 +106,12 @@ def add_strip_options(p, *, voltage=True):
 
 
 def material_from_args(args):
-    cm = args.c_moy
-    if cm not in ("paper", "formula"):
-        try:
-            cm = float(cm)
-        except ValueError:
-            raise UsageError(f"--c-moy must be paper, formula or a number > 0 mol/m^3; got {args.c_moy!r}") from None
-    base = MATERIALS.get(getattr(args, "material", "nafion-li"), NAFION_LI)
-    return base.with_(E=args.modulus, c_moy=cm)
+    """The material of the options, through the library's one parser (params.material_from_spec)."""
+    spec = {"preset": getattr(args, "material", "nafion-li"), "E": args.modulus, "c_moy": args.c_moy}
+    return material_from_spec(spec, labels=_MATERIAL_OPTIONS)
+
+
+_MATERIAL_OPTIONS = {"preset": "--material", "E": "--modulus", "c_moy": "--c-moy"}
 
 
 def strip_from_args(args):
