@@ -4,17 +4,19 @@ from __future__ import annotations
 
 from ..fileio import atomic_write, check_output_path
 from ..jsonio import dumps
-from ..validate import claims, to_markdown
+from ..validate import VERDICTS, claims, to_markdown
 from . import SUMMARIES
 
 
 def register(sub):
+    """Add the ``validate`` subcommand."""
     p = sub.add_parser("validate", help=SUMMARIES["validate"])
     p.add_argument("--json", action="store_true", help='print {"claims": [...]}')
     p.add_argument("--out", default=None, help="write a Markdown report to this file")
 
 
 def run(args) -> int:
+    """Run ``ipmc-asym validate``."""
     if args.out:
         check_output_path(args.out, "file")
     rows = claims()
@@ -22,10 +24,16 @@ def run(args) -> int:
         with atomic_write(args.out) as fh:
             fh.write(to_markdown(rows))
     if args.json:
-        print(dumps({"claims": [{k: r[k] for k in ("claim", "section", "paper", "ours", "verdict", "key")}
-                                     for r in rows]}, indent=2))
+        print(dumps({"claims": [{k: r[k] for k in JSON_KEYS} for r in rows]}, indent=2))
     else:
+        pad = " " * 4
         for r in rows:
-            print(f"[{r['verdict']:>16s}] {r['section']:>18s}  {r['claim']}\n{'':38s}paper: {r['paper']}\n"
-                  f"{'':38s}ours:  {r['ours']}")
+            print(f"[{r['verdict']}] {r['section']}  {r['claim']}\n{pad}paper:     {r['paper']}\n"
+                  f"{pad}ours:      {r['ours']}\n{pad}criterion: {r['criterion']} ({r['reason']})")
+        n = {v: sum(r["verdict"] == v for r in rows) for v in VERDICTS}
+        print("summary: " + ", ".join(f"{k} {v}" for k, v in n.items()))
     return 0
+
+
+#: the keys of a JSON claim row
+JSON_KEYS = ("claim", "section", "paper", "ours", "verdict", "key", "criterion", "reason")
