@@ -12,11 +12,6 @@ from ipmc_asym.kernels import _generated as G
 from ipmc_asym.kernels.quadrature import layer_functions
 
 
-def test_generated_file_is_up_to_date():
-    """Regenerate into a temp dir: any difference with the committed file fails."""
-    assert codegen.check() == 0
-
-
 def test_generated_header():
     text = codegen.TARGET.read_text()
     assert "GENERATED" in text and "DO NOT EDIT" in text and f"SymPy {sp.__version__}" in text
@@ -71,9 +66,12 @@ def test_factor_three_between_sections():
     assert scaling.factor_three() == {"theta": 3, "w_small": 3, "F_block": 3}
 
 
-def test_linear_exact_solution_and_anode_statement():
-    Cz, b1, statement = M.linear_exact_solution()
-    assert "zeta(2)" in statement and "never in z" in statement
+def test_linear_exact_solution():
+    # the derivation asserts the ODE, the BCs and electroneutrality; check B1 numerically
+    # against the constant-free limit of the electroneutrality root (A1 = 0)
+    Cz, b1, _ = M.linear_exact_solution()
+    for A2 in (1e-3, 1.0, 38.7):
+        assert float(b1.subs(M.A2, A2)) == pytest.approx(2 / (1 + math.exp(-A2)), rel=1e-14)
 
 
 # ---- every generated kernel against its SymPy expression at random points -------------------

@@ -76,7 +76,6 @@ def test_broadcast_sign_and_zero():
     I = moment_integral(th, v, "constant", "corrected")
     assert I.shape == (2, 5)
     assert np.all(I[:, 2] == 0.0)
-    np.testing.assert_allclose(I[:, :2], -I[:, :2:-1][:, ::-1][:, ::-1][:, ::-1][:, :2] if False else -I[:, [4, 3]], rtol=1e-14)
     assert np.all(np.sign(I) == np.sign(v))
     assert isinstance(moment_integral(200e-6, 1.0), float)
 
