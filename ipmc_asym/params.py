@@ -311,11 +311,6 @@ class Groups:
     extra: dict = field(default_factory=dict, compare=False, repr=False)
 
     @property
-    def eps_bar_core(self) -> float:
-        """Dimensionless permittivity in the neutral core, ``A0 + A1``."""
-        return self.A0 + self.A1
-
-    @property
     def debye(self) -> float:
         """Core Debye length relative to ``e``: ``lambda = sqrt((A0 + A1) / A2)``.
 

@@ -151,6 +151,7 @@ def test_profiles_consistent(nominal):
         assert r.bc_residual < 1e-10
 
 
+@pytest.mark.slow
 def test_self_convergence():
     for model in ("constant", "linear", "affine"):
         a = solve(NOMINAL, model, tol=1e-10)
@@ -165,6 +166,7 @@ def test_self_convergence():
 CORNERS = [(10e-6, 1e-3), (10e-6, 10.0), (4e-3, 1e-3), (4e-3, 10.0), (200e-6, 0.1)]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("model", ["constant", "affine", "linear"])
 @pytest.mark.parametrize("thickness,voltage", CORNERS)
 def test_corners_converge(model, thickness, voltage):

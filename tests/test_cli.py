@@ -98,6 +98,7 @@ def test_strip_validation(kw, word):
         Strip(**kw)
 
 
+@pytest.mark.slow
 def test_derive_check_cli():
     """Regenerate the kernels into a temp dir: any difference with the committed file fails
     (the one run of the drift check)."""

@@ -100,6 +100,7 @@ def _kernel_cases():
     return kernels, constants
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("seed", range(3))
 def test_all_generated_kernels_match_sympy(seed):
     kernels, constants = _kernel_cases()

@@ -53,6 +53,7 @@ def test_thin_strip_high_voltage_flagged():
         assert not bool(moment(1e-6, 20.0, m, "quadrature").valid)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("model", MODELS)
 def test_quadrature_vs_bvp_reduced_grid(model):
     for th in (10e-6, 200e-6, 2e-3):
@@ -107,6 +108,7 @@ def test_continuous_across_voltage(model):
 _models = st.sampled_from(MODELS)
 
 
+@pytest.mark.slow
 @settings(max_examples=8, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(th=st.floats(min_value=50e-6, max_value=1e-3), v=st.floats(min_value=0.01, max_value=5.0),
        sgn=st.sampled_from([1.0, -1.0]), model=_models)

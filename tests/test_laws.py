@@ -31,6 +31,7 @@ def _fit(xs, ys):
     return np.polyfit(np.log(xs), np.log(np.abs(ys)), 1)[0]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("model,regime,volts,tol", [
     ("constant", "small voltage", (1e-3, 2e-3), 0.02),
     ("constant", "large voltage", (8.0, 10.0), 0.05),
