@@ -63,6 +63,7 @@ PHI0_POINTS = 30
 #: length and thickness fit ranges (m; thickness TOTAL): the paper's Figs 8-9, ranges not stated
 LENGTH_RANGE = (0.01, 0.04, 16)
 THICKNESS_RANGE = (100e-6, 400e-6, 16)
+WIDTH_RANGE = (2e-3, 10e-3, 5)
 #: the thickness and voltage spans of the local exponents (as ``ipmc-asym laws``)
 THICKNESS_SPAN = (10e-6, 4e-3)
 
@@ -272,7 +273,7 @@ class Context:
 
     @cached_property
     def table(self) -> dict:
-        ranges = {"length": LENGTH_RANGE[:2] + (8,), "width": (2e-3, 1e-2, 5),
+        ranges = {"length": LENGTH_RANGE[:2] + (8,), "width": WIDTH_RANGE,
                   "thickness": THICKNESS_RANGE[:2] + (8,)}
         return variation_table(scaling_fits(models=("constant",), ranges=ranges, base=self.s,
                                             material=self.m), "constant")
@@ -420,10 +421,10 @@ def _I_phi_half(ctx):
         f = fit_power_law(v, moment(ctx.s.thickness, v, "constant", "quadrature", material=ctx.m).I)
         val[_rng(a, b)] = f["exponent"]
         txt.append(f"{_rng(a, b)}: {f['exponent']:.3f}")
-    where = ", ".join(f"{a:.3g}-{b:.3g} V" for a, b in spans) or "nowhere in 1 mV-10 V"
+    where = ", ".join(f"{a:.3g}-{b:.3g} V" for a, b in spans) or "no part of it"
     return Ours(val, "fitted exponent of I: " + "; ".join(txt) + f". Local exponent (ipmc-asym laws): "
-                f"{ex['at_1V']:+.3f} at 1 V, {ex['min']:+.3f} .. {ex['max']:+.3f} over 1 mV-10 V, within "
-                f"{LAW_HOLD_TOL:g} of 1/2 on {where}; M_A = A5 I ~ phi0^(1 + that)")
+                f"{ex['at_1V']:+.3f} at 1 V, {ex['min']:+.3f} .. {ex['max']:+.3f} over the voltage range of "
+                f"laws, within {LAW_HOLD_TOL:g} of 1/2 on {where}; M_A = A5 I ~ phi0^(1 + that)")
 
 
 def _fit_models(var, rng, quantity):
@@ -457,7 +458,7 @@ def _table(ctx):
 
 def _F_width(ctx):
     v = ctx.table["F_block"]["width"]
-    return Ours(v, f"F^p ~ l^{v:.4f} (fit over 2l = 2-10 mm)")
+    return Ours(v, f"F^p ~ l^{v:.4f} (fit over 2l = {WIDTH_RANGE[0] * 1e3:g}-{WIDTH_RANGE[1] * 1e3:g} mm)")
 
 
 def _large_3mm(ctx):
@@ -665,7 +666,7 @@ def to_markdown(rows, material: Material = NAFION_LI, strip: Strip | None = None
            "Criteria and slips: docs/design.md.", "",
            "| # | claim | section | paper | ours | criterion | verdict |", "|---|---|---|---|---|---|---|"]
     for i, r in enumerate(rows, 1):
-        cells = [str(i)] + [str(r[k]).replace("|", "/") for k in
+        cells = [str(i)] + [str(r[k]).replace("|", "\\|") for k in
                             ("claim", "section", "paper", "ours", "criterion", "verdict")]
         out.append("| " + " | ".join(cells) + " |")
     n = {v: sum(r["verdict"] == v for r in rows) for v in VERDICTS}
