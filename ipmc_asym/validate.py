@@ -40,7 +40,6 @@ from typing import Callable, NamedTuple
 import numpy as np
 
 from .beam import small_displacement_error
-from .bvp import solve
 from .estimate import evaluate
 from .fits import fit_power_law, linear_r, scaling_fits, variation_table
 from .integral import moment
@@ -400,6 +399,8 @@ def _I_e(ctx):
 
 
 def _charge_e(ctx):
+    from .bvp import solve  # deferred: heavy import (start-up): scipy.integrate
+
     ths = (50e-6, ctx.s.thickness, 1e-3)
     val, txt = {}, []
     for mm in ctx.models:
