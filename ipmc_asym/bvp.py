@@ -64,7 +64,7 @@ from .bvp_problems import (
 )
 from .params import NAFION_LI, Groups, Material, Strip, check_finite, check_positive
 from .permittivity import Permittivity, get_model
-from .settings import BVP_MAX_NODES, BVP_TOL
+from .settings import BVP_MAX_NODES, BVP_MAX_NODES_FIRST, BVP_TOL, BVP_TOL_FALLBACK
 
 __all__ = ["BVPResult", "solve", "moment_integral_bvp", "b1_guess", "make_mesh"]
 
@@ -202,7 +202,8 @@ def _bc_res(prob, res) -> float:
 
 
 def solve(strip: Strip, model="constant", material: Material = NAFION_LI, *, tol: float = BVP_TOL,
-          max_nodes: int = BVP_MAX_NODES, continuation: bool = True) -> BVPResult:
+          max_nodes: int = BVP_MAX_NODES, continuation: bool = True,
+          fallback: bool = True) -> BVPResult:
     """Solve the full nonlinear BVP across the thickness and return profiles and ``I``.
 
     Parameters
@@ -221,6 +222,12 @@ def solve(strip: Strip, model="constant", material: Material = NAFION_LI, *, tol
     continuation : bool
         If the direct solve fails, solve at smaller voltages and step up to the target,
         reusing each solution as the next guess.
+    fallback : bool
+        If ``tol`` cannot be met, retry with the looser ``settings.BVP_TOL_FALLBACK``
+        tolerances (rounding-limited meshes where the layers overlap; ``I`` moves by
+        < 1e-12 relative there).  The attempts before the last are capped at
+        ``settings.BVP_MAX_NODES_FIRST`` nodes so that a hopeless attempt fails fast.
+        The message says which tolerance was met.
 
     Returns
     -------
@@ -247,14 +254,32 @@ def solve(strip: Strip, model="constant", material: Material = NAFION_LI, *, tol
                          max_rms_residual=0.0, bc_residual=0.0,
                          seconds=time.perf_counter() - t0)
 
-    res, prob, g = _solve_abs(strip, perm, material, tol, max_nodes)
-    how = ""
-    if res.status != 0 and continuation:
-        res2 = _continuation(strip, perm, material, tol, max_nodes)
-        if res2 is not None:
-            res, prob, g = res2
-            how = " (after voltage continuation)"
-    return _finish(res, prob, g, g_signed, name, t0, how)
+    res, prob, g = _solve_abs(strip, perm, material, tol, max_nodes if not fallback
+                              else min(int(max_nodes), BVP_MAX_NODES_FIRST))
+    if res.status == 0 or not (continuation or fallback):
+        return _finish(res, prob, g, g_signed, name, t0, "")
+    first = (res, prob, g)
+    # Continuation in voltage at the loosest tolerance allowed (the direct solve fails where
+    # the neutral-core guess is poor, e.g. overlapping layers); then refine that solution at
+    # the tolerances asked for, tightest first, each a single solve from it.
+    loose = [t for t in BVP_TOL_FALLBACK if t > tol] if fallback else []
+    t_cont = loose[-1] if loose else tol
+    cont = _continuation(strip, perm, material, t_cont, int(max_nodes)) if continuation else None
+    if cont is None or cont[0].status != 0:
+        if fallback and not continuation:
+            for t in loose:
+                r = _solve_abs(strip, perm, material, t, int(max_nodes))
+                if r[0].status == 0:
+                    return _finish(*r, g_signed, name, t0, f" (tolerance relaxed to {t:g})")
+        return _finish(*first, g_signed, name, t0, "")
+    res_c, prob_c, g_c = cont
+    for t in [tol] + loose[:-1]:
+        r = _run(prob_c, g_c, res_c.x, res_c.y, float(res_c.p[0]), t,
+                 min(int(max_nodes), BVP_MAX_NODES_FIRST))
+        if r.status == 0:
+            return _finish(r, prob_c, g_c, g_signed, name, t0, " (after voltage continuation)")
+    how = " (after voltage continuation)" + (f" (tolerance relaxed to {t_cont:g})" if t_cont != tol else "")
+    return _finish(res_c, prob_c, g_c, g_signed, name, t0, how)
 
 
 def _continuation(strip, perm, material, tol, max_nodes):

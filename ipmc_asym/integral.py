@@ -38,9 +38,10 @@ from .progress import progress as _progress_bar
 from .registry import FIDELITIES as _FIDELITY_SPECS
 from .registry import MODELS as _MODEL_SPECS
 from .registry import check_choice, fidelity_names
-from .settings import BVP_STATED_ERROR, VALIDITY_LIMIT
+from .settings import BVP_STATED_ERROR, MIN_THICKNESS, ROUNDING_ERROR, VALIDITY_LIMIT
 
-__all__ = ["FIDELITIES", "MomentResult", "moment_integral", "moment", "groups_arrays", "check_fidelity"]
+__all__ = ["FIDELITIES", "MomentResult", "moment_integral", "moment", "groups_arrays", "check_fidelity",
+           "check_min_thickness", "invalid_message"]
 
 FIDELITIES = fidelity_names()
 #: order argument of the sweep driver: 1 leading, 2 corrected, 0 quadrature
@@ -64,8 +65,11 @@ class MomentResult:
     lam : ndarray   core Debye length / e
     A2 : ndarray
     valid : ndarray of bool   error estimate below ``VALIDITY_LIMIT`` and layers separate
+        (``bvp``: the solve converged)
     fidelity : str
     model : str
+    success : ndarray of bool   ``bvp``: solve_bvp converged at that point (True otherwise)
+    message : str   ``bvp``: the first failure's message ("" if none)
     """
 
     I: np.ndarray
@@ -77,6 +81,8 @@ class MomentResult:
     valid: np.ndarray
     fidelity: str
     model: str
+    success: np.ndarray | None = None
+    message: str = ""
 
 
 def _material(material, kw) -> Material:
@@ -98,6 +104,7 @@ def groups_arrays(thickness, voltage, perm: Permittivity, material: Material):
     v = np.asarray(voltage, dtype=float)
     if not np.all(np.isfinite(th)) or np.any(th <= 0):
         raise ValueError("thickness (total, 2e) must be finite and > 0 m")
+    check_min_thickness(th)
     if not np.all(np.isfinite(v)):
         raise ValueError("voltage must be finite (volts)")
     th, v = np.broadcast_arrays(th, v)
@@ -109,6 +116,20 @@ def groups_arrays(thickness, voltage, perm: Permittivity, material: Material):
     A3 = -m.rho2 * m.Z3 / (cm * m.F)
     rho = perm.eps0 / eps_core
     return lam, A2, A3, rho, np.sign(v)
+
+
+def check_min_thickness(thickness) -> None:
+    """One-line ``ValueError`` where a TOTAL thickness is below ``settings.MIN_THICKNESS``.
+
+    No rung describes such a film (the continuum model itself does not): refuse at once
+    instead of sending the caller to a BVP that takes seconds and then fails.
+    """
+    th = np.asarray(thickness, dtype=float)
+    if th.size and np.nanmin(th) < MIN_THICKNESS:
+        raise ValueError(
+            f"thickness (total, 2e) = {float(np.nanmin(th)):.3g} m is below {MIN_THICKNESS:g} m: "
+            "the continuum model does not describe films spanning only a few ionic clusters "
+            "(settings.MIN_THICKNESS, docs/design.md)")
 
 
 @jit
@@ -126,15 +147,27 @@ def _core_error(core, lam):
 def _point(lam, A2, A3, rho, model_id, order):
     """(I for |phi0|, error, B1, core) of one point; ``order`` 0 = quadrature.
 
+    ``error`` bounds the relative error of the returned ``I`` (not of one term of it).
     Zero volts: no field, I = 0 exactly (the odd extension; no 0/0).
     """
     if A2 == 0.0:
         return 0.0, 0.0, 1.0, 2.0
     if order == 0:
         Ii, J1, J2, b1, c = moment_quadrature(lam, A2, A3, rho)
-        e_i = 1e-14
+        e_i = ROUNDING_ERROR
     else:
         Ii, e_i, b1, c = moment_closed(lam, A2, A3, rho, model_id, order)
+        # The kernel keeps ~20 lam of exponential tails in its core; the layer width the
+        # quadrature measures (to |y| = 1) is the depletion width +- 0.5 lam (measured on
+        # 1 um - 10 mm x 0.1 mV - 20 V), so 2 - dep - lam is a conservative core and the
+        # core interaction 4 exp(-core/lam) below is no longer overstated by ~e^19
+        # (``corrected`` was flagged invalid at 10 um while accurate to ~1e-9).
+        c = c + 19.0 * lam
+        if order == 1:
+            # the kernel states t = |lam J2 / J1| (+ truncation), relative to the leading
+            # term; relative to I = lam J1 (1 + lam J2/J1) the error is at most t / (1 - t)
+            e_i = e_i / (1.0 - e_i) if e_i < 1.0 else math.inf
+        e_i = max(e_i, ROUNDING_ERROR)
     # neglected core interaction: exponentially small in core/lambda
     return Ii, e_i + _core_error(c, lam), b1, c
 
@@ -191,8 +224,9 @@ def moment(thickness, voltage, model="constant", fidelity="quadrature", *, mater
     err = np.empty(shape)
     B1 = np.empty(shape)
     core = np.empty(shape)
+    success, message = np.ones(shape, bool), ""
     if fidelity == "bvp":
-        _bvp_loop(thickness, voltage, perm, mat, I, err, B1, core, progress)
+        success, message = _bvp_loop(thickness, voltage, perm, mat, I, err, B1, core, progress)
     else:
         fl = [np.ascontiguousarray(a).reshape(-1) for a in (lam, A2, sign)]
         outs = [np.empty(lam.size) for _ in range(4)]
@@ -200,9 +234,9 @@ def moment(thickness, voltage, model="constant", fidelity="quadrature", *, mater
         _sweep(fl[0], fl[1], A3, rho, mid, _ORDER[fidelity], fl[2], *outs)
         for dst, src in zip((I, err, B1, core), outs):
             dst[...] = src.reshape(shape)
-    valid = (err < VALIDITY_LIMIT) & (core > 0)
+    valid = (err < VALIDITY_LIMIT) & (core > 0) & success
     return MomentResult(I=I, error=err, B1=B1, core=core, lam=lam, A2=A2, valid=valid,
-                        fidelity=fidelity, model=perm.name)
+                        fidelity=fidelity, model=perm.name, success=success, message=message)
 
 
 def closed_model_id(perm: Permittivity, fidelity: str) -> int:
@@ -223,46 +257,61 @@ def closed_model_id(perm: Permittivity, fidelity: str) -> int:
 
 
 def _bvp_loop(thickness, voltage, perm, mat, I, err, B1, core, progress):
+    """Point-by-point BVP; a failed point gets ``I = NaN``, ``error = inf`` (never raises).
+
+    Solved at ``|phi0|`` and signed afterwards (``I`` is odd): ``B1`` is that of ``|phi0|``
+    directly, with no ``B1 exp(A2)`` round trip (which overflows above ~18 V).
+
+    Returns ``(success, first failure message)``.
+    """
     from .bvp import (
         solve,  # deferred: scipy.integrate is heavy (start-up of the closed forms)
     )
 
     th, v = np.broadcast_arrays(np.asarray(thickness, float), np.asarray(voltage, float))
     n = th.size
+    ok = np.ones(th.shape, bool)
+    msg = ""
     show = (n > 20) if progress is None else progress
     bar = _progress_bar(n, "BVP", enabled=show)
     for idx in np.ndindex(th.shape):
-        res = solve(Strip(thickness=float(th[idx]), voltage=float(v[idx])), perm, mat)
-        if not res.success:
-            raise RuntimeError(
-                f"BVP did not converge at thickness={float(th[idx]):g} m, voltage={float(v[idx]):g} V "
-                f"({res.message}); try a looser tol or fidelity 'quadrature'"
-            )
-        I[idx] = res.I
-        err[idx] = BVP_STATED_ERROR
-        B1[idx] = res.B1 if v[idx] >= 0 else res.B1 * math.exp(res.groups.A2)
+        vi = float(v[idx])
+        res = solve(Strip(thickness=float(th[idx]), voltage=abs(vi)), perm, mat)
         core[idx] = 2.0
+        if not res.success:
+            ok[idx] = False
+            I[idx], err[idx], B1[idx] = math.nan, math.inf, math.nan
+            if not msg:
+                msg = (f"BVP did not converge at thickness (total) {float(th[idx]):.3g} m, voltage "
+                       f"{vi:.3g} V ({res.message.rstrip('.')})")
+        else:
+            I[idx] = math.copysign(res.I, vi) if vi != 0.0 else 0.0
+            err[idx] = BVP_STATED_ERROR
+            B1[idx] = res.B1
         bar.update(1)
     bar.close()
+    return ok, msg
 
 
 def moment_integral(thickness, voltage, model="constant", fidelity="quadrature", *, material=None,
-                    on_invalid="warn", **material_kw):
+                    on_invalid="raise", **material_kw):
     """Moment integral ``I = int_{-1}^{1} p_bar z_bar dz_bar`` (dimensionless).
 
     Parameters
     ----------
     thickness : float or array_like
-        TOTAL thickness ``2e`` in metres.
+        TOTAL thickness ``2e`` in metres (>= ``settings.MIN_THICKNESS``).
     voltage : float or array_like
         Voltage ``phi0`` in volts (sign = bending direction; 0 gives 0).
     model : {"constant", "linear", "affine"}, Permittivity or callable
     fidelity : {"leading", "corrected", "quadrature", "bvp"}
     material : Material, optional; ``**material_kw`` override fields of the preset.
-    on_invalid : {"warn", "raise", "ignore"}
-        What to do where the fidelity is outside its validity (error estimate above
-        ``VALIDITY_LIMIT`` or overlapping layers): a ``RuntimeWarning`` (default), a
-        ``ValueError``, or nothing (use :func:`moment` to get the flags and estimates).
+    on_invalid : {"raise", "nan", "warn"}
+        Where the fidelity is outside its validity (error estimate above ``VALIDITY_LIMIT``,
+        overlapping layers, or a BVP that did not converge): a one-line ``ValueError``
+        (default), or NaN at those points (``"warn"``: NaN plus a ``RuntimeWarning``).  A
+        number whose validity check failed is never returned; :func:`moment` gives the
+        flags and estimates, and :func:`ipmc_asym.evaluate` escalates.
 
     Returns
     -------
@@ -270,15 +319,28 @@ def moment_integral(thickness, voltage, model="constant", fidelity="quadrature",
         ``I`` with the broadcast shape of the inputs (a float for scalar inputs).
         ``M_A = A5 I`` with ``A5 = 6 l e^2 F |phi0| C_moy``.
     """
-    if on_invalid not in ("warn", "raise", "ignore"):
-        raise ValueError(f"on_invalid must be one of warn, raise, ignore; got {on_invalid!r}")
+    check_choice("on_invalid", on_invalid, ("raise", "nan", "warn"))
     r = moment(thickness, voltage, model, fidelity, material=material, **material_kw)
     bad = ~np.asarray(r.valid)
-    if on_invalid != "ignore" and np.any(bad):
-        msg = (f"fidelity {fidelity!r} is outside its validity at {int(bad.sum())} of {bad.size} point(s) "
-               f"(error estimate up to {float(np.max(np.where(bad, r.error, 0))):.2g} > {VALIDITY_LIMIT:g}, "
-               f"or electrode layers overlapping); use a higher fidelity ('bvp' where layers overlap)")
+    I = np.array(r.I, dtype=float)
+    if np.any(bad):
+        msg = invalid_message(r)
         if on_invalid == "raise":
             raise ValueError(msg)
-        warnings.warn(msg, RuntimeWarning, stacklevel=2)
-    return float(r.I) if r.I.ndim == 0 else r.I
+        if on_invalid == "warn":
+            warnings.warn(msg, RuntimeWarning, stacklevel=2)
+        I[bad] = np.nan
+    return float(I) if I.ndim == 0 else I
+
+
+def invalid_message(r: MomentResult) -> str:
+    """One line: where and why ``r`` is outside its validity."""
+    bad = ~np.asarray(r.valid)
+    n = int(bad.sum())
+    if r.fidelity == "bvp" and r.message:
+        return f"{r.message}; no valid result at {n} of {bad.size} point(s)"
+    e = np.asarray(r.error)
+    worst = float(np.max(np.where(bad, e, 0.0))) if n else 0.0
+    return (f"fidelity {r.fidelity!r} is outside its validity at {n} of {bad.size} point(s) "
+            f"(error estimate up to {worst:.2g} > {VALIDITY_LIMIT:g}, or electrode layers "
+            "overlapping); use a higher fidelity, or ipmc_asym.evaluate, which escalates")

@@ -11,7 +11,7 @@ from __future__ import annotations
 import importlib
 import sys
 
-from .common import Parser, UsageError
+from .common import Parser, UsageError, join_negative_values
 
 __all__ = ["main", "build_parser", "COMMANDS", "UsageError"]
 
@@ -64,21 +64,32 @@ def build_parser(only: str | None = None):
 
 
 def main(argv=None) -> int:
+    """Run one command; exit status 0, 2 (bad input or no valid result: one line), 130 (Ctrl-C)."""
     argv = sys.argv[1:] if argv is None else list(argv)
+    argv = join_negative_values(argv)
     only = next((a for a in argv if not a.startswith("-")), None)
-    ap, handlers = build_parser(only if only in COMMANDS else None)
-    args = ap.parse_args(argv)
+    command = only if only in COMMANDS else "?"
     try:
+        ap, handlers = build_parser(only if only in COMMANDS else None)
+        args = ap.parse_args(argv)
+        command = args.command
         rc = handlers[args.command](args)
-    except (ValueError, UsageError) as exc:
+    except (ValueError, UsageError, OverflowError, ArithmeticError) as exc:
         msg = str(exc).splitlines()[0] if str(exc) else exc.__class__.__name__
-        sys.stderr.write(f"ipmc-asym {args.command}: error: {msg}\n")
+        sys.stderr.write(f"ipmc-asym {command}: error: {msg}\n")
         return 2
-    except RuntimeError as exc:  # e.g. BVP non-convergence: message + suggestion
-        sys.stderr.write(f"ipmc-asym {args.command}: {str(exc).splitlines()[0]}\n")
-        return 1
-    except BrokenPipeError:
-        return 0
+    except RuntimeError as exc:  # a solver failure the library could not turn into a refusal
+        sys.stderr.write(f"ipmc-asym {command}: error: {str(exc).splitlines()[0]}\n")
+        return 2
+    except OSError as exc:
+        if isinstance(exc, BrokenPipeError):
+            return 0
+        sys.stderr.write(f"ipmc-asym {command}: error: {exc.strerror or exc} ({exc.filename or ''})\n")
+        return 2
+    except KeyboardInterrupt:
+        # every file is written through fileio.atomic_write/atomic_path: nothing partial is left
+        sys.stderr.write(f"ipmc-asym {command}: interrupted (Ctrl-C); no partial output file left\n")
+        return 130
     return int(rc or 0)
 
 

@@ -7,13 +7,14 @@ from __future__ import annotations
 
 import argparse
 import os
+import re
 import sys
 
 from ..params import Strip, material_from_spec
 from ..units import parse_length, parse_pressure, parse_voltage
 
 __all__ = ["UsageError", "Parser", "add_strip_options", "material_from_args", "strip_from_args",
-           "arg_type", "count_type", "length_type", "pressure_type", "voltage_type", "tol_type", "first_run_notice"]
+           "arg_type", "count_type", "join_negative_values", "fmt_num", "c_moy_label", "length_type", "pressure_type", "voltage_type", "tol_type", "first_run_notice"]
 
 
 class UsageError(Exception):
@@ -64,12 +65,17 @@ def voltage_type(name="voltage"):
 
 
 def _tol(text):
+    """``0.01``, ``1%``, ``1e-3`` -> a relative tolerance in (0, 1)."""
+    t = str(text).strip()
+    scale = 1.0
+    if t.endswith("%"):
+        t, scale = t[:-1].strip(), 0.01
     try:
-        v = float(text)
+        v = float(t) * scale
     except ValueError:
-        raise ValueError(f"--tol must be a number in (0, 1); got {text!r}") from None
+        raise ValueError(f"--tol must be a relative tolerance in (0, 1), e.g. 0.01 or 1%; got {text!r}") from None
     if not 0.0 < v < 1.0:
-        raise ValueError(f"--tol must be a number in (0, 1); got {text!r}")
+        raise ValueError(f"--tol must be a relative tolerance in (0, 1), e.g. 0.01 or 1%; got {text!r}")
     return v
 
 
@@ -91,6 +97,49 @@ def count_type(name, minimum=1):
     return arg_type(conv, name)
 
 
+_NEGATIVE = re.compile(r"^-(\d|\.\d)")
+
+
+def join_negative_values(argv):
+    """``['--voltage', '-1V']`` -> ``['--voltage=-1V']`` for every long option.
+
+    argparse reads a token starting with ``-`` as an option unless it is a bare negative
+    number (``-1``), so ``--voltage -1V`` and ``--vary voltage=...`` style values with a unit
+    would be rejected; a long option followed by ``-<digit>`` or ``-.<digit>`` always takes
+    it as its value (no option of ipmc-asym starts with a digit).
+    """
+    out = []
+    i = 0
+    argv = list(argv)
+    while i < len(argv):
+        a = argv[i]
+        if (a.startswith("--") and "=" not in a and a != "--" and i + 1 < len(argv)
+                and _NEGATIVE.match(argv[i + 1])):
+            out.append(f"{a}={argv[i + 1]}")
+            i += 2
+            continue
+        out.append(a)
+        i += 1
+    return out
+
+
+def fmt_num(x, spec="g"):
+    """``format(x, spec)`` with ``-0`` printed as ``0`` and ``None`` as ``n/a``."""
+    if x is None:
+        return "n/a"
+    x = float(x)
+    if x == 0.0:
+        x = 0.0  # drops the sign of -0.0
+    return format(x, spec)
+
+
+def c_moy_label(material) -> str:
+    """``3082 mol/m^3 (paper)`` / ``(formula)`` / ``(given)``."""
+    src = material.c_moy
+    how = src if isinstance(src, str) else "given"
+    return f"{material.C_moy:.6g} mol/m^3 ({how})"
+
+
 def add_strip_options(p, *, voltage=True):
     """The strip/material options shared by several commands (SI or with units)."""
     p.add_argument("--length", type=length_type("length"), default=0.02, help="strip length L (default 2cm)")
@@ -102,7 +151,8 @@ def add_strip_options(p, *, voltage=True):
                        help="voltage phi0 (default 1V; sign = direction)")
     p.add_argument("--modulus", type=pressure_type("modulus"), default=1.3e8,
                    help="Young's modulus E (default 1.3e8 Pa)")
-    p.add_argument("--c-moy", default="paper", help="C_moy: paper (3082), formula (~3162) or a value in mol/m^3")
+    p.add_argument("--c-moy", default="paper",
+                   help="mean cation concentration C_moy: paper (3082, default), formula (~3162) or a value in mol/m^3")
 
 
 def material_from_args(args):

@@ -9,6 +9,8 @@ from ..units import fmt_length
 from . import SUMMARIES
 from .common import (
     add_strip_options,
+    c_moy_label,
+    fmt_num,
     first_run_notice,
     material_from_args,
     strip_from_args,
@@ -20,13 +22,16 @@ def register(sub):
     p = sub.add_parser("estimate", help=SUMMARIES["estimate"])
     add_strip_options(p)
     p.add_argument("--model", default="all", choices=model_choices(),
-                   help="permittivity model (default all three)")
+                   help="permittivity model: constant, linear, affine or all (default all three)")
     p.add_argument("--fidelity", default="quadrature", choices=fidelity_names(),
-                   help="rung of the fidelity ladder (default quadrature)")
+                   help="cheapest rung of the fidelity ladder to try (default quadrature); a rung that is "
+                        "not valid for this strip is escalated to the next valid one (said per row)")
+    p.add_argument("--no-escalate", action="store_true",
+                   help="use --fidelity only: exit 2 where it is not valid instead of escalating")
     p.add_argument("--tol", type=tol_type, default=None,
-                   help="relative tolerance: warn when the error estimate exceeds it; also the threshold "
-                        "for calling a displacement 'small' (default 1%%)")
-    p.add_argument("--json", action="store_true", help="print one JSON object")
+                   help="relative accuracy required of I (escalate until the error bound meets it) and the "
+                        "threshold for calling a displacement 'small', e.g. 1e-3 or 0.1%% (default 1%%)")
+    p.add_argument("--json", action="store_true", help="print one JSON object {inputs, results}")
 
 
 def run(args):
@@ -34,7 +39,11 @@ def run(args):
     strip = strip_from_args(args)
     if args.fidelity != "bvp":
         first_run_notice()
-    rows = estimate_rows(strip, model_list(args.model), args.fidelity, material, args.tol)
+    rows = estimate_rows(strip, model_list(args.model), args.fidelity, material, args.tol,
+                         escalate=not args.no_escalate, on_invalid="nan")
+    for r in rows:
+        if r["I"] is None:  # no rung valid: refuse the whole command, one line
+            raise ValueError(r["warnings"][-1])
     inputs = {
         "length": strip.length, "width_total": strip.width, "thickness_total": strip.thickness,
         "half_thickness_e": strip.e, "half_width_l": strip.l, "voltage": strip.voltage,
@@ -46,23 +55,27 @@ def run(args):
         return 0
     print(f"IPMC strip: L = {fmt_length(strip.length)}, total width 2l = {fmt_length(strip.width)}, "
           f"total thickness 2e = {fmt_length(strip.thickness)} (half thickness e = {fmt_length(strip.e)}), "
-          f"phi0 = {strip.voltage:g} V, E = {material.E:.3g} Pa, C_moy = {material.C_moy:.6g} mol/m^3 "
-          f"({material.c_moy})")
+          f"phi0 = {fmt_num(strip.voltage)} V, E = {material.E:.3g} Pa, C_moy = {c_moy_label(material)}")
     hdr = (f"{'model':9s} {'fidelity':10s} {'I':>11s} {'M_A [N m]':>11s} {'theta [rad]':>11s} "
            f"{'w [mm]':>9s} {'w_small[mm]':>11s} {'F_block[mN]':>11s} {'F_small[mN]':>11s} {'rel.err':>8s} regime")
     print(hdr)
 
-    def mm(x):
-        return f"{x * 1e3:9.4g}" if x is not None else f"{'n/a':>9s}"
-
-    def mN(x):
-        return f"{x * 1e3:11.4g}" if x is not None else f"{'n/a':>11s}"
+    def sc(x, k):
+        return None if x is None else x * k
 
     for r in rows:
-        print(f"{r['model']:9s} {r['fidelity']:10s} {r['I']:11.5g} {r['M_A']:11.4g} {r['theta']:11.4g} "
-              f"{mm(r['w'])} {mm(r['w_small']):>11s} {mN(r['F_block'])} {mN(r['F_block_small'])} "
-              f"{r['error_estimate']:8.1e} {r['regime']}")
+        fid = r["fidelity_used"] + ("*" if r["escalated"] else "")
+        print(f"{r['model']:9s} {fid:10s} {fmt_num(r['I'], '.5g'):>11s} {fmt_num(r['M_A'], '.4g'):>11s} "
+              f"{fmt_num(r['theta'], '.4g'):>11s} {fmt_num(sc(r['w'], 1e3), '.4g'):>9s} "
+              f"{fmt_num(sc(r['w_small'], 1e3), '.4g'):>11s} {fmt_num(sc(r['F_block'], 1e3), '.4g'):>11s} "
+              f"{fmt_num(sc(r['F_block_small'], 1e3), '.4g'):>11s} {fmt_num(r['error_estimate'], '8.1e')} "
+              f"{r['regime']}")
+    if any(r["escalated"] for r in rows):
+        print("* escalated: the requested fidelity is not valid here; the first valid rung was used")
     for r in rows:
         for w in r["warnings"]:
             print(f"warning [{r['model']}]: {w}")
+        if not r["valid"]:
+            failed = ", ".join(k for k, ok in r["checks"].items() if not ok)
+            print(f"not valid [{r['model']}]: failed check(s) {failed}; withheld (n/a): {', '.join(r['withheld'])}")
     return 0
