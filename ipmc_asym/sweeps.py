@@ -19,30 +19,44 @@ Layer rule: stdlib + numpy at import.
 
 from __future__ import annotations
 
-import csv
+import math
 import sys
 
 import numpy as np
 
-from .beam import solve_beam
+from .beam import max_strain, solve_beam
+from .estimate import check_tol, moment_escalating
 from .fileio import atomic_write
-from .integral import check_fidelity, moment
+from .integral import check_fidelity
 from .params import NAFION_LI, Material, Strip, moment_scale, second_moment
 from .permittivity import get_model
 from .progress import progress as progress_bar
 from .registry import model_names
-from .settings import OUTSIDE_REGIMES
+from .settings import CHUNK_ROWS, MAX_ROWS, OUTSIDE_REGIMES, STRAIN_LIMIT
 from .units import parse_length, parse_pressure, parse_voltage
 
-__all__ = ["VARIABLES", "DTYPE", "parse_vary", "sweep", "write_csv", "rows_as_dicts"]
+__all__ = ["VARIABLES", "DTYPE", "LABELS", "CHECK_COLS", "parse_vary", "parse_vary_spec", "vary_values", "sweep", "iter_sweep", "count_rows",
+           "withhold", "format_chunk", "csv_header", "write_csv", "write_json", "rows_as_dicts"]
 
 VARIABLES = ("length", "width", "thickness", "voltage", "modulus")
 
 _FLOAT_COLS = ("length", "width", "thickness", "voltage", "modulus", "I", "M_A", "theta", "w", "w_small",
-               "F_block", "F_block_small", "B1", "error")
-DTYPE = np.dtype([(c, "f8") for c in _FLOAT_COLS[:5]] + [("model", "U8"), ("fidelity", "U10")]
-                 + [(c, "f8") for c in _FLOAT_COLS[5:]] + [("regime", "U17"), ("valid", "?")])
+               "F_block", "F_block_small", "B1", "error", "max_strain")
+#: per-row validity checks (columns ``check_<name>``); ``valid`` is their conjunction
+CHECK_COLS = tuple(f"check_{c}" for c in ("electrochemistry", "layer_separation", "beam_regime", "strain"))
+DTYPE = np.dtype([(c, "f8") for c in _FLOAT_COLS[:5]] + [("model", "U8"), ("fidelity", "U10"),
+                 ("fidelity_used", "U10"), ("escalated", "?")]
+                 + [(c, "f8") for c in _FLOAT_COLS[5:]] + [("regime", "U17")]
+                 + [(c, "?") for c in CHECK_COLS] + [("valid", "?")])
+#: labels of the output files (CSV header, JSON keys): SI units, TOTAL thickness / width
+LABELS = {"length": "length_m", "width": "width_total_2l_m", "thickness": "thickness_total_2e_m",
+          "voltage": "voltage_V", "modulus": "modulus_Pa", "M_A": "M_A_Nm", "theta": "theta_rad",
+          "w": "w_m", "w_small": "w_small_m", "F_block": "F_block_N", "F_block_small": "F_block_small_N",
+          "error": "error_bound_rel"}
 OUTSIDE = OUTSIDE_REGIMES
+#: outputs of the free strip (not valid past a quarter turn) and all mechanical outputs (strain)
+_FREE = ("theta", "w", "w_small")
+_MECH = _FREE + ("F_block", "F_block_small")
 
 
 def _parse_value(name, text):
@@ -53,8 +67,9 @@ def _parse_value(name, text):
     return parse_pressure(name, text)
 
 
-def parse_vary(spec: str):
-    """``'length=1cm:4cm:16'`` -> ``("length", array)``; ``':log'`` suffix for log spacing."""
+def parse_vary_spec(spec: str):
+    """``'length=1cm:4cm:16'`` -> ``(name, start, stop, n, log)`` without building the values
+    (so that a huge ``n`` can be refused before any memory is used)."""
     if "=" not in spec:
         raise ValueError(f"--vary must be NAME=START:STOP:N[:log]; got {spec!r}")
     name, rng = spec.split("=", 1)
@@ -71,20 +86,26 @@ def parse_vary(spec: str):
     a = _parse_value(name, parts[0])
     b = _parse_value(name, parts[1])
     try:
-        n = int(parts[2])
+        nf = float(parts[2].strip().replace("_", ""))
     except ValueError:
-        raise ValueError(f"--vary {name}: N must be an integer >= 1; got {parts[2]!r}") from None
-    if n < 1:
-        raise ValueError(f"--vary {name}: N must be an integer >= 1; got {n}")
-    if log:
-        if a <= 0 or b <= 0:
-            raise ValueError(f"--vary {name}: log spacing needs START, STOP > 0")
-        vals = np.geomspace(a, b, n)
-    else:
-        vals = np.linspace(a, b, n)
-    if name != "voltage" and np.any(vals <= 0):
+        raise ValueError(f"--vary {name}: N must be an integer >= 1 (e.g. 16 or 1e6); got {parts[2]!r}") from None
+    if not math.isfinite(nf) or not nf.is_integer() or nf < 1:
+        raise ValueError(f"--vary {name}: N must be an integer >= 1 (e.g. 16 or 1e6); got {parts[2]!r}")
+    if log and (a <= 0 or b <= 0):
+        raise ValueError(f"--vary {name}: log spacing needs START, STOP > 0")
+    if name != "voltage" and (a <= 0 or b <= 0):
         raise ValueError(f"--vary {name}: values must be > 0")
-    return name, vals
+    return name, a, b, int(nf), log
+
+
+def vary_values(a, b, n, log):
+    return np.geomspace(a, b, n) if log else np.linspace(a, b, n)
+
+
+def parse_vary(spec: str):
+    """``'length=1cm:4cm:16'`` -> ``("length", array)``; ``':log'`` suffix for log spacing."""
+    name, a, b, n, log = parse_vary_spec(spec)
+    return name, vary_values(a, b, n, log)
 
 
 def _models(model):
@@ -95,81 +116,182 @@ def _models(model):
     return [model]
 
 
+def _axes(vary: dict):
+    for k in vary:
+        if k not in VARIABLES:
+            raise ValueError(f"vary: unknown variable {k!r}; use {', '.join(VARIABLES)}")
+    axes = [np.atleast_1d(np.asarray(v, dtype=float)).ravel() for v in vary.values()]
+    for k, a in zip(vary, axes):
+        if a.size == 0:
+            raise ValueError(f"vary: {k} has no values")
+        if not np.all(np.isfinite(a)) or (k != "voltage" and np.any(a <= 0)):
+            raise ValueError(f"{k} must be finite and > 0" if k != "voltage" else "voltage must be finite")
+    return axes
+
+
+def count_rows(vary: dict, model="constant") -> int:
+    """Rows a sweep would produce (grid points x models), without building anything."""
+    n = 1
+    for v in vary.values():
+        n *= int(np.size(v))
+    return n * len(_models(model))
+
+
+def iter_sweep(vary: dict, model="constant", fidelity="quadrature", base: Strip | None = None,
+               material: Material = NAFION_LI, tol=None, *, chunk_rows: int = CHUNK_ROWS,
+               escalate: bool = True, progress=None, failures: list | None = None):
+    """The sweep as a generator of structured-array chunks (dtype :data:`DTYPE`).
+
+    Memory is ``O(chunk_rows)`` whatever the number of rows: each chunk's grid points are
+    decoded from their flat index (``np.unravel_index``), never from a full meshgrid.  Rows
+    come model by model, grid in C order (first ``vary`` key slowest).
+
+    Parameters
+    ----------
+    vary, model, fidelity, base, material, tol : see :func:`sweep`
+    chunk_rows : int
+        Rows per chunk (default ``settings.CHUNK_ROWS``).
+    escalate : bool
+        Climb the fidelity ladder per point to the first valid rung (default).
+    progress : tqdm-like, optional
+        ``update(k)`` is called with the rows of each chunk computed.
+    failures : list, optional
+        Receives one line per chunk that has points with no valid rung (why).
+
+    Yields
+    ------
+    numpy structured array
+        Rows of :data:`DTYPE`.  Where no rung is valid the electrochemical and mechanical
+        columns are NaN and ``check_electrochemistry``/``valid`` False (other rows kept);
+        the beam checks are columns too (``regime``, ``max_strain``).
+    """
+    check_fidelity(fidelity)
+    base = Strip() if base is None else base
+    axes = _axes(vary)
+    names = list(vary)
+    shape = tuple(a.size for a in axes)
+    n = int(np.prod(shape)) if axes else 1
+    const = {"length": base.length, "width": base.width, "thickness": base.thickness,
+             "voltage": base.voltage, "modulus": material.E}
+    chunk_rows = max(1, int(chunk_rows))
+    for m in _models(model):
+        perm = get_model(m)
+        for lo in range(0, n, chunk_rows):
+            hi = min(n, lo + chunk_rows)
+            k = hi - lo
+            idx = np.unravel_index(np.arange(lo, hi), shape) if axes else ()
+            cols = {}
+            for c in VARIABLES:
+                if c in names:
+                    j = names.index(c)
+                    cols[c] = axes[j][idx[j]]
+                else:
+                    cols[c] = np.full(k, float(const[c]))
+            yield _chunk(cols, perm, fidelity, material, tol, escalate, failures)
+            if progress is not None:
+                progress.update(k)
+
+
+def _chunk(cols, perm, fidelity, material, tol, escalate, failures):
+    k = cols["length"].size
+    A5 = moment_scale(cols["width"], cols["thickness"], cols["voltage"], material.F, material.C_moy)
+    EI = cols["modulus"] * second_moment(cols["width"], cols["thickness"])
+    # I depends on (thickness, voltage) only: evaluate each distinct pair once
+    tv = np.stack([cols["thickness"], cols["voltage"]], axis=1)
+    uniq, inv = np.unique(tv, axis=0, return_inverse=True)
+    inv = np.asarray(inv).reshape(-1)
+    r = moment_escalating(uniq[:, 0], uniq[:, 1], perm, fidelity, material, tol=tol, escalate=escalate,
+                          progress=False)
+    arr = np.empty(k, dtype=DTYPE)
+    for c in VARIABLES:
+        arr[c] = cols[c]
+    arr["model"] = perm.name
+    arr["fidelity"] = fidelity
+    used = r.fidelity_used[inv]
+    arr["fidelity_used"] = used
+    arr["escalated"] = (used != fidelity) & (used != "")
+    ok = r.valid[inv]
+    I = r.I[inv]
+    M = np.where(ok, A5 * np.where(ok, I, 0.0), np.nan)
+    with np.errstate(all="ignore"):
+        b = solve_beam(np.where(ok, M, 0.0), cols["length"], EI, tol=tol)
+        strain = np.asarray(max_strain(np.where(ok, M, 0.0), EI, 0.5 * cols["thickness"]))
+    arr["I"] = I
+    arr["M_A"] = M
+    for c in _MECH:
+        arr[c] = np.where(ok, np.broadcast_to(np.asarray(getattr(b, c), dtype=float), (k,)), np.nan)
+    arr["regime"] = np.where(ok, np.broadcast_to(np.asarray(b.regime), (k,)), "")
+    arr["max_strain"] = np.where(ok, strain, np.nan)
+    arr["B1"] = r.B1[inv]
+    arr["error"] = r.error[inv]
+    arr["check_electrochemistry"] = r.electrochemistry[inv]
+    arr["check_layer_separation"] = r.layer_separation[inv]
+    arr["check_beam_regime"] = ok & ~np.isin(arr["regime"], OUTSIDE_REGIMES)
+    arr["check_strain"] = ok & (strain <= STRAIN_LIMIT)
+    arr["valid"] = (arr["check_electrochemistry"] & arr["check_layer_separation"] & arr["check_beam_regime"]
+                    & arr["check_strain"])
+    if failures is not None and not np.all(ok):
+        failures.append(r.message)
+    return arr
+
+
 def sweep(vary: dict, model="constant", fidelity="quadrature", base: Strip | None = None,
-          material: Material = NAFION_LI, tol=None, progress: bool | None = None) -> np.ndarray:
-    """Evaluate the strip on the grid spanned by ``vary`` (name -> 1-D values, SI).
+          material: Material = NAFION_LI, tol=None, progress: bool | None = None, *,
+          escalate: bool = True, max_rows: int | None = None) -> np.ndarray:
+    """Evaluate the strip on the grid spanned by ``vary`` (name -> 1-D values, SI), in memory.
 
     Parameters
     ----------
     vary : dict
         Keys among :data:`VARIABLES`; each value a 1-D array.  The grid is their outer
         product (first key slowest).  Variables not in ``vary`` take ``base`` / ``material``.
+        ``thickness`` and ``width`` are TOTAL (2e, 2l).
     model : str, list of str or "all"
-    fidelity : {"leading", "corrected", "quadrature", "bvp"}
+    fidelity : str
+        Cheapest rung tried; escalated per point to the first valid rung (``fidelity_used``,
+        ``escalated`` columns) unless ``escalate=False``.
     base : Strip, default nominal
     material : Material (``modulus`` overrides ``material.E``)
-    tol : float, optional   tolerance of the "small" beam regime (default 1 %)
+    tol : float, optional   accuracy required of ``I`` and tolerance of the "small" beam regime
+    max_rows : int, optional
+        Refuse (one-line ``ValueError``) above this many rows (default ``settings.MAX_ROWS``);
+        for more, stream with :func:`iter_sweep`.
 
     Returns
     -------
     numpy structured array (dtype :data:`DTYPE`), one row per grid point and model.
+    Rows where a check failed keep their inputs and say which check (``check_*``,
+    ``valid``); where no rung is valid, ``I`` and the mechanics are NaN.
     """
     check_fidelity(fidelity)
-    base = Strip() if base is None else base
-    for k in vary:
-        if k not in VARIABLES:
-            raise ValueError(f"vary: unknown variable {k!r}; use {', '.join(VARIABLES)}")
-    axes = [np.atleast_1d(np.asarray(v, dtype=float)).ravel() for v in vary.values()]
-    grids = np.meshgrid(*axes, indexing="ij") if axes else []
-    cols = {
-        "length": base.length, "width": base.width, "thickness": base.thickness,
-        "voltage": base.voltage, "modulus": material.E,
-    }
-    for k, g in zip(vary, grids):
-        cols[k] = g.ravel()
-    n = int(np.prod([a.size for a in axes])) if axes else 1
-    for k in cols:
-        cols[k] = np.broadcast_to(np.asarray(cols[k], dtype=float), (n,)).copy()
-    for k in ("length", "width", "thickness", "modulus"):
-        if np.any(~np.isfinite(cols[k])) or np.any(cols[k] <= 0):
-            raise ValueError(f"{k} must be finite and > 0")
-    mats = material
-    C_moy = mats.C_moy
-    A5 = moment_scale(cols["width"], cols["thickness"], cols["voltage"], mats.F, C_moy)
-    EI = cols["modulus"] * second_moment(cols["width"], cols["thickness"])
-    out_parts = []
-    models = _models(model)
-    show = (n * len(models) > 20000 or fidelity == "bvp") if progress is None else progress
-    bar = progress_bar(len(models), "sweep", enabled=show and fidelity != "bvp", unit="model")
-    for m in models:
-        perm = get_model(m)
-        # I depends on (thickness, voltage) only: evaluate each distinct pair once
-        tv = np.stack([cols["thickness"], cols["voltage"]], axis=1)
-        uniq, inv = np.unique(tv, axis=0, return_inverse=True)
-        inv = np.asarray(inv).reshape(-1)
-        r = moment(uniq[:, 0], uniq[:, 1], perm, fidelity, material=mats,
-                   progress=(show if fidelity == "bvp" else False))
-        I = np.asarray(r.I, dtype=float)[inv]
-        M = A5 * I
-        with np.errstate(all="ignore"):
-            b = solve_beam(M, cols["length"], EI, tol=tol)
-        arr = np.empty(n, dtype=DTYPE)
-        for k in ("length", "width", "thickness", "voltage", "modulus"):
-            arr[k] = cols[k]
-        arr["model"] = perm.name
-        arr["fidelity"] = fidelity
-        arr["I"] = I
-        arr["M_A"] = M
-        for k in ("theta", "w", "w_small", "F_block", "F_block_small"):
-            arr[k] = np.broadcast_to(np.asarray(getattr(b, k), dtype=float), (n,))
-        arr["regime"] = np.broadcast_to(np.asarray(b.regime), (n,))
-        arr["B1"] = np.asarray(r.B1)[inv]
-        arr["error"] = np.asarray(r.error)[inv]
-        arr["valid"] = np.asarray(r.valid)[inv]
-        out_parts.append(arr)
-        bar.update(1)
-    bar.close()
-    return np.concatenate(out_parts)
+    tol = check_tol(tol)
+    _axes(vary)
+    n = count_rows(vary, model)
+    limit = MAX_ROWS if max_rows is None else int(max_rows)
+    if n > limit:
+        raise ValueError(f"sweep of {n} rows exceeds max_rows {limit} (settings.MAX_ROWS); "
+                         "stream it with iter_sweep or ipmc-asym sweep --out")
+    show = (n > 20000 or fidelity == "bvp") if progress is None else progress
+    bar = progress_bar(n, "sweep", enabled=show, unit="row")
+    try:
+        parts = list(iter_sweep(vary, model, fidelity, base, material, tol, escalate=escalate, progress=bar))
+    finally:
+        bar.close()
+    return np.concatenate(parts) if parts else np.empty(0, DTYPE)
+
+
+def withhold(arr: np.ndarray) -> np.ndarray:
+    """A copy with the outputs whose check failed set to NaN (what the CLI prints).
+
+    Free-strip outputs (``theta, w, w_small``) past a quarter turn; every mechanical output
+    above the strain limit; everything computed where no rung is valid (already NaN).
+    """
+    out = arr.copy()
+    for c in _FREE:
+        out[c] = np.where(arr["check_beam_regime"], arr[c], np.nan)
+    for c in _MECH:
+        out[c] = np.where(arr["check_strain"], out[c], np.nan)
+    return out
 
 
 def rows_as_dicts(arr: np.ndarray) -> list[dict]:
@@ -191,17 +313,92 @@ def rows_as_dicts(arr: np.ndarray) -> list[dict]:
     return out
 
 
-def write_csv(arr: np.ndarray, path):
-    """CSV with SI columns (header = field names)."""
+def _row_format(names, sep, json_keys=False):
+    parts = []
+    for c in names:
+        kind = DTYPE[c].kind
+        f = ("%.17g" if json_keys else "%.10g") if kind == "f" else "%s"
+        if json_keys:
+            key = LABELS.get(c, c)
+            f = f'"{key}": ' + (f if kind in "fb?" else f'"{f}"')
+        parts.append(f)
+    return sep.join(parts)
+
+
+def format_chunk(arr: np.ndarray, kind: str = "csv") -> str:
+    """Text of one chunk (no header), one line per row, built per column with ``tolist``
+    and one ``%`` format per row in C (``np.savetxt`` style): non-finite floats become an
+    empty CSV field / JSON ``null``, booleans ``True``/``False`` (CSV) or ``true``/``false``."""
+    names = arr.dtype.names
+    cols = []
+    for c in names:
+        a = arr[c]
+        if a.dtype.kind == "b":
+            cols.append(a.tolist() if kind == "csv" else np.where(a, "true", "false").tolist())
+        else:
+            cols.append(a.tolist())
+    if kind == "csv":
+        fmt = _row_format(names, ",")
+        text = "\n".join(map(fmt.__mod__, zip(*cols)))
+        # no string column can contain these tokens (model, fidelity, regime vocabularies)
+        return text.replace("-inf", "").replace("inf", "").replace("nan", "")
+    fmt = "{" + _row_format(names, ", ", json_keys=True) + "}"
+    text = ",\n".join(map(fmt.__mod__, zip(*cols)))
+    return text.replace("-inf", "null").replace("inf", "null").replace("nan", "null")
+
+
+def csv_header(names=DTYPE.names) -> str:
+    return ",".join(LABELS.get(c, c) for c in names)
+
+
+def write_csv(arr, path, progress=None):
+    """CSV with SI columns (header labels say units and TOTAL thickness/width).
+
+    ``arr`` is a structured array or an iterable of chunks (streamed, memory independent of
+    the number of rows); ``path`` ``None``/``"-"`` is stdout, otherwise written atomically.
+    Returns the number of rows written.
+    """
+    chunks = [arr] if isinstance(arr, np.ndarray) else arr
+
     def rows(fh):
-        wr = csv.writer(fh)
-        wr.writerow(arr.dtype.names)
-        for rec in arr:
-            wr.writerow([f"{v:.10g}" if isinstance(v, (np.floating, float)) else
-                         (str(bool(v)) if isinstance(v, np.bool_) else str(v)) for v in rec.tolist()])
+        fh.write(csv_header() + "\n")
+        n = 0
+        for c in chunks:
+            if c.size:
+                fh.write(format_chunk(c, "csv"))
+                fh.write("\n")
+            n += c.size
+            if progress is not None:
+                progress.update(c.size)
+        return n
 
     if path in (None, "-"):
-        rows(sys.stdout)
-    else:
-        with atomic_write(path) as fh:
-            rows(fh)
+        return rows(sys.stdout)
+    with atomic_write(path) as fh:
+        return rows(fh)
+
+
+def write_json(chunks, fh, extra_before: dict | None = None, extra_after=None):
+    """Stream ``{"rows": [...], ...}`` chunk by chunk; ``extra_after`` is a callable giving
+    the keys written after the rows (e.g. fits, timing).  Returns the number of rows."""
+    from .jsonio import dumps
+
+    fh.write("{\n")
+    for k, v in (extra_before or {}).items():
+        fh.write(f"{dumps(k)}: {dumps(v, indent=None)},\n")
+    fh.write('"rows": [\n')
+    n = 0
+    first = True
+    for c in ([chunks] if isinstance(chunks, np.ndarray) else chunks):
+        if not c.size:
+            continue
+        if not first:
+            fh.write(",\n")
+        fh.write(format_chunk(c, "json"))
+        first = False
+        n += c.size
+    fh.write("\n]")
+    for k, v in (extra_after() if extra_after else {}).items():
+        fh.write(f",\n{dumps(k)}: {dumps(v, indent=1)}")
+    fh.write("\n}\n")
+    return n

@@ -93,9 +93,13 @@ def test_c_moy_choice_changes_result():
 
 def test_outside_validity_is_never_silent():
     """1 um total thickness at 20 V: the layers fill the strip; leading must say so."""
-    with pytest.warns(RuntimeWarning, match="outside its validity"):
-        moment_integral(1e-6, 20.0, "linear", "leading")
     with pytest.raises(ValueError, match="outside its validity"):
-        moment_integral(1e-6, 20.0, "linear", "leading", on_invalid="raise")
+        moment_integral(1e-6, 20.0, "linear", "leading")  # default: raise, never a number
+    with pytest.warns(RuntimeWarning, match="outside its validity"):
+        assert math.isnan(moment_integral(1e-6, 20.0, "linear", "leading", on_invalid="warn"))
+    I = moment_integral([1e-6, 200e-6], 20.0, "linear", "leading", on_invalid="nan")
+    assert math.isnan(I[0]) and math.isfinite(I[1])
+    with pytest.raises(ValueError, match="on_invalid"):
+        moment_integral(200e-6, 1.0, on_invalid="ignore")
     r = moment(1e-6, 20.0, "linear", "leading")
     assert not bool(r.valid) and float(r.error) > 1e-2

@@ -1,61 +1,152 @@
-"""``ipmc-asym sweep``: evaluate the strip on a grid of parameters (vectorised)."""
+"""``ipmc-asym sweep``: evaluate the strip on a grid of parameters (vectorised, streamed)."""
 
 from __future__ import annotations
 
+import math
 import sys
 import time
+import warnings
 
-from ..fileio import check_output_path
+import numpy as np
+
+from ..fileio import atomic_write, check_output_path
 from ..fits import sweep_fits
 from ..jsonio import dumps
+from ..progress import progress
 from ..registry import fidelity_names, model_choices
-from ..sweeps import parse_vary, rows_as_dicts, sweep, write_csv
+from ..settings import MAX_ROWS
+from ..estimate import model_list
+from ..sweeps import iter_sweep, parse_vary_spec, sweep, vary_values, withhold, write_csv, write_json
 from . import SUMMARIES
-from .common import add_strip_options, material_from_args, strip_from_args
+from .common import add_strip_options, count_type, material_from_args, strip_from_args, tol_type
+
+#: points per axis used for the fits (a subsample of a longer axis fits the same law)
+FIT_POINTS = 2000
 
 
 def register(sub):
     p = sub.add_parser("sweep", help=SUMMARIES["sweep"])
     p.add_argument("--vary", action="append", default=[], metavar="NAME=START:STOP:N[:log]",
-                   help="length, width, thickness (TOTAL), voltage or modulus; repeat for a grid")
+                   help="length, width (TOTAL 2l), thickness (TOTAL 2e), voltage or modulus, with units "
+                        "(e.g. length=1cm:4cm:16, thickness=10um:1mm:20:log); repeat for a grid")
     add_strip_options(p)
-    p.add_argument("--model", default="constant", choices=model_choices(), help="permittivity model (default constant)")
+    p.add_argument("--model", default="constant", choices=model_choices(),
+                   help="permittivity model: constant, linear, affine or all (default constant)")
     p.add_argument("--fidelity", default="quadrature", choices=fidelity_names(),
-                   help="rung of the fidelity ladder (default quadrature)")
-    p.add_argument("--tol", type=float, default=None, help="tolerance of the 'small' beam regime (1%%)")
-    p.add_argument("--out", default=None, help="CSV file (SI columns); default: stdout unless --json")
-    p.add_argument("--json", action="store_true", help='print {"rows": [...], "fits": [...]}')
-    p.add_argument("--no-progress", action="store_true")
+                   help="cheapest rung tried per point (default quadrature); escalated where not valid "
+                        "(fidelity_used / escalated columns)")
+    p.add_argument("--no-escalate", action="store_true",
+                   help="use --fidelity only; rows where it is not valid are marked and left empty")
+    p.add_argument("--tol", type=tol_type, default=None,
+                   help="relative accuracy required of I, and tolerance of the 'small' beam regime "
+                        "(e.g. 1e-3 or 0.1%%; default 1%%)")
+    p.add_argument("--max-rows", type=count_type("--max-rows"), default=MAX_ROWS,
+                   help=f"refuse a sweep of more rows than this (default {MAX_ROWS:.0e}, settings.MAX_ROWS)")
+    p.add_argument("--out", default=None,
+                   help="output file, written in chunks and atomically: .json for JSON, CSV otherwise "
+                        "(SI columns; default: stdout)")
+    p.add_argument("--json", action="store_true",
+                   help='JSON {"rows": [...], "fits": [...]} on stdout (with --out F.csv: a summary only)')
+    p.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
+
+
+def _fits(vary, args, base, mat):
+    """Power-law fits along each swept axis (through the middle of the other axes)."""
+    fits, notes = [], []
+    for var, vals in vary.items():
+        if vals.size < 2:
+            notes.append(f"no fit along {var}: only {vals.size} value")
+            continue
+        if np.any(vals <= 0):
+            notes.append(f"no fit along {var}: a power law needs values > 0 (got {vals.min():g})")
+            continue
+        sub = vals if vals.size <= FIT_POINTS else vals[np.linspace(0, vals.size - 1, FIT_POINTS).astype(int)]
+        others = {k: v for k, v in vary.items() if k != var}
+        mid = {k: float(v[v.size // 2]) for k, v in others.items()}
+        strip = base.with_(**{k: x for k, x in mid.items() if k != "modulus"})
+        m = mat.with_(E=mid["modulus"]) if "modulus" in mid else mat
+        arr = sweep({var: sub}, args.model, args.fidelity, strip, m, args.tol, progress=False,
+                    escalate=not args.no_escalate)
+        for f in sweep_fits(withhold(arr), [var]):
+            if others:
+                f["through"] = mid
+            if len(sub) < vals.size:
+                f["subsample"] = len(sub)
+            fits.append(f)
+    return fits, notes
+
+
+def _fit_line(f) -> str:
+    var = "total thickness 2e" if f["variable"] == "thickness" else f["variable"]
+    head = f"fit [{f['model']}] |{f['quantity']}| vs {var}"
+    thr = f" (through {', '.join(f'{k}={v:g}' for k, v in f['through'].items())})" if "through" in f else ""
+    if not (math.isfinite(f["exponent"]) and math.isfinite(f["prefactor"])):
+        return f"{head}: no fit: {f.get('note', 'fewer than 2 usable points')}{thr}"
+    if not math.isfinite(f["r"]):
+        return (f"{head}: constant over the range ({f['prefactor']:.4g}): no power law to fit, exponent 0"
+                f"{thr}")
+    return (f"{head} ~ {f['prefactor']:.4g} * {f['variable']}^{f['exponent']:.4g} "
+            f"(r={f['r']:.5f}, n={f['n']}, left out {f['n_left_out']}){thr}")
 
 
 def run(args) -> int:
     if not args.vary:
         raise ValueError("sweep needs at least one --vary NAME=START:STOP:N (e.g. length=1cm:4cm:16)")
-    vary = {}
+    specs = {}
     for s in args.vary:
-        k, v = parse_vary(s)
-        if k in vary:
-            raise ValueError(f"--vary {k} given twice")
-        vary[k] = v
+        spec = parse_vary_spec(s)
+        if spec[0] in specs:
+            raise ValueError(f"--vary {spec[0]} given twice")
+        specs[spec[0]] = spec
+    # refuse before building anything (a 10^8-point axis alone would take 800 MB)
+    n = len(model_list(args.model)) * math.prod(sp[3] for sp in specs.values())
+    if n > args.max_rows:
+        raise ValueError(f"the sweep has {n:.3g} rows, more than --max-rows {args.max_rows:g}; "
+                         "narrow it or raise --max-rows")
+    vary = {k: vary_values(*sp[1:]) for k, sp in specs.items()}
     if args.out:
         check_output_path(args.out, "file")
     base = strip_from_args(args)
     mat = material_from_args(args)
     t0 = time.perf_counter()
-    arr = sweep(vary, args.model, args.fidelity, base, mat, args.tol,
-                progress=False if args.no_progress else None)
+    failures: list = []
+    bar = progress(n, "sweep", enabled=False if args.no_progress else None, unit="row")
+    with warnings.catch_warnings():
+        # no NumPy RuntimeWarning with internal paths: non-finite results are columns/notes
+        warnings.simplefilter("ignore", RuntimeWarning)
+        chunks = (withhold(c) for c in iter_sweep(vary, args.model, args.fidelity, base, mat, args.tol,
+                                                  escalate=not args.no_escalate, progress=bar,
+                                                  failures=failures))
+        try:
+            fits, notes = _fits(vary, args, base, mat)
+
+            def tail():
+                return {"fits": fits, "fit_notes": notes, "seconds": time.perf_counter() - t0}
+
+            to_json_file = bool(args.out) and args.out.lower().endswith(".json")
+            if args.out and to_json_file:
+                with atomic_write(args.out) as fh:
+                    rows = write_json(chunks, fh, {"n_rows": n}, tail)
+            elif args.out:
+                rows = write_csv(chunks, args.out)
+            elif args.json:
+                rows = write_json(chunks, sys.stdout, {"n_rows": n}, tail)
+            else:
+                rows = write_csv(chunks, "-")
+        finally:
+            bar.close()
     dt = time.perf_counter() - t0
-    fits = sweep_fits(arr, list(vary)) if len(vary) == 1 else []
     if args.out:
-        write_csv(arr, args.out)
-        sys.stderr.write(f"sweep: {arr.size} rows in {dt:.3g} s -> {args.out}\n")
-    if args.json:
-        print(dumps({"rows": rows_as_dicts(arr), "fits": fits, "seconds": dt}, indent=1))
-    elif not args.out:
-        write_csv(arr, "-")
-    if not args.json and fits:
+        sys.stderr.write(f"sweep: {rows} rows in {dt:.3g} s -> {args.out}\n")
+        if args.json and not to_json_file:
+            print(dumps({"out": args.out, "n_rows": rows, "fits": fits, "fit_notes": notes, "seconds": dt},
+                        indent=1))
+    if failures:
+        sys.stderr.write(f"sweep: rows with no valid fidelity are kept with valid=False and empty "
+                         f"results; first: {failures[0]}\n")
+    if not args.json:
         for f in fits:
-            sys.stderr.write(
-                f"fit [{f['model']}] |{f['quantity']}| ~ {f['prefactor']:.4g} * {f['variable']}^"
-                f"{f['exponent']:.4g} (r={f['r']:.5f}, n={f['n']}, left out {f['n_left_out']})\n")
+            sys.stderr.write(_fit_line(f) + "\n")
+        for note in notes:
+            sys.stderr.write(note + "\n")
     return 0
