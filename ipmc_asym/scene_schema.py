@@ -44,7 +44,7 @@ import numpy as np
 
 from .params import NOMINAL_STRIP, Material, Strip, material_from_spec
 from .registry import model_names
-from .settings import DEFAULT_SCENE_TOL
+from .settings import MAX_ROWS, DEFAULT_SCENE_TOL
 from .units import parse_length, parse_voltage
 
 __all__ = ["Scene", "OUTPUTS", "AXES", "load_scene", "parse_scene", "read_scene"]
@@ -168,6 +168,9 @@ def _values(key, spec, axis):
         n = spec["n"]
         if isinstance(n, bool) or not isinstance(n, int) or n < 1:
             raise ValueError(f"{key}.n must be an integer >= 1; got {n!r}")
+        if n > MAX_ROWS:  # refuse before allocating (a scene is evaluated in memory)
+            raise ValueError(f"{key}.n = {n} exceeds {MAX_ROWS} points (settings.MAX_ROWS); "
+                             "use ipmc-asym sweep --out for streamed grids")
         log = spec.get("log", False)
         if not isinstance(log, bool):
             raise ValueError(f"{key}.log must be true or false; got {log!r}")
@@ -246,6 +249,9 @@ def parse_scene(scene: dict) -> Scene:
     elif "voltage" not in axes:
         raise ValueError("voltage: missing (give voltage, voltages or [sweep].voltage)")
     names = list(axes)
+    if int(np.prod([axes[k].size for k in names], dtype=float)) > MAX_ROWS:
+        raise ValueError(f"the scene grid has {int(np.prod([axes[k].size for k in names], dtype=float))} "
+                         f"points, more than {MAX_ROWS} (settings.MAX_ROWS); use ipmc-asym sweep --out")
     grids = np.meshgrid(*[axes[k] for k in names], indexing="ij") if names else []
     shape = grids[0].shape if names else ()
     pts = {k: (grids[names.index(k)] if k in names else np.full(shape, base[k])).reshape(-1) for k in AXES}

@@ -43,18 +43,20 @@ from .beam import (
     blocking_force_error,
     blocking_force_large,
     blocking_force_small,
+    max_strain,
     rotation,
     small_displacement_error,
     tip_deflection,
     tip_deflection_small,
 )
+from .beam import regime as beam_regime
 from .fits import fit_power_law
-from .integral import moment
 from .params import moment_scale, second_moment
 from .profiles import LAYER_WIDTHS, layer_widths
 from .registry import fidelity_names
 from .scene_schema import OUTPUTS, Scene, load_scene, read_scene
-from .settings import BVP_STATED_ERROR
+from .estimate import moment_escalating
+from .settings import BVP_STATED_ERROR, OUTSIDE_REGIMES, STRAIN_LIMIT
 
 __all__ = ["run_scene", "load_scene", "OUTPUTS", "LADDER", "Scene"]
 
@@ -66,33 +68,21 @@ _ANODE_WIDTH, _CATHODE_WIDTH = "devoid_um", "accumulation_um"
 
 
 def _plan_moment(sc: Scene):
-    """I, error estimate and fidelity per point, escalating until the estimate meets tol."""
-    th, v, tol = sc.points["thickness"], sc.points["voltage"], sc.tolerance
-    n = th.size
-    I = np.full(n, np.nan)
-    err = np.full(n, np.inf)
-    fid = np.array([LADDER[-1]] * n, dtype=object)
-    todo = np.ones(n, bool)
-    if isinstance(sc.model, str):
-        for f in LADDER[:-1]:
-            idx = np.flatnonzero(todo)
-            if idx.size == 0:
-                break
-            r = moment(th[idx], v[idx], sc.model, f, material=sc.material)
-            ok = r.valid & (r.error <= tol) & np.isfinite(r.I)
-            sel = idx[ok]
-            I[sel], err[sel], fid[sel] = r.I[ok], r.error[ok], f
-            todo[sel] = False
-    idx = np.flatnonzero(todo)
-    if idx.size:
-        r = moment(th[idx], v[idx], sc.model, LADDER[-1], material=sc.material, progress=False)
-        I[idx], err[idx] = r.I, r.error
-    return I, err, fid
+    """I, error bound and fidelity per point: the cheapest rung meeting the tolerance
+    (:func:`ipmc_asym.estimate.moment_escalating`, generic over the registry's ladder).
+    Where no rung is valid: a one-line ``ValueError`` (never a number that failed its check)."""
+    r = moment_escalating(sc.points["thickness"], sc.points["voltage"], sc.model, LADDER[0], sc.material,
+                          tol=min(sc.tolerance, 0.5), progress=False)
+    if not np.all(r.valid):
+        raise ValueError(r.message)
+    return r.I, r.error, r.fidelity_used
 
 
 def _scaling_fit(x, y, what):
     """Power-law fit of one output over the swept variable (fits.fit_power_law)."""
     x, y = np.asarray(x, float), np.asarray(y, float)
+    keep = np.isfinite(y)  # points withheld by a beam check are left out
+    x, y = x[keep], y[keep]
     if x.size < 2 or np.unique(x).size < 2:
         raise ValueError("scaling_fit needs a [sweep] (or voltages) over at least 2 distinct values")
     if np.any(x <= 0) or np.any(y == 0) or not np.all(np.isfinite(y)):
@@ -149,13 +139,23 @@ def run_scene(scene) -> dict:
         Unknown section/key, wrong type, impossible value or unreadable file (the message
         names the key).
     """
-    sc = read_scene(scene)
+    raw = scene
+    if not isinstance(scene, (dict, Scene)):
+        raw = load_scene(scene)
+    sc = read_scene(raw)
     pts, n, tol, outputs = sc.points, sc.n, sc.tolerance, sc.outputs
+    defaults = []
+    if isinstance(raw, dict):
+        given = set(raw.get("strip", {}) or {}) | set(raw.get("sweep", {}) or {})
+        defaults = [k for k in ("length", "width", "thickness") if k not in given]
     material = sc.material
     res = {"scene": sc.name, "model": sc.model if isinstance(sc.model, str) else "custom", "tolerance": tol,
            "material": {"name": material.name, "E": material.E, "C_moy": material.C_moy,
                         "c_moy": str(material.c_moy), "phi4": material.phi4},
            "swept": list(sc.swept),
+           "defaults_used": {k: float(pts[k][0]) for k in defaults},
+           "point_units": {"length": "m", "width": "m, TOTAL width 2l", "thickness": "m, TOTAL thickness 2e",
+                           "voltage": "V"},
            "points": [{k: float(pts[k][i]) for k in ("length", "width", "thickness", "voltage")}
                       for i in range(n)],
            "outputs": {}}
@@ -175,29 +175,42 @@ def run_scene(scene) -> dict:
             out["moment"] = {"values": M.tolist(), "unit": "N m", "fidelity": fl, "error_estimate": el}
         L = pts["length"]
         EI = material.E * second_moment(pts["width"], pts["thickness"])
+        # beam checks: free-strip outputs past a quarter turn, and every mechanical output above
+        # the strain limit, are outside the model and withheld (None), point by point
+        reg = np.atleast_1d(beam_regime(M, L, EI, tol))
+        strain = np.atleast_1d(max_strain(M, EI, 0.5 * pts["thickness"]))
+        mech_ok = strain <= STRAIN_LIMIT
+        free_ok = ~np.isin(reg, OUTSIDE_REGIMES) & mech_ok
+        res["checks"] = [{"electrochemistry": True, "layer_separation": True,
+                          "beam_regime": bool(not np.isin(reg[i], OUTSIDE_REGIMES)),
+                          "strain": bool(mech_ok[i]), "max_strain": float(strain[i])} for i in range(n)]
+        res["valid"] = bool(np.all(free_ok))
+
+        def _kept(a, ok):
+            return [float(x) if o else None for x, o in zip(np.atleast_1d(a), ok)]
         if "rotation" in outputs:
             th = np.atleast_1d(rotation(M, L, EI))
-            vals["rotation"] = th
-            out["rotation"] = {"values": th.tolist(), "unit": "rad", "fidelity": fl, "error_estimate": el,
+            vals["rotation"] = np.where(free_ok, th, np.nan)
+            out["rotation"] = {"values": _kept(th, free_ok), "unit": "rad", "fidelity": fl, "error_estimate": el,
                                "beam": ["exact"] * n}
         if "tip_deflection" in outputs:
             serr = np.atleast_1d(small_displacement_error(M, L, EI))
             small = serr <= tol
             w = np.where(small, tip_deflection_small(M, L, EI), tip_deflection(M, L, EI))
-            vals["tip_deflection"] = w
-            out["tip_deflection"] = {"values": w.tolist(), "unit": "m", "fidelity": fl,
+            vals["tip_deflection"] = np.where(free_ok, w, np.nan)
+            out["tip_deflection"] = {"values": _kept(w, free_ok), "unit": "m", "fidelity": fl,
                                      "error_estimate": (err + np.where(small, serr, 0.0)).tolist(),
                                      "beam": ["small" if s else "large" for s in small]}
         if "blocking_force" in outputs:
             berr = np.atleast_1d(blocking_force_error(M, L, EI))
             small = berr <= tol
             F = np.where(small, blocking_force_small(M, L), blocking_force_large(M, L, EI))
-            if not np.all(np.isfinite(F)):
-                k = int(np.flatnonzero(~np.isfinite(F))[0])
+            if not np.all(np.isfinite(F) | ~mech_ok):
+                k = int(np.flatnonzero(~np.isfinite(F) & mech_ok)[0])
                 raise ValueError(f"blocking_force: no large-displacement blocking force at point {k} "
                                  f"({res['points'][k]}); the strip bends too far (|kappa L| too large)")
-            vals["blocking_force"] = F
-            out["blocking_force"] = {"values": F.tolist(), "unit": "N", "fidelity": fl,
+            vals["blocking_force"] = np.where(mech_ok, F, np.nan)
+            out["blocking_force"] = {"values": _kept(F, mech_ok), "unit": "N", "fidelity": fl,
                                      "error_estimate": (err + np.where(small, berr, 0.0)).tolist(),
                                      "beam": ["small" if s else "large" for s in small]}
     if "profiles" in outputs:

@@ -6,7 +6,9 @@ import sys
 
 from ..jsonio import dumps
 from ..scenes import run_scene
+from ..units import fmt_length
 from . import SUMMARIES
+from .common import fmt_num
 
 
 def register(sub):
@@ -24,6 +26,16 @@ def run(args) -> int:
         return 0
     print(f"scene {res['scene']!r}: model {res['model']}, tolerance {res['tolerance']:g}, "
           f"{len(res['points'])} point(s), swept: {', '.join(res['swept']) or 'nothing'}")
+    for k, x in res.get("defaults_used", {}).items():
+        label = {"thickness": "total thickness 2e", "width": "total width 2l"}.get(k, k)
+        print(f"  note: [strip].{k} not given: using the default {label} = {fmt_length(x)}")
+    lab = {"length": "L", "width": "2l", "thickness": "2e", "voltage": "phi0"}
+
+    def where(i):
+        p = res["points"][i]
+        keys = res["swept"] or []
+        return ", ".join(f"{lab[k]}={fmt_length(p[k]) if k != 'voltage' else fmt_num(p[k]) + ' V'}" for k in keys)
+
     for k, o in res["outputs"].items():
         if k == "scaling_fit":
             for q, f in o["fits"].items():
@@ -32,12 +44,18 @@ def run(args) -> int:
             continue
         if k == "profiles":
             for i, pr in enumerate(o["values"]):
-                print(f"  profiles[{i}]: B1 = {pr['B1']:.6g}, anode layer {pr['anode_layer']['width_m']:.3g} m, "
-                      f"cathode layer {pr['cathode_layer']['width_m']:.3g} m (bvp)")
+                print(f"  profiles[{where(i) or i}]: B1 = {pr['B1']:.6g}, anode layer "
+                      f"{pr['anode_layer']['width_m']:.3g} m, cathode layer {pr['cathode_layer']['width_m']:.3g} m (bvp)")
             continue
         for i, v in enumerate(o["values"]):
             beam = f", beam {o['beam'][i]}" if "beam" in o else ""
-            print(f"  {k}[{i}] = {v:.6g} {'' if o['unit'] == 'dimensionless' else o['unit']}  ({o['fidelity'][i]}, rel. err <= "
+            unit = "" if o["unit"] == "dimensionless" else o["unit"]
+            if v is None:
+                c = res.get("checks", [{}] * (i + 1))[i]
+                failed = ", ".join(n for n in ("beam_regime", "strain") if not c.get(n, True))
+                print(f"  {k}[{where(i) or i}] = n/a (withheld: check {failed} failed)")
+                continue
+            print(f"  {k}[{where(i) or i}] = {fmt_num(v, '.6g')} {unit}  ({o['fidelity'][i]}, rel. err <= "
                   f"{o['error_estimate'][i]:.2g}{beam})")
     sys.stdout.flush()
     return 0
