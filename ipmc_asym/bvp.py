@@ -274,7 +274,7 @@ def solve(strip: Strip, model="constant", material: Material = NAFION_LI, *, tol
         return _finish(*first, g_signed, name, t0, "")
     res_c, prob_c, g_c = cont
     for t in [tol] + loose[:-1]:
-        r = _run(prob_c, g_c, res_c.x, res_c.y, float(res_c.p[0]), t,
+        r = _run(prob_c, res_c.x, res_c.y, float(res_c.p[0]), t,
                  min(int(max_nodes), BVP_MAX_NODES_FIRST))
         if r.status == 0:
             return _finish(r, prob_c, g_c, g_signed, name, t0, " (after voltage continuation)")

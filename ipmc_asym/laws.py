@@ -35,6 +35,13 @@ def local_exponents(model, var, n=241, thickness=200e-6, voltage=1.0):
     return x, local_exponent(x, I)
 
 
+#: LaTeX of the quantity names and of the symbols SymPy would spell as plain text
+LATEX_NAMES = {"I": "I", "M_A": "M_A", "theta": r"\theta", "w_small": "w_{small}", "w": "w",
+               "F_block": "F_{block}", "F_block_small": "F_{block,small}"}
+LATEX_SYMBOLS = {"eps0": r"\varepsilon_0", "Delta_eps": r"\Delta\varepsilon", "deps": r"\Delta\varepsilon", "eps_moy": r"\varepsilon_{moy}",
+                 "phi0": r"\phi_0", "phi4": r"\phi_4"}
+
+
 def law_table(model=None):
     """Leading-order laws from the derivation: list of dict rows (SymPy objects stringified)."""
     import sympy as sp
@@ -45,9 +52,11 @@ def law_table(model=None):
     for r in scaling.laws():
         if model and r["model"] != model:
             continue
+        names = {s: LATEX_SYMBOLS[s.name] for s in r["expr"].free_symbols if s.name in LATEX_SYMBOLS}
         rows.append({
             "model": r["model"], "regime": r["regime"], "quantity": r["quantity"],
-            "formula": str(r["expr"]), "latex": sp.latex(r["expr"]),
+            "latex_name": LATEX_NAMES.get(r["quantity"], r["quantity"]),
+            "formula": str(r["expr"]), "latex": sp.latex(r["expr"], symbol_names=names),
             "exponents": {k: str(v) for k, v in r["exponents"].items()},
         })
     return rows

@@ -280,13 +280,14 @@ def sweep(vary: dict, model="constant", fidelity="quadrature", base: Strip | Non
     return np.concatenate(parts) if parts else np.empty(0, DTYPE)
 
 
-def withhold(arr: np.ndarray) -> np.ndarray:
-    """A copy with the outputs whose check failed set to NaN (what the CLI prints).
+def withhold(arr: np.ndarray, copy: bool = True) -> np.ndarray:
+    """``arr`` (a copy unless ``copy=False``) with the outputs whose check failed set to NaN
+    (what the CLI prints).
 
     Free-strip outputs (``theta, w, w_small``) past a quarter turn; every mechanical output
     above the strain limit; everything computed where no rung is valid (already NaN).
     """
-    out = arr.copy()
+    out = arr.copy() if copy else arr
     for c in _FREE:
         out[c] = np.where(arr["check_beam_regime"], arr[c], np.nan)
     for c in _MECH:
@@ -323,6 +324,15 @@ def _row_format(names, sep, json_keys=False):
             f = f'"{key}": ' + (f if kind in "fb?" else f'"{f}"')
         parts.append(f)
     return sep.join(parts)
+
+
+#: rows formatted at once: the per-row Python objects of ``tolist`` (~1 kB/row) stay ~30 MB
+FORMAT_ROWS = 2**15
+
+
+def _pieces(arr):
+    for lo in range(0, arr.size, FORMAT_ROWS):
+        yield arr[lo:lo + FORMAT_ROWS]
 
 
 def format_chunk(arr: np.ndarray, kind: str = "csv") -> str:
@@ -364,8 +374,8 @@ def write_csv(arr, path, progress=None):
         fh.write(csv_header() + "\n")
         n = 0
         for c in chunks:
-            if c.size:
-                fh.write(format_chunk(c, "csv"))
+            for piece in _pieces(c):
+                fh.write(format_chunk(piece, "csv"))
                 fh.write("\n")
             n += c.size
             if progress is not None:
@@ -390,12 +400,11 @@ def write_json(chunks, fh, extra_before: dict | None = None, extra_after=None):
     n = 0
     first = True
     for c in ([chunks] if isinstance(chunks, np.ndarray) else chunks):
-        if not c.size:
-            continue
-        if not first:
-            fh.write(",\n")
-        fh.write(format_chunk(c, "json"))
-        first = False
+        for piece in _pieces(c):
+            if not first:
+                fh.write(",\n")
+            fh.write(format_chunk(piece, "json"))
+            first = False
         n += c.size
     fh.write("\n]")
     for k, v in (extra_after() if extra_after else {}).items():

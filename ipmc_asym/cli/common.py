@@ -6,6 +6,7 @@ Only the command line imports this module.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 import re
 import sys
@@ -167,6 +168,20 @@ _MATERIAL_OPTIONS = {"preset": "--material", "E": "--modulus", "c_moy": "--c-moy
 def strip_from_args(args):
     return Strip(length=args.length, width=args.width, thickness=args.thickness,
                  voltage=getattr(args, "voltage", 1.0))
+
+
+@contextlib.contextmanager
+def new_dir_removed_on_failure(path):
+    """Around work writing into directory ``path``: if the work fails (or Ctrl-C) and the
+    directory did not exist before and is still empty, remove it (no empty directory left)."""
+    existed = os.path.isdir(path)
+    try:
+        yield
+    except BaseException:
+        if not existed and os.path.isdir(path) and not os.listdir(path):
+            with contextlib.suppress(OSError):
+                os.rmdir(path)
+        raise
 
 
 def first_run_notice():

@@ -7,7 +7,7 @@ import sys
 from ..bench import load_bench
 from ..fileio import check_output_path
 from . import SUMMARIES
-from .common import count_type
+from .common import count_type, new_dir_removed_on_failure
 
 
 def register(sub):
@@ -25,8 +25,9 @@ def run(args) -> int:
     bench = load_bench(args.bench) if args.bench else None
     from ..plotting.figures import make_all  # deferred: matplotlib (start-up)
 
-    out = make_all(args.out, args.dpi, quick=args.quick, bench=bench,
-                   log=lambda msg: print(f"figures: {msg}", file=sys.stderr, flush=True))
+    with new_dir_removed_on_failure(args.out):
+        out = make_all(args.out, args.dpi, quick=args.quick, bench=bench,
+                       log=lambda msg: print(f"figures: {msg}", file=sys.stderr, flush=True))
     for f in out["files"]:
         print("wrote", f)
     for n in out["notes"]:

@@ -11,7 +11,7 @@ from . import SUMMARIES
 def register(sub):
     p = sub.add_parser("laws", help=SUMMARIES["laws"])
     p.add_argument("--model", default="all", choices=model_choices(), help="permittivity model (default all)")
-    p.add_argument("--json", action="store_true")
+    p.add_argument("--json", action="store_true", help="print one JSON object (laws, local exponents, ranges)")
     p.add_argument("--latex", action="store_true", help="print LaTeX for every quantity (default: for I only)")
 
 
@@ -25,15 +25,15 @@ def run(args):
         print(dumps(data, indent=2))
         return 0
     print("Leading-order scaling laws (SI; e = HALF thickness, l = HALF width; M_A = A5 I).")
-    print(f"Prefactors of theta, w_p, F^p from sections 3-4 are {factor} x the paper's section 6.2 ones;"
-          " we use sections 3-4.")
+    ratios = ", ".join(f"{k} x{v}" for k, v in factor.items())
+    print(f"Prefactors from sections 3-4 over the paper's section 6.2 ones: {ratios}; we use sections 3-4.")
     for m in models:
         print(f"\n== {m} ==")
         for r in data["models"][m]["laws"]:
             ex = "  ".join(f"{k}^{v}" for k, v in r["exponents"].items())
             print(f"  [{r['regime']}] {r['quantity']:8s} ~ {ex:38s} = {r['formula']}")
             if args.latex or r["quantity"] == "I":
-                print(f"      LaTeX: {r['quantity'].replace('_', ' ')} = {r['latex']}")
+                print(f"      LaTeX: {r['latex_name']} = {r['latex']}")
         rg = data["models"][m]["ranges"]
         ep, ee = rg["exponent_phi0"], rg["exponent_e"]
         print(f"  local d ln I/d ln phi0 over 1 mV-10 V (2e = 200 um): {ep['min']:+.3f} .. {ep['max']:+.3f} "
@@ -41,7 +41,12 @@ def run(args):
         print(f"  local d ln I/d ln e over 2e = 10 um-4 mm (1 V): {ee['min']:+.4f} .. {ee['max']:+.4f} "
               f"({ee['at_200um']:+.4f} at 200 um)")
         for k, spans in {**rg["voltage"], **rg["thickness"]}.items():
-            txt = ", ".join(f"{a:.3g}-{b:.3g}" for a, b in spans) or "nowhere in the range"
-            unit = "m (total thickness)" if "e^" in k else "V"
-            print(f"  {k}: holds (|exponent error| < {HOLD_TOL}) for {txt} {unit if spans else ''}")
+            thick = "e^" in k
+            unit = "m (total thickness 2e)" if thick else "V"
+            where = "2e = 10 um - 4 mm" if thick else "1 mV - 10 V"
+            if spans:
+                txt = ", ".join(f"{a:.3g}-{b:.3g}" for a, b in spans)
+                print(f"  {k}: holds (|exponent error| < {HOLD_TOL}) for {txt} {unit}")
+            else:
+                print(f"  {k}: does not hold anywhere in {where} (|exponent error| >= {HOLD_TOL} throughout)")
     return 0

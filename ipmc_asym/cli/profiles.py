@@ -7,7 +7,7 @@ from ..jsonio import dumps
 from ..profiles import PAPER_LAYERS
 from ..registry import model_choices, model_names
 from . import SUMMARIES
-from .common import add_strip_options, material_from_args, strip_from_args
+from .common import add_strip_options, material_from_args, new_dir_removed_on_failure, strip_from_args
 
 
 def register(sub):
@@ -27,7 +27,8 @@ def run(args) -> int:
     from ..plotting.profiles import write_all  # deferred: matplotlib (start-up)
 
     models = model_names() if args.model == "all" else (args.model,)
-    out = write_all(args.out, models, strip, mat)
+    with new_dir_removed_on_failure(args.out):
+        out = write_all(args.out, models, strip, mat)
     if args.json:
         print(dumps(out, indent=2))
         return 0

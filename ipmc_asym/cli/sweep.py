@@ -111,10 +111,10 @@ def run(args) -> int:
     t0 = time.perf_counter()
     failures: list = []
     bar = progress(n, "sweep", enabled=False if args.no_progress else None, unit="row")
-    with warnings.catch_warnings():
+    with warnings.catch_warnings(), np.errstate(all="ignore"):
         # no NumPy RuntimeWarning with internal paths: non-finite results are columns/notes
         warnings.simplefilter("ignore", RuntimeWarning)
-        chunks = (withhold(c) for c in iter_sweep(vary, args.model, args.fidelity, base, mat, args.tol,
+        chunks = (withhold(c, copy=False) for c in iter_sweep(vary, args.model, args.fidelity, base, mat, args.tol,
                                                   escalate=not args.no_escalate, progress=bar,
                                                   failures=failures))
         try:
