@@ -34,7 +34,9 @@ _COL = MODEL_COLOURS
 INFLUENCE = {
     "length": (np.linspace(0.005, 0.04, 36), 1e2, "length L (cm)", "influence_length", 8),
     "thickness": (np.linspace(50e-6, 400e-6, 36), 1e6, "TOTAL thickness 2e (µm)", "influence_thickness", 9),
-    "voltage": (np.linspace(0.02, 3.0, 60), 1.0, r"voltage $\varphi_0$ (V)", "influence_voltage", 10),
+    # log-spaced: I(phi0) changes regime around 0.1 V (Debye-Hueckel -> layers); a linear
+    # 0.05 V step drew kinks there
+    "voltage": (np.geomspace(0.01, 3.0, 90), 1.0, r"voltage $\varphi_0$ (V)", "influence_voltage", 10),
     "width": (np.linspace(1e-3, 10e-3, 19), 1e3, "TOTAL width 2l (mm)", "influence_width", None),
 }
 
@@ -48,23 +50,40 @@ def influence_figure(var, path, base: Strip | None = None, material: Material = 
     base = Strip() if base is None else base
     arr = sweep({var: vals}, list(MODELS3), "quadrature", base, material)
     fig, axs = plt.subplots(1, 3, figsize=(13, 4.0), dpi=dpi)
+    handles = []
+    ymax = [0.0, 0.0, 0.0]
     for m in MODELS3:
         a = arr[arr["model"] == m]
         x = a[var] * sc
-        out = np.isin(a["regime"], OUTSIDE_REGIMES)
+        # outside the beam model: past a quarter turn, or strain above settings.STRAIN_LIMIT
+        out = ~(a["check_beam_regime"] & a["check_strain"]) | np.isin(a["regime"], OUTSIDE_REGIMES)
         inside = ~out
-        for ax, q, qs, fac in ((axs[0], "w", "w_small", 1e3), (axs[1], "F_block", "F_block_small", 1e3),
-                               (axs[2], "theta", None, 1.0)):
+        for k, (ax, q, qs, fac) in enumerate(((axs[0], "w", "w_small", 1e3),
+                                              (axs[1], "F_block", "F_block_small", 1e3),
+                                              (axs[2], "theta", None, 1.0))):
             y = np.abs(a[q]) * fac
             yi = np.where(inside, y, np.nan)
-            ax.plot(x, yi, "-", color=_COL[m], label=f"{m}")
+            (h,) = ax.plot(x, yi, "-", color=_COL[m], label=f"{m}")
+            if k == 0:
+                handles.append(h)
+            if np.any(np.isfinite(yi)):
+                ymax[k] = max(ymax[k], float(np.nanmax(yi)))
             if out.any():
-                yo = np.where(out | np.roll(out, -1) | np.roll(out, 1), y, np.nan)
-                ax.plot(x, yo, ":", color=_COL[m], alpha=0.7)
+                # beyond the quarter turn: marked dotted, up to the first point past it only
+                edge = out & (np.roll(inside, 1) | np.roll(inside, -1))
+                yo = np.where(edge | (inside & np.roll(out, -1)) | (inside & np.roll(out, 1)), y, np.nan)
+                ax.plot(x, yo, ":", color=_COL[m], alpha=0.8)
+                if k == 0 and inside.any() and out.any():
+                    xq = x[np.flatnonzero(out)[0]] if out[-1] else x[np.flatnonzero(out)[-1]]
+                    ax.axvline(xq, color=_COL[m], lw=0.6, ls=":", alpha=0.6)
             if qs is not None and q == "w":
-                ax.plot(x, np.abs(a[qs]) * fac, "--", color=_COL[m], lw=0.8, alpha=0.6)
+                # small-displacement formula: only where the strip is inside the model
+                ax.plot(x, np.where(inside, np.abs(a[qs]) * fac, np.nan), "--", color=_COL[m], lw=0.8, alpha=0.6)
+    for k, ax in enumerate(axs):
+        if ymax[k] > 0:
+            ax.set_ylim(0.0, 1.15 * ymax[k] if k < 2 else max(1.15 * ymax[k], 1.7))
     axs[0].set_ylabel("tip deflection |w| (mm)")
-    axs[0].set_title("(a) deflection: solid arc, dashed small-displ., dotted past quarter turn", fontsize=8)
+    axs[0].set_title("(a) deflection (dashed: small displ.; dotted: outside the model)", fontsize=9)
     axs[1].set_ylabel(r"blocking force $F^p$ (mN)")
     axs[1].set_title("(b) blocking force (large displacements)", fontsize=9)
     axs[2].set_ylabel(r"rotation $|\theta|$ (rad)")
@@ -73,7 +92,12 @@ def influence_figure(var, path, base: Strip | None = None, material: Material = 
     for ax in axs:
         ax.set_xlabel(xlabel)
         ax.grid(True, alpha=0.3)
-        ax.legend(fontsize=8)
+    if var == "voltage":
+        for ax in axs:
+            ax.set_xscale("log")
+    # one legend for the figure, below the panels: never on a curve or the pi/2 line
+    fig.legend(handles, [h.get_label() for h in handles], loc="lower center", ncol=3, fontsize=8,
+               frameon=False)
     fixed = {k: v for k, v in (("L", f"{base.length * 100:g} cm"), ("2l", f"{base.width * 1e3:g} mm"),
                                 ("2e", f"{base.thickness * 1e6:g} µm"), ("phi0", f"{base.voltage:g} V"))}
     var_key = {"length": "L", "width": "2l", "thickness": "2e", "voltage": "phi0"}[var]
@@ -81,7 +105,7 @@ def influence_figure(var, path, base: Strip | None = None, material: Material = 
     t = f"Influence of {var}" + (f" (paper Fig. {fig_no})" if fig_no else "") + "; fixed " + \
         ", ".join(f"{k}={v}" for k, v in fixed.items()) + f", E={material.E:.3g} Pa"
     fig.suptitle(t, fontsize=10)
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, 0.06, 1, 1))
     return savefig(fig, path)
 
 

@@ -21,9 +21,15 @@ def plot_profiles(results: dict, quantity: str, path, e: float, dpi: int = 110, 
     plt = pyplot()
     attr, label = QUANTITIES[quantity]
     fig, axs = plt.subplots(1, 3, figsize=(13, 4.0), dpi=dpi)
+    fmax = 0.0
     for name, res in results.items():
         z = np.asarray(res.z)
         f = np.asarray(getattr(res, attr))
+        if quantity == "E":
+            # the linear model's field spikes to ~1e17 at the anode (eps -> 0 there): on a
+            # linear axis it flattens every other curve, so |E| is drawn on a log axis
+            f = np.where(np.abs(f) > 0, np.abs(f), np.nan)
+            fmax = max(fmax, float(np.nanmax(f)))
         c = MODEL_COLOURS.get(name, None)
         axs[0].plot(z, f, color=c, label=name)
         da = (z + 1.0) * e * 1e6
@@ -41,6 +47,13 @@ def plot_profiles(results: dict, quantity: str, path, e: float, dpi: int = 110, 
         ax.set_title(f"zoom at the {side}", fontsize=9)
     if quantity == "C":
         axs[2].set_yscale("log")
+    if quantity == "E":
+        for ax in axs:
+            ax.set_yscale("log")
+            # the neutral core's field is exponentially small (down to 1e-300): show 12 decades
+            # below the smallest face value, where the layers are
+            ax.set_ylim(1e-6, 10.0 * fmax)
+        label = f"|{label}| (log)"
     for ax in axs:
         ax.set_ylabel(label)
         ax.grid(True, alpha=0.3)
