@@ -48,11 +48,9 @@ DTYPE = np.dtype([(c, "f8") for c in _FLOAT_COLS[:5]] + [("model", "U8"), ("fide
                  ("fidelity_used", "U10"), ("escalated", "?")]
                  + [(c, "f8") for c in _FLOAT_COLS[5:]] + [("regime", "U17")]
                  + [(c, "?") for c in CHECK_COLS] + [("valid", "?")])
-#: labels of the output files (CSV header, JSON keys): SI units, TOTAL thickness / width
-LABELS = {"length": "length_m", "width": "width_total_2l_m", "thickness": "thickness_total_2e_m",
-          "voltage": "voltage_V", "modulus": "modulus_Pa", "M_A": "M_A_Nm", "theta": "theta_rad",
-          "w": "w_m", "w_small": "w_small_m", "F_block": "F_block_N", "F_block_small": "F_block_small_N",
-          "error": "error_bound_rel"}
+#: column labels of the output files (CSV header, JSON keys) where the field name alone is
+#: ambiguous: width and thickness are TOTAL (2l, 2e).  All columns are SI (m, V, Pa, N m, N, rad).
+LABELS = {"width": "width_total_2l", "thickness": "thickness_total_2e"}
 OUTSIDE = OUTSIDE_REGIMES
 #: outputs of the free strip (not valid past a quarter turn) and all mechanical outputs (strain)
 _FREE = ("theta", "w", "w_small")
