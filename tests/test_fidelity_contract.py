@@ -31,13 +31,6 @@ V = np.array([0.05, 1.0, 5.0])
 T, VV = np.meshgrid(TH, V, indexing="ij")
 NOMINAL = (1, 1)  # 200 um, 1 V
 
-# leading states lam |J2/J1|, the error relative to ITS value; relative to the true I it is
-# x/(1 - x) (x = lam |J2/J1|), up to ~0.8 % larger: kernels/closed.py, owned elsewhere
-LEADING_UNDERSTATES = pytest.mark.xfail(
-    strict=True, reason="leading's error estimate is relative to the leading value, not to I "
-    "(kernels/closed.py: use x/(1 - x))")
-
-
 @pytest.fixture(scope="module", params=model_names())
 def bvp(request):
     """The BVP rung on the grid, and independent references with their own error."""
@@ -54,8 +47,7 @@ def bvp(request):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("fidelity", [pytest.param(f, marks=LEADING_UNDERSTATES) if f == "leading" else f
-                                      for f in fidelity_names()])
+@pytest.mark.parametrize("fidelity", fidelity_names())
 def test_fidelity_contract(bvp, fidelity):
     model, b, exact, exact_err = bvp
     if fidelity == "bvp":
