@@ -33,12 +33,12 @@ from .permittivity import get_model
 from .progress import progress as progress_bar
 from .registry import model_names
 from .settings import CHUNK_ROWS, MAX_ROWS, OUTSIDE_REGIMES, STRAIN_LIMIT
-from .units import parse_length, parse_pressure, parse_voltage
+from .units import SWEEP_VARIABLES as VARIABLES
+from .units import parse_vary, parse_vary_spec, vary_values
 
 __all__ = ["VARIABLES", "DTYPE", "LABELS", "CHECK_COLS", "parse_vary", "parse_vary_spec", "vary_values", "sweep", "iter_sweep", "count_rows",
            "withhold", "format_chunk", "csv_header", "write_csv", "write_json", "rows_as_dicts"]
 
-VARIABLES = ("length", "width", "thickness", "voltage", "modulus")
 
 _FLOAT_COLS = ("length", "width", "thickness", "voltage", "modulus", "I", "M_A", "theta", "w", "w_small",
                "F_block", "F_block_small", "B1", "error", "max_strain")
@@ -55,55 +55,6 @@ OUTSIDE = OUTSIDE_REGIMES
 #: outputs of the free strip (not valid past a quarter turn) and all mechanical outputs (strain)
 _FREE = ("theta", "w", "w_small")
 _MECH = _FREE + ("F_block", "F_block_small")
-
-
-def _parse_value(name, text):
-    if name in ("length", "width", "thickness"):
-        return parse_length(name, text)
-    if name == "voltage":
-        return parse_voltage(name, text)
-    return parse_pressure(name, text)
-
-
-def parse_vary_spec(spec: str):
-    """``'length=1cm:4cm:16'`` -> ``(name, start, stop, n, log)`` without building the values
-    (so that a huge ``n`` can be refused before any memory is used)."""
-    if "=" not in spec:
-        raise ValueError(f"--vary must be NAME=START:STOP:N[:log]; got {spec!r}")
-    name, rng = spec.split("=", 1)
-    name = name.strip()
-    if name not in VARIABLES:
-        raise ValueError(f"--vary name must be one of {', '.join(VARIABLES)}; got {name!r}")
-    parts = rng.split(":")
-    log = False
-    if len(parts) == 4 and parts[3].strip().lower() in ("log", "lin"):
-        log = parts[3].strip().lower() == "log"
-        parts = parts[:3]
-    if len(parts) != 3:
-        raise ValueError(f"--vary {name}: expected START:STOP:N[:log]; got {rng!r}")
-    a = _parse_value(name, parts[0])
-    b = _parse_value(name, parts[1])
-    try:
-        nf = float(parts[2].strip().replace("_", ""))
-    except ValueError:
-        raise ValueError(f"--vary {name}: N must be an integer >= 1 (e.g. 16 or 1e6); got {parts[2]!r}") from None
-    if not math.isfinite(nf) or not nf.is_integer() or nf < 1:
-        raise ValueError(f"--vary {name}: N must be an integer >= 1 (e.g. 16 or 1e6); got {parts[2]!r}")
-    if log and (a <= 0 or b <= 0):
-        raise ValueError(f"--vary {name}: log spacing needs START, STOP > 0")
-    if name != "voltage" and (a <= 0 or b <= 0):
-        raise ValueError(f"--vary {name}: values must be > 0")
-    return name, a, b, int(nf), log
-
-
-def vary_values(a, b, n, log):
-    return np.geomspace(a, b, n) if log else np.linspace(a, b, n)
-
-
-def parse_vary(spec: str):
-    """``'length=1cm:4cm:16'`` -> ``("length", array)``; ``':log'`` suffix for log spacing."""
-    name, a, b, n, log = parse_vary_spec(spec)
-    return name, vary_values(a, b, n, log)
 
 
 def _models(model):

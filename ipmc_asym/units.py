@@ -8,7 +8,10 @@ from __future__ import annotations
 import math
 import re
 
-__all__ = ["parse_length", "parse_voltage", "parse_pressure", "parse_quantity", "fmt_length"]
+import numpy as np
+
+__all__ = ["parse_length", "parse_voltage", "parse_pressure", "parse_quantity", "fmt_length", "SWEEP_VARIABLES",
+           "parse_vary_spec", "parse_vary", "vary_values"]
 
 _LENGTH = {
     "m": 1.0, "cm": 1e-2, "mm": 1e-3, "um": 1e-6, "µm": 1e-6, "μm": 1e-6,
@@ -68,3 +71,56 @@ def fmt_length(x: float) -> str:
         if ax >= f or unit == "nm":
             return f"{x / f:.4g} {unit}"
     return f"{x:g} m"
+
+
+#: the quantities a sweep can vary (SI; width and thickness TOTAL 2l, 2e)
+SWEEP_VARIABLES = ("length", "width", "thickness", "voltage", "modulus")
+
+
+def _parse_value(name, text):
+    if name in ("length", "width", "thickness"):
+        return parse_length(name, text)
+    if name == "voltage":
+        return parse_voltage(name, text)
+    return parse_pressure(name, text)
+
+
+def parse_vary_spec(spec: str):
+    """``'length=1cm:4cm:16'`` -> ``(name, start, stop, n, log)`` without building the values
+    (so that a huge ``n`` can be refused before any memory is used)."""
+    if "=" not in spec:
+        raise ValueError(f"--vary must be NAME=START:STOP:N[:log]; got {spec!r}")
+    name, rng = spec.split("=", 1)
+    name = name.strip()
+    if name not in SWEEP_VARIABLES:
+        raise ValueError(f"--vary name must be one of {', '.join(SWEEP_VARIABLES)}; got {name!r}")
+    parts = rng.split(":")
+    log = False
+    if len(parts) == 4 and parts[3].strip().lower() in ("log", "lin"):
+        log = parts[3].strip().lower() == "log"
+        parts = parts[:3]
+    if len(parts) != 3:
+        raise ValueError(f"--vary {name}: expected START:STOP:N[:log]; got {rng!r}")
+    a = _parse_value(name, parts[0])
+    b = _parse_value(name, parts[1])
+    try:
+        nf = float(parts[2].strip().replace("_", ""))
+    except ValueError:
+        raise ValueError(f"--vary {name}: N must be an integer >= 1 (e.g. 16 or 1e6); got {parts[2]!r}") from None
+    if not math.isfinite(nf) or not nf.is_integer() or nf < 1:
+        raise ValueError(f"--vary {name}: N must be an integer >= 1 (e.g. 16 or 1e6); got {parts[2]!r}")
+    if log and (a <= 0 or b <= 0):
+        raise ValueError(f"--vary {name}: log spacing needs START, STOP > 0")
+    if name != "voltage" and (a <= 0 or b <= 0):
+        raise ValueError(f"--vary {name}: values must be > 0")
+    return name, a, b, int(nf), log
+
+
+def vary_values(a, b, n, log):
+    return np.geomspace(a, b, n) if log else np.linspace(a, b, n)
+
+
+def parse_vary(spec: str):
+    """``'length=1cm:4cm:16'`` -> ``("length", array)``; ``':log'`` suffix for log spacing."""
+    name, a, b, n, log = parse_vary_spec(spec)
+    return name, vary_values(a, b, n, log)

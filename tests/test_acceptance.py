@@ -136,6 +136,7 @@ def _bvp(m, th, v):
 
 
 def _grid_point(m, th, v, extra=()):
+    th, v = float(th), float(v)
     rc, out, err = run_cli(["estimate", "--json", "--model", m, f"--thickness={th!r}", f"--voltage={v!r}",
                             *extra])
     assert "Traceback" not in err
@@ -150,18 +151,24 @@ def _grid_point(m, th, v, extra=()):
 
 
 def _grid(ths, vs):
+    answered = refused = 0
     for m in model_names():
         for th in ths:
             for v in vs:
                 for s in (1.0, -1.0):
                     res = _grid_point(m, th, s * v)
-                    if res is not None:
+                    if res is None:
+                        refused += 1
+                    else:
+                        answered += 1
                         rel, est = res
                         # within 1e-8 of the BVP wherever the stated bound is; never beyond the bound
                         assert rel <= max(1e-8, est), (m, th, s * v, rel, est)
                     res = _grid_point(m, th, s * v, ("--tol", "1e-8")) if s > 0 else None
                     if res is not None:
                         assert res[0] <= 1e-8, (m, th, s * v, res)
+    # the grid is inside the range the package claims (>= 1 um): it must answer, not refuse
+    assert refused == 0 and answered == 2 * len(model_names()) * len(ths) * len(vs)
 
 
 def test_grid_against_bvp_coarse():

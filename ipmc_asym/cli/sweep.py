@@ -10,13 +10,11 @@ import warnings
 import numpy as np
 
 from ..fileio import atomic_write, check_output_path
-from ..fits import sweep_fits
 from ..jsonio import dumps
 from ..progress import progress
-from ..registry import fidelity_names, model_choices
+from ..registry import fidelity_names, model_choices, model_names
 from ..settings import MAX_ROWS
-from ..estimate import model_list
-from ..sweeps import iter_sweep, parse_vary_spec, sweep, vary_values, withhold, write_csv, write_json
+from ..units import parse_vary_spec, vary_values
 from . import SUMMARIES
 from .common import add_strip_options, count_type, material_from_args, strip_from_args, tol_type
 
@@ -52,6 +50,8 @@ def register(sub):
 
 def _fits(vary, args, base, mat):
     """Power-law fits along each swept axis (through the middle of the other axes)."""
+    from ..fits import sweep_fits
+    from ..sweeps import sweep, withhold
     fits, notes = [], []
     for var, vals in vary.items():
         if vals.size < 2:
@@ -99,13 +99,16 @@ def run(args) -> int:
             raise ValueError(f"--vary {spec[0]} given twice")
         specs[spec[0]] = spec
     # refuse before building anything (a 10^8-point axis alone would take 800 MB)
-    n = len(model_list(args.model)) * math.prod(sp[3] for sp in specs.values())
+    n = (len(model_names()) if args.model == "all" else 1) * math.prod(sp[3] for sp in specs.values())
     if n > args.max_rows:
         raise ValueError(f"the sweep has {n:.3g} rows, more than --max-rows {args.max_rows:g}; "
                          "narrow it or raise --max-rows")
     vary = {k: vary_values(*sp[1:]) for k, sp in specs.items()}
     if args.out:
         check_output_path(args.out, "file")
+    # deferred: the compiled kernels load only once the sweep is known to be accepted
+    from ..sweeps import iter_sweep, withhold, write_csv, write_json
+
     base = strip_from_args(args)
     mat = material_from_args(args)
     t0 = time.perf_counter()
