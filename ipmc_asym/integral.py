@@ -14,8 +14,15 @@ Fidelity ladder (docs/design.md; the registry :mod:`ipmc_asym.registry`), named 
     The same two terms with the layer functions integrated numerically (Gauss-Legendre
     panels in a compiled kernel).  Error: exponentially small in ``core/lambda`` while the
     layers do not overlap.
+``exact``
+    Nothing neglected, at any thickness (overlapping layers, non-neutral core): the first
+    integral with the exact ``B1`` and its constant ``K`` from the thickness constraint,
+    the moment by Gauss-Legendre panels (``kernels/exact.py``, ``derivations/exact.py``).
+    Compiled and parallel like the others, ~10-40 us a point.  Error:
+    ``settings.EXACT_STATED_ERROR``.
 ``bvp``
-    The full nonlinear BVP (:mod:`ipmc_asym.bvp`), point by point.
+    The full nonlinear BVP (:mod:`ipmc_asym.bvp`), point by point: an independent method
+    (the cross-check) and the only rung for a user ``eps(C)``.
 
 ``I`` is computed on ``|phi0|`` and carries the sign of the voltage (mirror symmetry);
 ``I = 0`` at zero volts.  Thickness is the TOTAL thickness ``2e`` (SI).
@@ -31,6 +38,7 @@ import numpy as np
 
 from ._jit import jit, jit_parallel, prange
 from .kernels.closed import moment_closed
+from .kernels.exact import moment_exact
 from .kernels.quadrature import moment_quadrature
 from .params import NAFION_LI, Material, Strip, debye_length
 from .permittivity import MODELS, Permittivity, get_model
@@ -38,13 +46,15 @@ from .progress import progress as _progress_bar
 from .registry import FIDELITIES as _FIDELITY_SPECS
 from .registry import MODELS as _MODEL_SPECS
 from .registry import check_choice, fidelity_names
-from .settings import BVP_STATED_ERROR, VALIDITY_LIMIT
+from .settings import BVP_STATED_ERROR, EXACT_STATED_ERROR, VALIDITY_LIMIT
 
 __all__ = ["FIDELITIES", "MomentResult", "moment_integral", "moment", "groups_arrays", "check_fidelity"]
 
 FIDELITIES = fidelity_names()
-#: order argument of the sweep driver: 1 leading, 2 corrected, 0 quadrature
+#: order argument of the sweep driver: 1 leading, 2 corrected, 0 quadrature, 3 exact
 _ORDER = {k: f.order for k, f in _FIDELITY_SPECS.items() if f.order >= 0}
+#: fidelities valid at every thickness (no neutral core assumed): ``core`` is informative only
+_ANY_THICKNESS = ("exact", "bvp")
 
 
 def check_fidelity(fidelity: str) -> str:
@@ -60,7 +70,9 @@ class MomentResult:
     I : ndarray   moment integral (dimensionless, signed like the voltage)
     error : ndarray   relative error estimate of ``I``
     B1 : ndarray   cathode concentration ``C(1)/C_moy`` (for ``|phi0|``)
-    core : ndarray   length of the neutral core left between the layers (units of ``e``)
+    core : ndarray   length of the neutral core left between the layers (units of ``e``);
+        for ``exact`` the distance between the points where ``|ln C| = 1`` (may be ~0: the
+        layers overlap, which ``exact`` handles), for ``bvp`` 2
     lam : ndarray   core Debye length / e
     A2 : ndarray
     valid : ndarray of bool   error estimate below ``VALIDITY_LIMIT`` and layers separate
@@ -124,12 +136,16 @@ def _core_error(core, lam):
 
 @jit
 def _point(lam, A2, A3, rho, model_id, order):
-    """(I for |phi0|, error, B1, core) of one point; ``order`` 0 = quadrature.
+    """(I for |phi0|, error, B1, core) of one point; ``order`` 0 = quadrature, 3 = exact.
 
     Zero volts: no field, I = 0 exactly (the odd extension; no 0/0).
     """
     if A2 == 0.0:
         return 0.0, 0.0, 1.0, 2.0
+    if order == 3:
+        Ii, b1, ell, c, niter = moment_exact(lam, A2, A3, rho)
+        # thickness constraint not met: no number (error = inf makes it invalid)
+        return Ii, (EXACT_STATED_ERROR if niter > 0 else math.inf), b1, c
     if order == 0:
         Ii, J1, J2, b1, c = moment_quadrature(lam, A2, A3, rho)
         e_i = 1e-14
@@ -141,7 +157,7 @@ def _point(lam, A2, A3, rho, model_id, order):
 
 @jit_parallel
 def _sweep(lam, A2, A3, rho, model_id, order, sign, I, err, B1, core):
-    """The one sweep driver (prange): ``order`` 1 leading, 2 corrected, 0 quadrature."""
+    """The one sweep driver (prange): ``order`` 1 leading, 2 corrected, 0 quadrature, 3 exact."""
     for i in prange(lam.size):
         Ii, e_i, b1, c = _point(lam[i], A2[i], A3, rho, model_id, order)
         I[i] = sign[i] * Ii
@@ -163,7 +179,7 @@ def moment(thickness, voltage, model="constant", fidelity="quadrature", *, mater
         Voltage ``phi0`` (V); any sign, zero allowed.  Broadcast against ``thickness``.
     model : {"constant", "linear", "affine"} or Permittivity or callable
         Permittivity model; a custom ``eps(C)`` callable requires ``fidelity="bvp"``.
-    fidelity : {"leading", "corrected", "quadrature", "bvp"}
+    fidelity : {"leading", "corrected", "quadrature", "exact", "bvp"}
     material : Material, optional
         Defaults to the ``nafion-li`` preset; ``**material_kw`` override its fields
         (e.g. ``c_moy="formula"``, ``phi4=0.4``).
@@ -200,13 +216,13 @@ def moment(thickness, voltage, model="constant", fidelity="quadrature", *, mater
         _sweep(fl[0], fl[1], A3, rho, mid, _ORDER[fidelity], fl[2], *outs)
         for dst, src in zip((I, err, B1, core), outs):
             dst[...] = src.reshape(shape)
-    valid = (err < VALIDITY_LIMIT) & (core > 0)
+    valid = (err < VALIDITY_LIMIT) & ((core > 0) | (fidelity in _ANY_THICKNESS))
     return MomentResult(I=I, error=err, B1=B1, core=core, lam=lam, A2=A2, valid=valid,
                         fidelity=fidelity, model=perm.name)
 
 
 def closed_model_id(perm: Permittivity, fidelity: str) -> int:
-    """Model id of the closed-form kernels (-1 for ``quadrature``, which takes any rho).
+    """Model id of the closed-form kernels (-1 for ``quadrature``/``exact``: any rho).
 
     The closed forms are derived for the paper's three (eps0, eps_moy - eps0) pairs only.
     """
@@ -257,7 +273,7 @@ def moment_integral(thickness, voltage, model="constant", fidelity="quadrature",
     voltage : float or array_like
         Voltage ``phi0`` in volts (sign = bending direction; 0 gives 0).
     model : {"constant", "linear", "affine"}, Permittivity or callable
-    fidelity : {"leading", "corrected", "quadrature", "bvp"}
+    fidelity : {"leading", "corrected", "quadrature", "exact", "bvp"}
     material : Material, optional; ``**material_kw`` override fields of the preset.
     on_invalid : {"warn", "raise", "ignore"}
         What to do where the fidelity is outside its validity (error estimate above
@@ -277,7 +293,7 @@ def moment_integral(thickness, voltage, model="constant", fidelity="quadrature",
     if on_invalid != "ignore" and np.any(bad):
         msg = (f"fidelity {fidelity!r} is outside its validity at {int(bad.sum())} of {bad.size} point(s) "
                f"(error estimate up to {float(np.max(np.where(bad, r.error, 0))):.2g} > {VALIDITY_LIMIT:g}, "
-               f"or electrode layers overlapping); use a higher fidelity ('bvp' where layers overlap)")
+               f"or electrode layers overlapping); use a higher fidelity ('exact' where layers overlap)")
         if on_invalid == "raise":
             raise ValueError(msg)
         warnings.warn(msg, RuntimeWarning, stacklevel=2)

@@ -83,6 +83,11 @@ FIDELITIES = {
     "quadrature": FidelitySpec(
         "quadrature", 0, "the same two terms, layer functions by compiled Gauss-Legendre panels",
         "1e-14 quadrature plus the core interaction ~4 exp(-core/lambda)", 1e-2, False),
+    "exact": FidelitySpec(
+        "exact", 3, "nothing neglected, any thickness: first integral, exact B1, K from the thickness "
+        "constraint (Newton on ln K), moments by compiled Gauss-Legendre panels",
+        "settings.EXACT_STATED_ERROR (measured <= 1e-12 against the BVP, the exact linear solution "
+        "and an ODE reference)", 1e-2, False),
     "bvp": FidelitySpec(
         "bvp", -1, "the full nonlinear BVP (scipy.integrate.solve_bvp, graded mesh)",
         "settings.BVP_STATED_ERROR (solve_bvp tolerance 1e-10; measured ~1e-12)", 1e-2, False),
