@@ -167,6 +167,85 @@ def _sweep(lam, A2, A3, rho, model_id, order, sign, I, err, B1, core):
 
 
 
+@jit
+def _groups_point(t, vv, lamc, a2c):
+    """``(lam, A2)`` of one point: ``lam = lamc / thickness`` (``params.debye_length``:
+    ``lam ~ 1/e``), ``A2 = a2c |phi0|`` (one division, no square root, per point)."""
+    return lamc / t, a2c * abs(vv)
+
+
+@jit_parallel
+def _sweep_fused(th, v, lamc, a2c, A3, rho, model_id, order, any_thickness,
+                 I, err, B1, core, lam_o, A2_o, valid):
+    """The fused sweep driver: groups, sign and validity computed inside the parallel loop.
+
+    ``th``, ``v``: flat arrays of the output size or of size 1 (broadcast); the outputs are
+    flat views of the result arrays, so nothing else is allocated.  Returns the counts of
+    bad thicknesses (not finite or <= 0) and bad voltages (not finite); those points are
+    left as NaN and the caller raises.
+    """
+    n = I.size
+    sth = th.size > 1
+    sv = v.size > 1
+    bad_th = 0
+    bad_v = 0
+    for i in prange(n):
+        t = th[i] if sth else th[0]
+        vv = v[i] if sv else v[0]
+        if not (math.isfinite(t) and t > 0.0):
+            bad_th += 1
+            I[i] = err[i] = B1[i] = core[i] = lam_o[i] = A2_o[i] = math.nan
+            valid[i] = False
+            continue
+        if not math.isfinite(vv):
+            bad_v += 1
+            I[i] = err[i] = B1[i] = core[i] = lam_o[i] = A2_o[i] = math.nan
+            valid[i] = False
+            continue
+        lam, A2 = _groups_point(t, vv, lamc, a2c)
+        Ii, e_i, b1, c = _point(lam, A2, A3, rho, model_id, order)
+        I[i] = Ii if vv >= 0.0 else -Ii
+        err[i] = e_i
+        B1[i] = b1
+        core[i] = c
+        lam_o[i] = lam
+        A2_o[i] = A2
+        valid[i] = (e_i < VALIDITY_LIMIT) and (c > 0.0 or any_thickness)
+    return bad_th, bad_v
+
+
+@jit
+def _scalar_point(t, vv, lamc, a2c, A3, rho, model_id, order, any_thickness):
+    """``(I, valid)`` of one point (the scalar fast path of :func:`moment_integral`)."""
+    lam, A2 = _groups_point(t, vv, lamc, a2c)
+    Ii, e_i, b1, c = _point(lam, A2, A3, rho, model_id, order)
+    return (Ii if vv >= 0.0 else -Ii), (e_i < VALIDITY_LIMIT) and (c > 0.0 or any_thickness)
+
+
+def _driver_constants(perm: Permittivity, mat: Material, fidelity: str) -> tuple:
+    """Scalar arguments of the fused drivers after ``(th, v)``."""
+    eps_core = perm.eps0 + perm.deps
+    lamc = float(debye_length(1.0, eps_core, mat))  # lam * thickness (lam ~ 1/e)
+    return (lamc, mat.F / (mat.R * mat.T),
+            -mat.rho2 * mat.Z3 / (mat.C_moy * mat.F), perm.eps0 / eps_core,
+            closed_model_id(perm, fidelity), _ORDER[fidelity], fidelity in _ANY_THICKNESS)
+
+
+#: (model name, fidelity) -> driver constants of the default material (scalar fast path)
+_SCALAR_CACHE: dict = {}
+_SCALAR_TYPES = (float, int)
+
+
+def _flat_input(a: np.ndarray, shape: tuple) -> np.ndarray:
+    """A flat float64 view of ``a`` for the fused driver: size-1 inputs stay size 1, same-shape
+    C-contiguous inputs are viewed; only a true broadcast of two arrays is materialised."""
+    if a.size == 1:
+        return a.reshape(1)
+    if a.shape == shape and a.flags.c_contiguous:
+        return a.reshape(-1)
+    return np.ascontiguousarray(np.broadcast_to(a, shape)).reshape(-1)
+
+
 def moment(thickness, voltage, model="constant", fidelity="quadrature", *, material: Material | None = None,
            progress: bool | None = None, **material_kw) -> MomentResult:
     """Moment integral with error estimate and validity flags.
@@ -201,21 +280,28 @@ def moment(thickness, voltage, model="constant", fidelity="quadrature", *, mater
     if perm.is_custom:  # groups of the secant through C = 0 and C_moy (bookkeeping only)
         e0 = max(float(perm.func(0.0)), 0.0)
         gperm = Permittivity("secant", eps0=e0, deps=max(float(perm.func(mat.C_moy)) - e0, 0.0))
+    if fidelity != "bvp":
+        th = np.asarray(thickness, dtype=np.float64)
+        v = np.asarray(voltage, dtype=np.float64)
+        shape = np.broadcast_shapes(th.shape, v.shape)
+        I, err, B1, core, lam, A2 = (np.empty(shape) for _ in range(6))
+        valid = np.empty(shape, dtype=np.bool_)
+        bad_th, bad_v = _sweep_fused(_flat_input(th, shape), _flat_input(v, shape),
+                                     *_driver_constants(gperm, mat, fidelity),
+                                     *(a.reshape(-1) for a in (I, err, B1, core, lam, A2, valid)))
+        if bad_th:
+            raise ValueError("thickness (total, 2e) must be finite and > 0 m")
+        if bad_v:
+            raise ValueError("voltage must be finite (volts)")
+        return MomentResult(I=I, error=err, B1=B1, core=core, lam=lam, A2=A2, valid=valid,
+                            fidelity=fidelity, model=perm.name)
     lam, A2, A3, rho, sign = groups_arrays(thickness, voltage, gperm, mat)
     shape = lam.shape
     I = np.empty(shape)
     err = np.empty(shape)
     B1 = np.empty(shape)
     core = np.empty(shape)
-    if fidelity == "bvp":
-        _bvp_loop(thickness, voltage, perm, mat, I, err, B1, core, progress)
-    else:
-        fl = [np.ascontiguousarray(a).reshape(-1) for a in (lam, A2, sign)]
-        outs = [np.empty(lam.size) for _ in range(4)]
-        mid = closed_model_id(perm, fidelity)
-        _sweep(fl[0], fl[1], A3, rho, mid, _ORDER[fidelity], fl[2], *outs)
-        for dst, src in zip((I, err, B1, core), outs):
-            dst[...] = src.reshape(shape)
+    _bvp_loop(thickness, voltage, perm, mat, I, err, B1, core, progress)
     valid = (err < VALIDITY_LIMIT) & ((core > 0) | (fidelity in _ANY_THICKNESS))
     return MomentResult(I=I, error=err, B1=B1, core=core, lam=lam, A2=A2, valid=valid,
                         fidelity=fidelity, model=perm.name)
@@ -286,6 +372,17 @@ def moment_integral(thickness, voltage, model="constant", fidelity="quadrature",
         ``I`` with the broadcast shape of the inputs (a float for scalar inputs).
         ``M_A = A5 I`` with ``A5 = 6 l e^2 F |phi0| C_moy``.
     """
+    # scalar fast path: one compiled call, no arrays (falls through on anything unusual)
+    if (type(thickness) in _SCALAR_TYPES and type(voltage) in _SCALAR_TYPES and material is None
+            and not material_kw and type(model) is str):
+        consts = _SCALAR_CACHE.get((model, fidelity))
+        if consts is None and model in _MODEL_SPECS and fidelity in _ORDER:
+            consts = _SCALAR_CACHE[(model, fidelity)] = _driver_constants(get_model(model), NAFION_LI, fidelity)
+        t, vv = float(thickness), float(voltage)
+        if consts is not None and t > 0.0 and math.isfinite(t) and math.isfinite(vv):
+            Ii, ok = _scalar_point(t, vv, *consts)
+            if ok:
+                return Ii
     if on_invalid not in ("warn", "raise", "ignore"):
         raise ValueError(f"on_invalid must be one of warn, raise, ignore; got {on_invalid!r}")
     r = moment(thickness, voltage, model, fidelity, material=material, **material_kw)
