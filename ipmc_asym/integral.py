@@ -144,8 +144,9 @@ def _point(lam, A2, A3, rho, model_id, order):
         return 0.0, 0.0, 1.0, 2.0
     if order == 3:
         Ii, b1, ell, c, niter = moment_exact(lam, A2, A3, rho)
-        # thickness constraint not met: no number (error = inf makes it invalid)
-        return Ii, (EXACT_STATED_ERROR if niter > 0 else math.inf), b1, c
+        if niter < 0:  # thickness constraint not met: no number, and invalid
+            return math.nan, math.inf, b1, c
+        return Ii, EXACT_STATED_ERROR, b1, c
     if order == 0:
         Ii, J1, J2, b1, c = moment_quadrature(lam, A2, A3, rho)
         e_i = 1e-14
@@ -233,7 +234,7 @@ def _driver_constants(perm: Permittivity, mat: Material, fidelity: str) -> tuple
 
 #: (model name, fidelity) -> driver constants of the default material (scalar fast path)
 _SCALAR_CACHE: dict = {}
-_SCALAR_TYPES = (float, int)
+_SCALAR_TYPES = (float, int, np.float64)
 
 
 def _flat_input(a: np.ndarray, shape: tuple) -> np.ndarray:
@@ -372,6 +373,8 @@ def moment_integral(thickness, voltage, model="constant", fidelity="quadrature",
         ``I`` with the broadcast shape of the inputs (a float for scalar inputs).
         ``M_A = A5 I`` with ``A5 = 6 l e^2 F |phi0| C_moy``.
     """
+    if on_invalid not in ("warn", "raise", "ignore"):
+        raise ValueError(f"on_invalid must be one of warn, raise, ignore; got {on_invalid!r}")
     # scalar fast path: one compiled call, no arrays (falls through on anything unusual)
     if (type(thickness) in _SCALAR_TYPES and type(voltage) in _SCALAR_TYPES and material is None
             and not material_kw and type(model) is str):
@@ -383,8 +386,6 @@ def moment_integral(thickness, voltage, model="constant", fidelity="quadrature",
             Ii, ok = _scalar_point(t, vv, *consts)
             if ok:
                 return Ii
-    if on_invalid not in ("warn", "raise", "ignore"):
-        raise ValueError(f"on_invalid must be one of warn, raise, ignore; got {on_invalid!r}")
     r = moment(thickness, voltage, model, fidelity, material=material, **material_kw)
     bad = ~np.asarray(r.valid)
     if on_invalid != "ignore" and np.any(bad):
