@@ -191,11 +191,11 @@ def startup_ratio(repeats: int = 3) -> dict:
 def section(quick: bool = False) -> dict:
     """The ``exact_api`` bench section (see the module docstring)."""
     T = TARGETS
-    ex = exact_timing(n=600 if quick else 3000, bvp_n=1 if quick else 2)
-    ak = api_vs_kernel(n=10**6 if quick else 10**7)
+    ex = exact_timing(n=200 if quick else 3000, bvp_n=1 if quick else 2)
+    ak = api_vs_kernel(n=2 * 10**5 if quick else 10**7)
     tmp = temporaries_per_point(n=10**5 if quick else 10**6)
     sc = scalar_call(number=2000 if quick else 20000)
-    st = startup_ratio(repeats=2 if quick else 3)
+    st = startup_ratio(repeats=1 if quick else 3)
     figs = []
     worst = max(ex["exact_s"].values())
     for model, s in ex["exact_s"].items():

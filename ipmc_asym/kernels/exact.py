@@ -45,7 +45,6 @@ Y_TINY = 1e-18
 LENGTH_TOL = 1e-14
 
 _LN2 = math.log(2.0)
-_DEBUG = False
 
 
 @jit
@@ -218,6 +217,7 @@ def moment_exact_nodes(lam, A2, A3, rho, X, Wt, S, split):
     hi = math.inf
     niter = -1
     moments = False
+    stalled = False
     r_prev = math.inf
     for it in range(100):
         kappa2 = math.exp(-2.0 * ell)
@@ -250,11 +250,9 @@ def moment_exact_nodes(lam, A2, A3, rho, X, Wt, S, split):
                 res[s, k] = acc[k]
             res[s, 4] = zeta1
         L = res[0, 0] + res[1, 0]
-        r = math.log(0.5 * L)
-        if _DEBUG:
-            print(it, ell, r, lo, hi, moments, frozen[0], frozen[1])
-        # the length grows with ell: Newton on ln L (about linear in
-        if moments and abs(r) <= LENGTH_TOL:  # ell for kappa >> 1 and kappa << 1 alike)
+        r = math.log(0.5 * L)  # the length grows with ell
+        # converged (or Newton stalled in round-off: 100x the tolerance, still ~1e-12 on I)
+        if moments and (abs(r) <= LENGTH_TOL or (stalled and abs(r) <= 100.0 * LENGTH_TOL)):
             niter = it + 1
             break
         if r < 0.0:
@@ -279,6 +277,7 @@ def moment_exact_nodes(lam, A2, A3, rho, X, Wt, S, split):
         r_prev = abs(r)
         if new == ell:
             moments = True
+            stalled = True
         ell = new
     Lc = res[0, 0]
     La = res[1, 0]
