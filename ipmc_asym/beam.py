@@ -448,7 +448,8 @@ def _branch_table_path():
 
     from ._jit import CACHE_DIR
 
-    h = hashlib.sha256(open(__file__, "rb").read()).hexdigest()[:16]
+    with open(__file__, "rb") as fh:
+        h = hashlib.sha256(fh.read()).hexdigest()[:16]
     return os.path.join(CACHE_DIR, f"beam_branch_{h}.npy")
 
 

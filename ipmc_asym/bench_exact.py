@@ -79,7 +79,7 @@ def exact_timing(n: int = 3000, bvp_n: int = 2, repeats: int = 3, seed: int = 0)
     try:
         for model in ("constant", "linear", "affine"):
             moment(th[:4], v[:4], model, "exact")
-            out[model] = _best(lambda: moment(th, v, model, "exact"), repeats) / n
+            out[model] = _best(lambda m=model: moment(th, v, m, "exact"), repeats) / n
     finally:
         _threads(old)
     bth, bv = exact_sample(bvp_n, seed + 7)
@@ -128,7 +128,6 @@ def api_vs_kernel(n: int = 10**7, repeats: int = 3, threads: int = 2) -> dict:
         ta2 = _best(api, repeats)
     finally:
         _threads(old)
-    del lam, A2, sign, outs
     return {"points": n, "kernel_s": tk, "api_s": ta, "api_parallel_s": ta2, "threads": threads}
 
 

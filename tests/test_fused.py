@@ -6,7 +6,14 @@ import math
 import numpy as np
 import pytest
 
-from ipmc_asym.integral import _ORDER, _sweep, closed_model_id, groups_arrays, moment, moment_integral
+from ipmc_asym.integral import (
+    _ORDER,
+    _sweep,
+    closed_model_id,
+    groups_arrays,
+    moment,
+    moment_integral,
+)
 from ipmc_asym.params import NAFION_LI
 from ipmc_asym.permittivity import get_model
 
