@@ -21,8 +21,8 @@ def main(argv=None) -> int:
             return 0
     if args.check:
         return codegen.check()
-    path = codegen.write()
-    print(f"wrote {path}")
+    for path in codegen.write():
+        print(f"wrote {path}")
     return 0
 
 

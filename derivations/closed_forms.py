@@ -38,13 +38,9 @@ DPS = 24
 mp.mp.dps = DPS
 
 RHO = {"constant": mp.mpf(1), "linear": mp.mpf(0), "affine": mp.mpf(5) / 1005}
-MODEL_IDS = {"constant": 0, "linear": 1, "affine": 2}
 NTERMS = 18
-PATCH_HALF = 1  # patches centred on even integers, |Y - c| <= 1
 K_MIN = -15  # patches from Y = -31 ...
 K_MAX = 4  # ... to Y = 9
-T_ASYM = 31.0  # beyond: depletion asymptotics (error ~ T e^{-T} < 1e-12)
-Y_ACC = 9.0
 
 
 # ---- exact power-series arithmetic on mpmath numbers ----------------------------------
@@ -108,18 +104,6 @@ def sqrtq_series(rho, n):
 N_SQRTQ = 16
 
 
-def w_value(y, rho):
-    y = mp.mpf(y)
-    if abs(y) < mp.mpf("1e-6"):  # series: avoids 0/0 at working precision
-        e1 = 1 + y / 2 + y**2 / 6
-        e2 = 1 + y / 3 + y**2 / 12
-    else:
-        e1 = mp.expm1(y) / y
-        e2 = 2 * (mp.expm1(y) - y) / y**2
-    Q = (1 - rho) * e1**2 + rho * e2
-    return ((1 - rho) * mp.exp(y) + rho) / mp.sqrt(Q)
-
-
 NCONT = 44  # terms used to continue W0, W1 from one centre to the next (ratio <= 1/3)
 
 
@@ -162,13 +146,6 @@ def march(rho, kmin, kmax):
             W0c, W1c = _peval(a, h), _peval(b, h)
             k += direction
     return out
-
-
-def patch_coefficients(c, rho, n=NTERMS):
-    """Table rows for the centre c (first n+1 coefficients of the continued patch)."""
-    k = int(c) // 2
-    a, b = march(rho, min(k, 0), max(k, 0))[k]
-    return a[: n + 1], b[: n + 1]
 
 
 # ---- asymptotics (SymPy) ---------------------------------------------------------------
@@ -235,10 +212,6 @@ def linear_exact():
 
 
 # ---- kernels -------------------------------------------------------------------------
-def _poly_table(name, rows):
-    return name, [[float(v) for v in row] for row in rows]
-
-
 def model_tables(name):
     rho = RHO[name]
     pts = march(rho, -30, K_MAX)
@@ -287,9 +260,10 @@ def _kernels():
             f"depletion_{name}", (Y,), (-(Om_T + K0s), -(P1_T + K1s)),
             f"(W0, W1) for Y << 0 (depletion zone, {name} model); error O(|Y| e^Y).",
             "derivations.closed_forms:depletion_forms"))
-        W0inf, W1inf = accumulation_constants(RHO[name]) if name == "constant" else (mp.mpf(0), mp.mpf(0))
-        consts[f"W0INF_{name.upper()}"] = W0inf
-        consts[f"W1INF_{name.upper()}"] = W1inf
+        if name == "constant":  # the only model whose cathode reaches the accumulation regime
+            W0inf, W1inf = accumulation_constants(RHO[name])
+            consts["W0INF_CONSTANT"] = W0inf
+            consts["W1INF_CONSTANT"] = W1inf
     tables["_kmin"], tables["_kmax"] = K_MIN, K_MAX
     tables["_sqrtq"] = {name: sqrtq_series(RHO[name], N_SQRTQ) for name in RHO}
     accY = sp.Symbol("Y")

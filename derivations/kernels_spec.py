@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import functools
+
 import sympy as sp
 from sympy.codegen.cfunctions import expm1
 
@@ -82,11 +84,6 @@ def model_kernels():
         ks.append(Kernel(f"b1_{name}", (A2, em1), (root,),
                          f"Exact B1, {name} model (rho = {r}); em1 = expm1(-A2).",
                          "derivations.model:b1_quadratic_rho"))
-        dh = sp.simplify(M.dhat_stable().subs(M.rho, r))
-        if r == 0:
-            dh = sp.Abs(expm1(Y))  # |Y| exprel(Y) = |e^Y - 1|
-        ks.append(Kernel(f"dhat_{name}", (Y,), (dh,), f"Dhat(Y) = sqrt(2 Hhat(Y)), {name} model.",
-                         "derivations.model:dhat_stable"))
         # the same Dhat from C = B1 directly (no exp): sqrt(2 Hhat(C)), fine when C - 1 is not small
         Cs = sp.Symbol("C", positive=True)
         Hc = M.H_of_C(Cs).subs({M.A0: 1 - r, M.A1: r})
@@ -99,7 +96,10 @@ def model_kernels():
     return ks
 
 
+@functools.lru_cache(maxsize=1)
 def all_kernels():
+    """(kernels, constants, tables) of ``_generated.py``; cached: the derivation takes seconds
+    and both ``codegen.check`` and the kernel-vs-SymPy tests need it (treat as read-only)."""
     kernels = list(base_kernels()) + model_kernels()
     ck, constants, tables = closed_forms.kernels()
     kernels.extend(ck)

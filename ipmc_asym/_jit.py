@@ -18,9 +18,11 @@ __all__ = ["jit", "jit_parallel", "prange", "CACHE_DIR"]
 
 
 def hashed_sources() -> list:
-    """The modules that define jitted functions (and what they inline)."""
+    """The modules that define jitted functions (and what they inline: ``settings`` values
+    such as ``EXACT_STATED_ERROR`` are frozen into the compiled sweep driver)."""
     here = Path(__file__).resolve().parent
-    return sorted([here / "_jit.py", here / "integral.py", *(here / "kernels").glob("*.py")])
+    return sorted([here / "_jit.py", here / "integral.py", here / "settings.py",
+                   *(here / "kernels").glob("*.py")])
 
 
 def _cache_dir() -> str:

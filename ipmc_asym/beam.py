@@ -68,7 +68,6 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.special import fresnel
 
 __all__ = [
     "KL_BLOCK_MAX",
@@ -310,6 +309,8 @@ def _fresnel_sc(a, b):
     ``sgn(a) k [cos d dS - sin d dC]`` and ``k [cos d dC + sin d dS]``, ``k = sqrt(pi/(2A))``,
     ``dS = S(v1) - S(v0)`` (scipy's Fresnel ``S(z) = int_0^z sin(pi u^2/2) du``).
     """
+    from scipy.special import fresnel  # deferred: heavy import (start-up)
+
     A = np.abs(a)
     sg = np.sign(a)
     c = b / (2.0 * a)
@@ -323,12 +324,49 @@ def _fresnel_sc(a, b):
     return sg * k * (cd * dS - sd * dC), k * (cd * dC + sd * dS)
 
 
+#: Gauss-Legendre nodes on [0, 1] for the branch integrals: the phase a t^2 + b t of the
+#: blocking condition stays below ~66 rad on the branch (|m| <= KL_BLOCK_MAX, measured), and
+#: 120 nodes integrate sin/cos of phases up to ~150 rad to ~1e-15 (n > phase/2 + ~30)
+_GL_N = 120
+
+
+@functools.lru_cache(maxsize=1)
+def _gl01():
+    x, w = np.polynomial.legendre.leggauss(_GL_N)
+    return 0.5 * (x + 1.0), 0.5 * w
+
+
+#: below this many points :func:`_G_and_dG` integrates by Gauss-Legendre (no SciPy import:
+#: ``estimate`` starts faster); above, the Fresnel form is cheaper (2 special functions
+#: instead of 2 x _GL_N trigonometric calls per point, constant memory)
+_GL_MAX_POINTS = 2048
+
+
 def _G_and_dG(psi, m):
-    """``G(psi, m) = int_0^1 sin(theta) dt`` and ``dG/dpsi`` for ``m != 0``, ``psi != 0``.
+    """``G(psi, m) = int_0^1 sin(theta) dt`` and ``dG/dpsi`` for ``m != 0``.
 
     ``theta = a t^2 + b t``, ``a = -m psi/2``, ``b = m (psi - 1)``;
-    ``dG/dpsi = m int (t - t^2/2) cos(theta) dt``, the moments of ``cos(theta)`` following
-    from ``d(sin theta)/dt = (2 a t + b) cos theta`` and ``d(t sin theta)/dt``.
+    ``dG/dpsi = m int (t - t^2/2) cos(theta) dt``.  Small inputs: Gauss-Legendre on [0, 1];
+    large ones: :func:`_G_and_dG_fresnel` (the same integrals in closed form).
+    """
+    psi = np.asarray(psi, dtype=float)
+    m = np.asarray(m, dtype=float)
+    if np.broadcast(psi, m).size > _GL_MAX_POINTS:
+        return _G_and_dG_fresnel(psi, m)
+    t, w = _gl01()
+    a = (-0.5 * m * psi)[..., None]
+    b = (m * (psi - 1.0))[..., None]
+    th = (a * t + b) * t
+    G = np.sin(th) @ w
+    dG = m * (np.cos(th) @ (w * (t - 0.5 * t * t)))
+    return G, dG
+
+
+def _G_and_dG_fresnel(psi, m):
+    """:func:`_G_and_dG` from Fresnel integrals (``m != 0``, ``psi != 0``).
+
+    The moments of ``cos(theta)`` follow from ``d(sin theta)/dt = (2 a t + b) cos theta`` and
+    ``d(t sin theta)/dt``.
     """
     a = -0.5 * m * psi
     b = m * (psi - 1.0)
@@ -403,8 +441,19 @@ def _newton(psi, m, iters=40):
     return psi, np.abs(step) <= 1e-11 * np.abs(psi)
 
 
-@functools.lru_cache(maxsize=1)
-def _branch_table():
+def _branch_table_path():
+    """Disk cache of the branch table, beside the Numba cache and keyed on this file."""
+    import hashlib
+    import os
+
+    from ._jit import CACHE_DIR
+
+    with open(__file__, "rb") as fh:
+        h = hashlib.sha256(fh.read()).hexdigest()[:16]
+    return os.path.join(CACHE_DIR, f"beam_branch_{h}.npy")
+
+
+def _compute_branch_table():
     """``(m, psi)`` on the continuous branch, ``0 <= m <= KL_BLOCK_MAX`` (continuation)."""
     n = int(math.ceil(KL_BLOCK_MAX / _TABLE_STEP)) + 1
     ms = np.linspace(0.0, KL_BLOCK_MAX, n)
@@ -418,6 +467,40 @@ def _branch_table():
         if not ok or abs(p - guess) > 1e-3:
             raise RuntimeError(f"blocking-force branch lost at kappa L = {m:.3f}")  # pragma: no cover
         ps[i] = float(p)
+    return ms, ps
+
+
+@functools.lru_cache(maxsize=1)
+def _branch_table():
+    """The branch table, computed once per installation (~0.3 s) and cached on disk.
+
+    A damaged or foreign file is ignored and rewritten; the cache is written atomically
+    (temporary file + rename), and a read-only cache directory only costs the recomputation.
+    """
+    import os
+    import tempfile
+
+    path = _branch_table_path()
+    n = int(math.ceil(KL_BLOCK_MAX / _TABLE_STEP)) + 1
+    try:
+        ps = np.load(path, allow_pickle=False)
+        if ps.shape == (n,) and ps.dtype == np.float64 and np.all(np.isfinite(ps)):
+            return np.linspace(0.0, KL_BLOCK_MAX, n), ps
+    except (OSError, ValueError):
+        pass
+    ms, ps = _compute_branch_table()
+    try:
+        os.makedirs(os.path.dirname(path), exist_ok=True)
+        fd, tmp = tempfile.mkstemp(dir=os.path.dirname(path), suffix=".tmp")
+        try:
+            with os.fdopen(fd, "wb") as f:
+                np.save(f, ps, allow_pickle=False)
+            os.replace(tmp, path)
+        except BaseException:
+            os.unlink(tmp)
+            raise
+    except OSError:
+        pass
     return ms, ps
 
 

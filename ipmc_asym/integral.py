@@ -14,8 +14,15 @@ Fidelity ladder (docs/design.md; the registry :mod:`ipmc_asym.registry`), named 
     The same two terms with the layer functions integrated numerically (Gauss-Legendre
     panels in a compiled kernel).  Error: exponentially small in ``core/lambda`` while the
     layers do not overlap.
+``exact``
+    Nothing neglected, at any thickness (overlapping layers, non-neutral core): the first
+    integral with the exact ``B1`` and its constant ``K`` from the thickness constraint,
+    the moment by Gauss-Legendre panels (``kernels/exact.py``, ``derivations/exact.py``).
+    Compiled and parallel like the others, ~10-40 us a point.  Error:
+    ``settings.EXACT_STATED_ERROR``.
 ``bvp``
-    The full nonlinear BVP (:mod:`ipmc_asym.bvp`), point by point.
+    The full nonlinear BVP (:mod:`ipmc_asym.bvp`), point by point: an independent method
+    (the cross-check) and the only rung for a user ``eps(C)``.
 
 ``I`` is computed on ``|phi0|`` and carries the sign of the voltage (mirror symmetry);
 ``I = 0`` at zero volts.  Thickness is the TOTAL thickness ``2e`` (SI).
@@ -31,6 +38,7 @@ import numpy as np
 
 from ._jit import jit, jit_parallel, prange
 from .kernels.closed import moment_closed
+from .kernels.exact import moment_exact
 from .kernels.quadrature import moment_quadrature
 from .params import NAFION_LI, Material, Strip, debye_length
 from .permittivity import MODELS, Permittivity, get_model
@@ -38,14 +46,16 @@ from .progress import progress as _progress_bar
 from .registry import FIDELITIES as _FIDELITY_SPECS
 from .registry import MODELS as _MODEL_SPECS
 from .registry import check_choice, fidelity_names
-from .settings import BVP_STATED_ERROR, MIN_THICKNESS, ROUNDING_ERROR, VALIDITY_LIMIT
+from .settings import BVP_STATED_ERROR, EXACT_STATED_ERROR, MIN_THICKNESS, ROUNDING_ERROR, VALIDITY_LIMIT
 
 __all__ = ["FIDELITIES", "MomentResult", "moment_integral", "moment", "groups_arrays", "check_fidelity",
-           "check_min_thickness", "invalid_message"]
+           "check_min_thickness", "invalid_message", "validity_limit"]
 
 FIDELITIES = fidelity_names()
-#: order argument of the sweep driver: 1 leading, 2 corrected, 0 quadrature
+#: order argument of the sweep driver: 1 leading, 2 corrected, 0 quadrature, 3 exact
 _ORDER = {k: f.order for k, f in _FIDELITY_SPECS.items() if f.order >= 0}
+#: fidelities valid at every thickness (no neutral core assumed): ``core`` is informative only
+_ANY_THICKNESS = ("exact", "bvp")
 
 
 def check_fidelity(fidelity: str) -> str:
@@ -61,7 +71,9 @@ class MomentResult:
     I : ndarray   moment integral (dimensionless, signed like the voltage)
     error : ndarray   relative error estimate of ``I``
     B1 : ndarray   cathode concentration ``C(1)/C_moy`` (for ``|phi0|``)
-    core : ndarray   length of the neutral core left between the layers (units of ``e``)
+    core : ndarray   length of the neutral core left between the layers (units of ``e``);
+        for ``exact`` the distance between the points where ``|ln C| = 1`` (may be ~0: the
+        layers overlap, which ``exact`` handles), for ``bvp`` 2
     lam : ndarray   core Debye length / e
     A2 : ndarray
     valid : ndarray of bool   error estimate below ``VALIDITY_LIMIT`` and layers separate
@@ -145,13 +157,18 @@ def _core_error(core, lam):
 
 @jit
 def _point(lam, A2, A3, rho, model_id, order):
-    """(I for |phi0|, error, B1, core) of one point; ``order`` 0 = quadrature.
+    """(I for |phi0|, error, B1, core) of one point; ``order`` 0 = quadrature, 3 = exact.
 
     ``error`` bounds the relative error of the returned ``I`` (not of one term of it).
     Zero volts: no field, I = 0 exactly (the odd extension; no 0/0).
     """
     if A2 == 0.0:
         return 0.0, 0.0, 1.0, 2.0
+    if order == 3:
+        Ii, b1, ell, c, niter = moment_exact(lam, A2, A3, rho)
+        if niter < 0:  # thickness constraint not met: no number, and invalid
+            return math.nan, math.inf, b1, c
+        return Ii, EXACT_STATED_ERROR, b1, c
     if order == 0:
         Ii, J1, J2, b1, c = moment_quadrature(lam, A2, A3, rho)
         e_i = ROUNDING_ERROR
@@ -174,7 +191,7 @@ def _point(lam, A2, A3, rho, model_id, order):
 
 @jit_parallel
 def _sweep(lam, A2, A3, rho, model_id, order, sign, I, err, B1, core):
-    """The one sweep driver (prange): ``order`` 1 leading, 2 corrected, 0 quadrature."""
+    """The one sweep driver (prange): ``order`` 1 leading, 2 corrected, 0 quadrature, 3 exact."""
     for i in prange(lam.size):
         Ii, e_i, b1, c = _point(lam[i], A2[i], A3, rho, model_id, order)
         I[i] = sign[i] * Ii
@@ -182,6 +199,97 @@ def _sweep(lam, A2, A3, rho, model_id, order, sign, I, err, B1, core):
         B1[i] = b1
         core[i] = c
 
+
+
+@jit
+def _groups_point(t, vv, lamc, a2c):
+    """``(lam, A2)`` of one point: ``lam = lamc / thickness`` (``params.debye_length``:
+    ``lam ~ 1/e``), ``A2 = a2c |phi0|`` (one division, no square root, per point)."""
+    return lamc / t, a2c * abs(vv)
+
+
+@jit_parallel
+def _sweep_fused(th, v, lamc, a2c, A3, rho, model_id, order, any_thickness, limit,
+                 I, err, B1, core, lam_o, A2_o, valid):
+    """The fused sweep driver: groups, sign and validity computed inside the parallel loop.
+
+    ``th``, ``v``: flat arrays of the output size or of size 1 (broadcast); the outputs are
+    flat views of the result arrays, so nothing else is allocated.  Returns the counts of
+    bad thicknesses (not finite or <= 0) and bad voltages (not finite); those points are
+    left as NaN and the caller raises.
+    """
+    n = I.size
+    sth = th.size > 1
+    sv = v.size > 1
+    bad_th = 0
+    bad_v = 0
+    for i in prange(n):
+        t = th[i] if sth else th[0]
+        vv = v[i] if sv else v[0]
+        if not (math.isfinite(t) and t > 0.0):
+            bad_th += 1
+            I[i] = err[i] = B1[i] = core[i] = lam_o[i] = A2_o[i] = math.nan
+            valid[i] = False
+            continue
+        if not math.isfinite(vv):
+            bad_v += 1
+            I[i] = err[i] = B1[i] = core[i] = lam_o[i] = A2_o[i] = math.nan
+            valid[i] = False
+            continue
+        lam, A2 = _groups_point(t, vv, lamc, a2c)
+        Ii, e_i, b1, c = _point(lam, A2, A3, rho, model_id, order)
+        I[i] = Ii if vv >= 0.0 else -Ii
+        err[i] = e_i
+        B1[i] = b1
+        core[i] = c
+        lam_o[i] = lam
+        A2_o[i] = A2
+        valid[i] = (e_i < limit) and (c > 0.0 or any_thickness)
+    return bad_th, bad_v
+
+
+@jit
+def _scalar_point(t, vv, lamc, a2c, A3, rho, model_id, order, any_thickness, limit):
+    """``(I, valid)`` of one point (the scalar fast path of :func:`moment_integral`)."""
+    lam, A2 = _groups_point(t, vv, lamc, a2c)
+    Ii, e_i, b1, c = _point(lam, A2, A3, rho, model_id, order)
+    return (Ii if vv >= 0.0 else -Ii), (e_i < limit) and (c > 0.0 or any_thickness)
+
+
+def _driver_constants(perm: Permittivity, mat: Material, fidelity: str) -> tuple:
+    """Scalar arguments of the fused drivers after ``(th, v)``."""
+    eps_core = perm.eps0 + perm.deps
+    lamc = float(debye_length(1.0, eps_core, mat))  # lam * thickness (lam ~ 1/e)
+    return (lamc, mat.F / (mat.R * mat.T),
+            -mat.rho2 * mat.Z3 / (mat.C_moy * mat.F), perm.eps0 / eps_core,
+            closed_model_id(perm, fidelity), _ORDER[fidelity], fidelity in _ANY_THICKNESS,
+            validity_limit(fidelity))
+
+
+def validity_limit(fidelity: str) -> float:
+    """The error bound above which a result of ``fidelity`` is invalid.
+
+    ``settings.VALIDITY_LIMIT``, or the rung's own ceiling where it is tighter: the
+    two-term rungs (``corrected``, ``quadrature``) are exact up to the interaction of the
+    layers across the core, so a bound above their ceiling means the layers interact and
+    ``exact`` is the method that holds there.
+    """
+    return min(VALIDITY_LIMIT, _FIDELITY_SPECS[fidelity].ceiling)
+
+
+#: (model name, fidelity) -> driver constants of the default material (scalar fast path)
+_SCALAR_CACHE: dict = {}
+_SCALAR_TYPES = (float, int, np.float64)
+
+
+def _flat_input(a: np.ndarray, shape: tuple) -> np.ndarray:
+    """A flat float64 view of ``a`` for the fused driver: size-1 inputs stay size 1, same-shape
+    C-contiguous inputs are viewed; only a true broadcast of two arrays is materialised."""
+    if a.size == 1:
+        return a.reshape(1)
+    if a.shape == shape and a.flags.c_contiguous:
+        return a.reshape(-1)
+    return np.ascontiguousarray(np.broadcast_to(a, shape)).reshape(-1)
 
 
 def moment(thickness, voltage, model="constant", fidelity="quadrature", *, material: Material | None = None,
@@ -196,7 +304,7 @@ def moment(thickness, voltage, model="constant", fidelity="quadrature", *, mater
         Voltage ``phi0`` (V); any sign, zero allowed.  Broadcast against ``thickness``.
     model : {"constant", "linear", "affine"} or Permittivity or callable
         Permittivity model; a custom ``eps(C)`` callable requires ``fidelity="bvp"``.
-    fidelity : {"leading", "corrected", "quadrature", "bvp"}
+    fidelity : {"leading", "corrected", "quadrature", "exact", "bvp"}
     material : Material, optional
         Defaults to the ``nafion-li`` preset; ``**material_kw`` override its fields
         (e.g. ``c_moy="formula"``, ``phi4=0.4``).
@@ -218,29 +326,36 @@ def moment(thickness, voltage, model="constant", fidelity="quadrature", *, mater
     if perm.is_custom:  # groups of the secant through C = 0 and C_moy (bookkeeping only)
         e0 = max(float(perm.func(0.0)), 0.0)
         gperm = Permittivity("secant", eps0=e0, deps=max(float(perm.func(mat.C_moy)) - e0, 0.0))
+    if fidelity != "bvp":
+        th = np.asarray(thickness, dtype=np.float64)
+        v = np.asarray(voltage, dtype=np.float64)
+        shape = np.broadcast_shapes(th.shape, v.shape)
+        I, err, B1, core, lam, A2 = (np.empty(shape) for _ in range(6))
+        valid = np.empty(shape, dtype=np.bool_)
+        check_min_thickness(th)
+        bad_th, bad_v = _sweep_fused(_flat_input(th, shape), _flat_input(v, shape),
+                                     *_driver_constants(gperm, mat, fidelity),
+                                     *(a.reshape(-1) for a in (I, err, B1, core, lam, A2, valid)))
+        if bad_th:
+            raise ValueError("thickness (total, 2e) must be finite and > 0 m")
+        if bad_v:
+            raise ValueError("voltage must be finite (volts)")
+        return MomentResult(I=I, error=err, B1=B1, core=core, lam=lam, A2=A2, valid=valid,
+                            fidelity=fidelity, model=perm.name)
     lam, A2, A3, rho, sign = groups_arrays(thickness, voltage, gperm, mat)
     shape = lam.shape
     I = np.empty(shape)
     err = np.empty(shape)
     B1 = np.empty(shape)
     core = np.empty(shape)
-    success, message = np.ones(shape, bool), ""
-    if fidelity == "bvp":
-        success, message = _bvp_loop(thickness, voltage, perm, mat, I, err, B1, core, progress)
-    else:
-        fl = [np.ascontiguousarray(a).reshape(-1) for a in (lam, A2, sign)]
-        outs = [np.empty(lam.size) for _ in range(4)]
-        mid = closed_model_id(perm, fidelity)
-        _sweep(fl[0], fl[1], A3, rho, mid, _ORDER[fidelity], fl[2], *outs)
-        for dst, src in zip((I, err, B1, core), outs):
-            dst[...] = src.reshape(shape)
-    valid = (err < VALIDITY_LIMIT) & (core > 0) & success
+    success, message = _bvp_loop(thickness, voltage, perm, mat, I, err, B1, core, progress)
+    valid = (err < validity_limit(fidelity)) & ((core > 0) | (fidelity in _ANY_THICKNESS)) & success
     return MomentResult(I=I, error=err, B1=B1, core=core, lam=lam, A2=A2, valid=valid,
                         fidelity=fidelity, model=perm.name, success=success, message=message)
 
 
 def closed_model_id(perm: Permittivity, fidelity: str) -> int:
-    """Model id of the closed-form kernels (-1 for ``quadrature``, which takes any rho).
+    """Model id of the closed-form kernels (-1 for ``quadrature``/``exact``: any rho).
 
     The closed forms are derived for the paper's three (eps0, eps_moy - eps0) pairs only.
     """
@@ -304,7 +419,7 @@ def moment_integral(thickness, voltage, model="constant", fidelity="quadrature",
     voltage : float or array_like
         Voltage ``phi0`` in volts (sign = bending direction; 0 gives 0).
     model : {"constant", "linear", "affine"}, Permittivity or callable
-    fidelity : {"leading", "corrected", "quadrature", "bvp"}
+    fidelity : {"leading", "corrected", "quadrature", "exact", "bvp"}
     material : Material, optional; ``**material_kw`` override fields of the preset.
     on_invalid : {"raise", "nan", "warn"}
         Where the fidelity is outside its validity (error estimate above ``VALIDITY_LIMIT``,
@@ -320,6 +435,18 @@ def moment_integral(thickness, voltage, model="constant", fidelity="quadrature",
         ``M_A = A5 I`` with ``A5 = 6 l e^2 F |phi0| C_moy``.
     """
     check_choice("on_invalid", on_invalid, ("raise", "nan", "warn"))
+    # scalar fast path: one compiled call, no arrays (falls through on anything unusual,
+    # including an invalid point, which then gets the full treatment below)
+    if (type(thickness) in _SCALAR_TYPES and type(voltage) in _SCALAR_TYPES and material is None
+            and not material_kw and type(model) is str):
+        consts = _SCALAR_CACHE.get((model, fidelity))
+        if consts is None and model in _MODEL_SPECS and fidelity in _ORDER:
+            consts = _SCALAR_CACHE[(model, fidelity)] = _driver_constants(get_model(model), NAFION_LI, fidelity)
+        t, vv = float(thickness), float(voltage)
+        if consts is not None and t >= MIN_THICKNESS and math.isfinite(t) and math.isfinite(vv):
+            Ii, ok = _scalar_point(t, vv, *consts)
+            if ok:
+                return Ii
     r = moment(thickness, voltage, model, fidelity, material=material, **material_kw)
     bad = ~np.asarray(r.valid)
     I = np.array(r.I, dtype=float)
@@ -342,5 +469,5 @@ def invalid_message(r: MomentResult) -> str:
     e = np.asarray(r.error)
     worst = float(np.max(np.where(bad, e, 0.0))) if n else 0.0
     return (f"fidelity {r.fidelity!r} is outside its validity at {n} of {bad.size} point(s) "
-            f"(error estimate up to {worst:.2g} > {VALIDITY_LIMIT:g}, or electrode layers "
-            "overlapping); use a higher fidelity, or ipmc_asym.evaluate, which escalates")
+            f"(error estimate up to {worst:.2g} > {validity_limit(r.fidelity):g}, or electrode layers "
+            "overlapping); use a higher fidelity ('exact' where layers overlap), or ipmc_asym.evaluate, which escalates")

@@ -2,9 +2,10 @@
 
 ``ipmc-asym scene FILE.toml [--json]`` and :func:`run_scene` (dict or path).  The planner
 computes ONLY the outputs asked for, each at the cheapest fidelity whose error estimate meets
-the tolerance, escalating point by point ``leading -> corrected -> quadrature -> bvp``
-(``bvp`` also where the layers overlap, i.e. ``valid`` is False, and for a custom ``eps(C)``
-callable, accepted by :func:`run_scene` with a dict).  Beam formulas are picked the same way:
+the tolerance, escalating point by point along the registry's ladder (``leading ->
+corrected -> quadrature -> exact -> bvp``; ``exact`` holds where the layers overlap, ``bvp``
+is the last resort and the only rung for a custom ``eps(C)`` callable, accepted by
+:func:`run_scene` with a dict).  Beam formulas are picked the same way:
 small-displacement deflection where :func:`ipmc_asym.beam.small_displacement_error` <= tol,
 the arc otherwise; small blocking force where :func:`ipmc_asym.beam.blocking_force_error`
 <= tol, the large-displacement root otherwise.

@@ -268,3 +268,16 @@ def test_max_strain_and_bad_input():
         beam.tip_deflection(1.0, -1.0, EI)
     with pytest.raises(ValueError, match="EI"):
         beam.solve_beam(1.0, L, 0.0)
+
+
+def test_branch_integrals_quadrature_equals_fresnel_form():
+    """The two implementations of G, dG/dpsi (Gauss-Legendre for small inputs, Fresnel
+    integrals for large ones) agree on and around the blocking-force branch."""
+    ms, ps = beam._branch_table()
+    m = np.concatenate([ms[20::50], ms[20::50]])
+    p = np.concatenate([ps[20::50], ps[20::50] * 1.3])
+    g1, d1 = beam._G_and_dG(p, m)
+    g2, d2 = beam._G_and_dG_fresnel(p, m)
+    assert np.allclose(g1, g2, rtol=0, atol=1e-14)
+    assert np.allclose(d1, d2, rtol=1e-12, atol=1e-14)
+    assert np.max(np.abs(g2[: m.size // 2])) < 1e-13  # the table sits on G = 0

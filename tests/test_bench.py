@@ -10,7 +10,7 @@ from ipmc_asym.plotting.speed import plot_speed_accuracy
 
 @pytest.fixture(scope="module")
 def res():
-    return run_bench(points=2000, bvp_points=3, repeats=1, compile_times=False)
+    return run_bench(points=2000, bvp_points=3, repeats=1, compile_times=False, quick_sections=True)
 
 
 def test_structure(res):
@@ -46,3 +46,17 @@ def test_table_and_plot(res, tmp_path):
     assert "leading" in t and "quadrature" in t
     p = plot_speed_accuracy(res, tmp_path / "sa.png")
     assert (tmp_path / "sa.png").stat().st_size > 1000 and str(p).endswith("sa.png")
+
+
+def test_exact_api_section(res):
+    """The issue-10 figures are reported (values finite, each with its target); no timing asserts."""
+    figs = res["sections"]["exact_api"]["figures"]
+    whats = " | ".join(f["what"] for f in figs)
+    for key in ("exact time per point", "speed-up over one BVP", "exact vs BVP", "bare driver",
+                "threads", "temporaries", "scalar", "import numba"):
+        assert key in whats
+    for f in figs:
+        assert f["value"] is not None and f["value"] == f["value"] and f["target"] is not None
+    acc = next(f for f in figs if f["what"].startswith("exact vs BVP"))
+    assert acc["value"] <= 1e-11  # an accuracy figure, not a timing: exact vs the BVP
+    json.dumps(res["sections"])

@@ -57,7 +57,7 @@ def test_table_says_which_thickness(capsys):
     (["--thickness", "0"], "thickness"),
     (["--voltage", "nan"], "voltage"),
     (["--model", "quadratic"], "model"),
-    (["--fidelity", "exact"], "fidelity"),
+    (["--fidelity", "exactly"], "fidelity"),
     (["--c-moy", "lots"], "c-moy"),
     (["--length", "3 furlongs"], "length"),
 ])

@@ -72,8 +72,8 @@ def test_bad_input_raises_valueerror(bad):
 def test_unknown_model_and_fidelity_list_valid_ones():
     with pytest.raises(ValueError, match="constant, linear, affine"):
         moment_integral(200e-6, 1.0, "quadratic")
-    with pytest.raises(ValueError, match="leading, corrected, quadrature, bvp"):
-        moment_integral(200e-6, 1.0, "constant", "exact")
+    with pytest.raises(ValueError, match="leading, corrected, quadrature, exact, bvp"):
+        moment_integral(200e-6, 1.0, "constant", "exactly")
     with pytest.raises(ValueError, match="phi4"):
         moment_integral(200e-6, 1.0, phi4=1.2)
 

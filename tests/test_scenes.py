@@ -86,12 +86,13 @@ def test_tight_tolerance_escalates():
     assert 0 < p0["anode_layer"]["width_m"] < 100e-6 / 2
 
 
-def test_escalates_to_bvp_where_layers_overlap():
+def test_escalates_to_exact_where_layers_overlap():
     # 2e = 0.2 um at 1 V: the anode layer alone (~0.2 um, tests/test_profiles.py) fills the
-    # strip, so no closed form or quadrature is valid and the planner must end on the BVP
+    # strip, so no closed form or quadrature is valid and the planner must end on 'exact'
+    # (valid at any thickness), checked against the BVP
     r = run_scene({"model": "constant", "voltage": 1.0, "strip": {"thickness": "0.2um"},
                    "outputs": ["I"], "tolerance": 1e-3})
-    assert r["outputs"]["I"]["fidelity"] == ["bvp"]
+    assert r["outputs"]["I"]["fidelity"] == ["exact"]
     ref = solve(Strip(thickness=0.2e-6), "constant")
     assert r["outputs"]["I"]["values"][0] == pytest.approx(ref.I, rel=1e-8)
 

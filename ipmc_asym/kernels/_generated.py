@@ -20,12 +20,8 @@ K0_LINEAR = 1.6449340668482264
 K1_AFFINE = 1.1914869311252376
 K1_CONSTANT = 0.7713732788165665
 K1_LINEAR = 1.2020569031595942
-W0INF_AFFINE = 0.0
 W0INF_CONSTANT = 3.8996523205143645
-W0INF_LINEAR = 0.0
-W1INF_AFFINE = 0.0
 W1INF_CONSTANT = 2.982357607753037
-W1INF_LINEAR = 0.0
 
 # Taylor patches about Y = 2k, k = K_MIN..K_MAX: rows = patches, columns = powers of (Y - 2k)
 K_MIN = -15
@@ -310,24 +306,6 @@ def dhat(Y, rho):
 
 
 @jit
-def dhat_affine(Y):
-    """Dhat(Y) = sqrt(2 Hhat(Y)), affine model.
-
-    Derived in ``derivations.model:dhat_stable``.
-    """
-    return (1.0/201.0)*14.177446878757825*math.sqrt(e2rel(Y) + 200.0*exprel(Y)*exprel(Y))*abs(Y)
-
-
-@jit
-def dhat_constant(Y):
-    """Dhat(Y) = sqrt(2 Hhat(Y)), constant model.
-
-    Derived in ``derivations.model:dhat_stable``.
-    """
-    return math.sqrt(e2rel(Y))*abs(Y)
-
-
-@jit
 def dhat_from_c_affine(C, Y):
     """Dhat = sqrt(2 Hhat(C)) with C = e^Y given (use when |Y| > 1/2), affine model.
 
@@ -353,15 +331,6 @@ def dhat_from_c_linear(C, Y):
     Derived in ``derivations.model:H_of_C``.
     """
     return abs(C - 1.0)
-
-
-@jit
-def dhat_linear(Y):
-    """Dhat(Y) = sqrt(2 Hhat(Y)), linear model.
-
-    Derived in ``derivations.model:dhat_stable``.
-    """
-    return abs(math.expm1(Y))
 
 
 @jit

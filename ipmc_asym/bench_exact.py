@@ -1,0 +1,226 @@
+"""Bench section ``exact_api`` (issue 10): the ``exact`` fidelity and the cost of the API.
+
+Every figure is measured side by side in one run, as a ratio where the target is a ratio:
+
+* ``exact`` time per point (1 thread) on 1 um - 10 mm x +-(1e-4 - 20) V x 3 models, and its
+  speed-up over one BVP solve on a sample of the same distribution;
+* ``exact`` vs the BVP on that sample (max relative difference of ``I``);
+* ``moment()`` (the API, fused driver) vs the bare sweep driver on precomputed groups at
+  ``10^7`` points (``leading``, 1 thread), and the API's 2-thread speed-up;
+* temporaries of one ``moment()`` call beyond its inputs and outputs (tracemalloc peak),
+  bytes per point;
+* one scalar ``moment_integral(2e-4, 1.0, fidelity="leading")`` call (warm), and its ratio to
+  the bare compiled point;
+* warm ``ipmc-asym estimate --fidelity leading`` over ``python -c "import numba"``.
+
+Module-level imports are stdlib + numpy only.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import subprocess
+import sys
+import time
+
+import numpy as np
+
+__all__ = ["section", "exact_sample", "api_vs_kernel", "temporaries_per_point", "scalar_call",
+           "startup_ratio"]
+
+EXACT_THICKNESS = (1e-6, 1e-2)
+EXACT_VOLTAGE = (1e-4, 20.0)
+TARGETS = {"exact_seconds_per_point": 30e-6, "exact_speedup_vs_bvp": 1e3, "exact_rel_error": 1e-11,
+           "api_over_kernel": 1.15, "api_two_thread_speedup": 1.8, "temporary_bytes_per_point": 16.0,
+           "scalar_call_s": 2e-6, "startup_over_import_numba": 2.0}
+
+
+def _fig(what, value, unit, target, ok, note=""):
+    return {"what": what, "value": value, "unit": unit, "target": target,
+            "pass": None if ok is None else bool(ok), "note": note}
+
+
+def _threads(n):
+    import numba
+
+    old = numba.get_num_threads()
+    numba.set_num_threads(max(1, min(int(n), numba.config.NUMBA_NUM_THREADS)))
+    return old
+
+
+def _best(f, repeats):
+    best = math.inf
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        f()
+        best = min(best, time.perf_counter() - t0)
+    return best
+
+
+def exact_sample(n: int, seed: int = 0):
+    """``n`` points log-uniform in thickness (1 um - 10 mm) and |voltage| (1e-4 - 20 V), random sign."""
+    rng = np.random.default_rng(seed)
+    th = np.exp(rng.uniform(*np.log(EXACT_THICKNESS), n))
+    v = np.exp(rng.uniform(*np.log(EXACT_VOLTAGE), n)) * rng.choice([-1.0, 1.0], n)
+    return th, v
+
+
+def exact_timing(n: int = 3000, bvp_n: int = 2, repeats: int = 3, seed: int = 0) -> dict:
+    """``exact`` seconds per point (1 thread, each model) and the BVP seconds per solve and
+    max relative difference on ``bvp_n`` points per model of the same distribution."""
+    from .bvp import solve  # deferred: heavy import (start-up): scipy.integrate
+    from .integral import moment
+    from .params import Strip
+
+    th, v = exact_sample(n, seed)
+    out = {}
+    old = _threads(1)
+    try:
+        for model in ("constant", "linear", "affine"):
+            moment(th[:4], v[:4], model, "exact")
+            out[model] = _best(lambda m=model: moment(th, v, m, "exact"), repeats) / n
+    finally:
+        _threads(old)
+    bth, bv = exact_sample(bvp_n, seed + 7)
+    bt, rel = [], []
+    for model in ("constant", "linear", "affine"):
+        for t_, v_ in zip(bth, bv):
+            t0 = time.perf_counter()
+            res = solve(Strip(thickness=float(t_), voltage=float(v_)), model)
+            dt = time.perf_counter() - t0
+            if not res.success:
+                continue
+            bt.append(dt)
+            Ie = float(moment(t_, v_, model, "exact").I)
+            rel.append(abs(Ie - res.I) / abs(res.I))
+    return {"exact_s": out, "bvp_s": float(np.mean(bt)) if bt else None,
+            "rel_error_max": float(max(rel)) if rel else None, "bvp_solved": len(bt)}
+
+
+def api_vs_kernel(n: int = 10**7, repeats: int = 3, threads: int = 2) -> dict:
+    """``moment()`` vs the bare driver on precomputed groups, ``leading``, constant model."""
+    from .integral import _ORDER, _sweep, closed_model_id, groups_arrays, moment
+    from .params import NAFION_LI
+    from .permittivity import get_model
+
+    th = np.exp(np.linspace(np.log(10e-6), np.log(4e-3), n))
+    v = np.exp(np.linspace(np.log(1e-3), np.log(10.0), n))[::-1].copy()
+    perm = get_model("constant")
+    lam, A2, A3, rho, sign = groups_arrays(th, v, perm, NAFION_LI)
+    lam, A2, sign = (np.ascontiguousarray(a) for a in (lam, A2, sign))
+    outs = [np.empty(n) for _ in range(4)]
+    mid, order = closed_model_id(perm, "leading"), _ORDER["leading"]
+
+    def kernel():
+        _sweep(lam, A2, A3, rho, mid, order, sign, *outs)
+
+    def api():
+        moment(th, v, "constant", "leading")
+
+    old = _threads(1)
+    try:
+        kernel()
+        api()
+        tk = _best(kernel, repeats)
+        ta = _best(api, repeats)
+        _threads(threads)
+        ta2 = _best(api, repeats)
+    finally:
+        _threads(old)
+    return {"points": n, "kernel_s": tk, "api_s": ta, "api_parallel_s": ta2, "threads": threads}
+
+
+def temporaries_per_point(n: int = 10**6) -> float:
+    """Peak bytes allocated by one ``moment()`` call beyond its outputs, per point (tracemalloc)."""
+    import tracemalloc
+
+    from .integral import moment
+
+    th = np.exp(np.linspace(np.log(10e-6), np.log(4e-3), n))
+    v = np.linspace(-2.0, 2.0, n)
+    moment(th[:10], v[:10], "constant", "leading")
+    tracemalloc.start()
+    try:
+        tracemalloc.reset_peak()
+        base = tracemalloc.get_traced_memory()[0]
+        r = moment(th, v, "constant", "leading")
+        peak = tracemalloc.get_traced_memory()[1] - base
+    finally:
+        tracemalloc.stop()
+    outputs = sum(a.nbytes for a in (r.I, r.error, r.B1, r.core, r.lam, r.A2, r.valid))
+    return max(peak - outputs, 0) / n
+
+
+def scalar_call(number: int = 20000) -> dict:
+    """Seconds per warm ``moment_integral(2e-4, 1.0, fidelity="leading")`` and per bare
+    compiled point (the same work without the API)."""
+    import timeit
+
+    from .integral import _SCALAR_CACHE, _scalar_point, moment_integral
+
+    moment_integral(2e-4, 1.0, fidelity="leading")
+    consts = _SCALAR_CACHE[("constant", "leading")]
+    api = min(timeit.repeat(lambda: moment_integral(2e-4, 1.0, fidelity="leading"), number=number, repeat=3)) / number
+    bare = min(timeit.repeat(lambda: _scalar_point(2e-4, 1.0, *consts), number=number, repeat=3)) / number
+    return {"api_s": api, "bare_s": bare}
+
+
+def startup_ratio(repeats: int = 3) -> dict:
+    """Best-of wall times of warm ``estimate --fidelity leading`` and ``import numba``, fresh processes."""
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    env = dict(os.environ)
+    env["PYTHONPATH"] = root + (os.pathsep + env["PYTHONPATH"] if env.get("PYTHONPATH") else "")
+    est = [sys.executable, "-c", "from ipmc_asym.cli import main; main(['estimate', '--fidelity', 'leading'])"]
+    nb = [sys.executable, "-c", "import numba"]
+    subprocess.run(est, env=env, capture_output=True, timeout=600)  # warm every cache
+    te = tn = math.inf
+    for _ in range(max(1, int(repeats))):  # interleaved: the same machine load for both
+        t0 = time.perf_counter()
+        subprocess.run(nb, env=env, capture_output=True, timeout=600)
+        tn = min(tn, time.perf_counter() - t0)
+        t0 = time.perf_counter()
+        p = subprocess.run(est, env=env, capture_output=True, timeout=600)
+        te = min(te, time.perf_counter() - t0)
+        if p.returncode != 0:
+            raise RuntimeError("bench: estimate subprocess failed")
+    return {"estimate_s": te, "import_numba_s": tn}
+
+
+def section(quick: bool = False) -> dict:
+    """The ``exact_api`` bench section (see the module docstring)."""
+    T = TARGETS
+    ex = exact_timing(n=200 if quick else 3000, bvp_n=1 if quick else 2)
+    ak = api_vs_kernel(n=2 * 10**5 if quick else 10**7)
+    tmp = temporaries_per_point(n=10**5 if quick else 10**6)
+    sc = scalar_call(number=2000 if quick else 20000)
+    st = startup_ratio(repeats=1 if quick else 3)
+    figs = []
+    worst = max(ex["exact_s"].values())
+    for model, s in ex["exact_s"].items():
+        figs.append(_fig(f"exact time per point, {model}, 1 thread", s, "s", T["exact_seconds_per_point"],
+                         s <= T["exact_seconds_per_point"], "1 um-10 mm x +-(1e-4-20) V, log-uniform"))
+    if ex["bvp_s"]:
+        sp = ex["bvp_s"] / worst
+        figs.append(_fig("exact speed-up over one BVP solve (slowest model)", sp, "x",
+                         T["exact_speedup_vs_bvp"], sp >= T["exact_speedup_vs_bvp"],
+                         f"BVP {ex['bvp_s']:.3g} s/solve on {ex['bvp_solved']} points"))
+        figs.append(_fig("exact vs BVP, max relative difference of I", ex["rel_error_max"], "", T["exact_rel_error"],
+                         ex["rel_error_max"] <= T["exact_rel_error"], "includes the BVP's own error (~1e-12)"))
+    r = ak["api_s"] / ak["kernel_s"]
+    figs.append(_fig(f"moment() / bare driver at {ak['points']:.0e} points (leading, 1 thread)", r, "x",
+                     T["api_over_kernel"], r <= T["api_over_kernel"]))
+    r2 = ak["api_s"] / ak["api_parallel_s"]
+    figs.append(_fig(f"moment() speed-up on {ak['threads']} threads", r2, "x", T["api_two_thread_speedup"],
+                     r2 >= T["api_two_thread_speedup"], "machine shared: other load lowers this"))
+    figs.append(_fig("temporaries of moment() beyond inputs and outputs", tmp, "bytes/point",
+                     T["temporary_bytes_per_point"], tmp <= T["temporary_bytes_per_point"], "tracemalloc peak"))
+    figs.append(_fig("scalar moment_integral(2e-4, 1.0, fidelity='leading')", sc["api_s"], "s",
+                     T["scalar_call_s"], sc["api_s"] <= T["scalar_call_s"],
+                     f"{sc['api_s'] / sc['bare_s']:.2f}x the bare compiled point"))
+    rs = st["estimate_s"] / st["import_numba_s"]
+    figs.append(_fig("warm `estimate --fidelity leading` / `python -c 'import numba'`", rs, "x",
+                     T["startup_over_import_numba"], rs <= T["startup_over_import_numba"],
+                     f"{st['estimate_s']:.2f} s vs {st['import_numba_s']:.2f} s"))
+    return {"figures": figs, "raw": {"exact": ex, "api": ak, "temporaries_bytes_per_point": tmp,
+                                     "scalar": sc, "startup": st}}
