@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .integral import check_fidelity, check_min_thickness, moment
+from .integral import ANY_THICKNESS, check_fidelity, check_min_thickness, moment
 from .params import NAFION_LI, Material, Strip, debye_length
 from .permittivity import MODELS, get_model
 from .registry import FIDELITIES as _FIDELITY_SPECS
@@ -140,8 +140,9 @@ def moment_escalating(thickness, voltage, model="constant", fidelity="quadrature
             why.append(f"{f}: {exc}")
             continue
         e_ok = np.isfinite(r.I) & (r.error <= limit)
-        l_ok = r.core > 0
-        ok = e_ok & l_ok & np.asarray(r.success)
+        l_ok = (r.core > 0) | (f in ANY_THICKNESS)
+        # r.valid adds the rung's own ceiling (registry) to the checks here
+        ok = e_ok & l_ok & np.asarray(r.success) & np.asarray(r.valid)
         sel = idx[ok]
         I[sel], err[sel], B1[sel], core[sel], used[sel] = r.I[ok], r.error[ok], r.B1[ok], r.core[ok], f
         elec[idx], layer[idx] = e_ok, l_ok

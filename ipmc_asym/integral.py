@@ -55,7 +55,9 @@ FIDELITIES = fidelity_names()
 #: order argument of the sweep driver: 1 leading, 2 corrected, 0 quadrature, 3 exact
 _ORDER = {k: f.order for k, f in _FIDELITY_SPECS.items() if f.order >= 0}
 #: fidelities valid at every thickness (no neutral core assumed): ``core`` is informative only
-_ANY_THICKNESS = ("exact", "bvp")
+#: rungs that hold whatever the thickness (overlapping layers, non-neutral core)
+ANY_THICKNESS = ("exact", "bvp")
+_ANY_THICKNESS = ANY_THICKNESS
 
 
 def check_fidelity(fidelity: str) -> str:
@@ -341,7 +343,7 @@ def moment(thickness, voltage, model="constant", fidelity="quadrature", *, mater
         if bad_v:
             raise ValueError("voltage must be finite (volts)")
         return MomentResult(I=I, error=err, B1=B1, core=core, lam=lam, A2=A2, valid=valid,
-                            fidelity=fidelity, model=perm.name)
+                            fidelity=fidelity, model=perm.name, success=np.ones(shape, bool))
     lam, A2, A3, rho, sign = groups_arrays(thickness, voltage, gperm, mat)
     shape = lam.shape
     I = np.empty(shape)
@@ -424,7 +426,8 @@ def moment_integral(thickness, voltage, model="constant", fidelity="quadrature",
     on_invalid : {"raise", "nan", "warn"}
         Where the fidelity is outside its validity (error estimate above ``VALIDITY_LIMIT``,
         overlapping layers, or a BVP that did not converge): a one-line ``ValueError``
-        (default), or NaN at those points (``"warn"``: NaN plus a ``RuntimeWarning``).  A
+        (default), or NaN at those points (``"warn"``: NaN plus a ``RuntimeWarning``;
+        ``"ignore"``, kept from earlier versions, is the same as ``"nan"``).  A
         number whose validity check failed is never returned; :func:`moment` gives the
         flags and estimates, and :func:`ipmc_asym.evaluate` escalates.
 
@@ -434,7 +437,7 @@ def moment_integral(thickness, voltage, model="constant", fidelity="quadrature",
         ``I`` with the broadcast shape of the inputs (a float for scalar inputs).
         ``M_A = A5 I`` with ``A5 = 6 l e^2 F |phi0| C_moy``.
     """
-    check_choice("on_invalid", on_invalid, ("raise", "nan", "warn"))
+    check_choice("on_invalid", on_invalid, ("raise", "nan", "warn", "ignore"))
     # scalar fast path: one compiled call, no arrays (falls through on anything unusual,
     # including an invalid point, which then gets the full treatment below)
     if (type(thickness) in _SCALAR_TYPES and type(voltage) in _SCALAR_TYPES and material is None

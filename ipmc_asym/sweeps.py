@@ -19,7 +19,6 @@ Layer rule: stdlib + numpy at import.
 
 from __future__ import annotations
 
-import math
 import sys
 
 import numpy as np

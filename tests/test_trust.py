@@ -142,10 +142,15 @@ def test_leading_error_bound_relative_to_I(model):
 def test_corrected_valid_at_10um(model):
     from ipmc_asym.bvp import moment_integral_bvp
 
+    from ipmc_asym.integral import validity_limit
+
     c = moment(10e-6, 1.0, model, "corrected")
-    assert bool(c.valid)
     ref = moment_integral_bvp(10e-6, 1.0, model)
-    assert abs(float(c.I) / ref - 1) <= float(c.error)
+    actual = abs(float(c.I) / ref - 1)
+    assert actual <= float(c.error)  # a bound...
+    assert float(c.error) <= 100 * max(actual, 1e-11)  # ...no longer overstated by ~e^19 = 2e8
+    # valid exactly where the bound is under the rung's ceiling (above it, exact takes over)
+    assert bool(c.valid) == (float(c.error) < validity_limit("corrected"))
 
 
 def test_evaluate_rejects_bad_tol():
@@ -160,7 +165,8 @@ def test_escalation_is_generic_over_the_registry(monkeypatch):
     from ipmc_asym.estimate import moment_escalating
 
     r = moment_escalating([1e-7, 2e-4], 1.0, "constant", fidelity_names()[0])
-    assert list(r.fidelity_used) == [fidelity_names()[-1], "leading"]
+    first_valid = next(f for f in fidelity_names() if bool(moment(1e-7, 1.0, "constant", f).valid))
+    assert list(r.fidelity_used) == [first_valid, "leading"]
     assert registry.fidelity_names() == tuple(registry.FIDELITIES)
 
 
@@ -174,7 +180,12 @@ def test_iter_sweep_chunks_equal_the_in_memory_sweep(tmp_path):
     whole = sweep(vary, "all", "leading")
     parts = list(iter_sweep(vary, "all", "leading", chunk_rows=4))
     assert len(parts) == 3 * 6
-    np.testing.assert_array_equal(np.concatenate(parts), whole)
+    joined = np.concatenate(parts)
+    for k in whole.dtype.names:  # the beam's vectorised Newton polish may differ by 1 ulp per chunk
+        if whole.dtype[k].kind == "f":
+            np.testing.assert_allclose(joined[k], whole[k], rtol=1e-14, atol=0)
+        else:
+            np.testing.assert_array_equal(joined[k], whole[k])
     p = tmp_path / "s.csv"
     assert write_csv(iter_sweep(vary, "all", "leading", chunk_rows=5), p) == whole.size
     data = np.genfromtxt(p, delimiter=",", names=True, dtype=None, encoding="utf-8")
