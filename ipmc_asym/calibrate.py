@@ -48,6 +48,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .registry import closed_form_fidelities, fidelity_names
 from .params import NAFION_LI, Material, Strip, moment_scale, second_moment
 from .units import parse_length, parse_pressure, parse_quantity, parse_voltage
 
@@ -73,7 +74,8 @@ FREE_PARAMETERS = {
 MEASURED = {"deflection": "m", "blocking_force": "N"}
 GEOMETRY = ("length", "width", "thickness", "voltage")
 _FORCE = {"N": 1.0, "mN": 1e-3, "uN": 1e-6, "µN": 1e-6, "μN": 1e-6, "kN": 1e3}
-LADDER = ("leading", "corrected", "quadrature", "bvp")
+#: the fidelity ladder, cheapest first (the registry is the one list)
+LADDER = fidelity_names()
 #: starting value of a permittivity parameter whose nominal value is 0 (log parameters)
 _EPS_START = {"eps0": 5e-6, "deps": 1e-3}
 
@@ -465,7 +467,7 @@ def fit(data: CalibrationData, free, model="constant", material: Material = NAFI
             raise ValueError(f"fidelity must be one of {', '.join(LADDER)}; got {fidelity!r}")
         ladder = [fidelity]
     else:
-        ladder = [f for f in LADDER if not (perm_free and f in ("leading", "corrected"))]
+        ladder = [f for f in LADDER if not (perm_free and f in closed_form_fidelities())]
 
     # multistart (fidelity of the first rung; the ladder then refines the best start)
     starts = [x0]
