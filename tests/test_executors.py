@@ -1,0 +1,80 @@
+"""Chunked runs on a 2-worker dask LocalCluster are identical to the serial run."""
+
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from ipmc_asym.executors import check_scheduler, chunk_slices, run_chunks, sweep_chunked
+from ipmc_asym.sweeps import sweep
+
+distributed = pytest.importorskip("distributed")
+
+
+@pytest.fixture(scope="module")
+def client():
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as cluster, distributed.Client(cluster) as c:
+        yield c
+
+
+def _same(a, b):
+    for k in a.dtype.names:
+        if a.dtype[k].kind == "f":
+            np.testing.assert_array_equal(a[k], b[k])  # bitwise, NaN == NaN
+        else:
+            assert (a[k] == b[k]).all(), k
+
+
+@pytest.mark.slow
+def test_bvp_sweep_2d_identical_on_cluster(client):
+    vary = {"thickness": np.array([150e-6, 250e-6]), "voltage": np.array([0.5, 2.0])}
+    serial = sweep(vary, model="constant", fidelity="bvp", progress=False)
+    dist = sweep_chunked(vary, client, seconds_per_point=0.1,  # 2 chunks (one per thickness)
+                          model="constant", fidelity="bvp")
+    assert dist.size == serial.size == 4
+    _same(serial, dist)
+    # the work really ran on two worker processes, each set up once
+    info = client.run(lambda: __import__("os").environ.get("OMP_NUM_THREADS"))
+    assert len(info) == 2
+
+
+def test_uq_identical_on_cluster(client):
+    from ipmc_asym.uq import run_uq
+
+    sc = {"name": "t", "voltage": "1V", "tolerance": 1e-3, "outputs": ["I", "tip_deflection", "blocking_force"],
+          "uncertain": {"thickness": {"dist": "normal", "mean": "200um", "sd": "10um"},
+                        "c_moy": {"dist": "triangular", "low": 2900, "mode": 3082, "high": 3200},
+                        "modulus": {"dist": "lognormal", "median": "130MPa", "sigma": 0.2}}}
+    a = run_uq(sc, 4096, chunk_rows=1000)
+    b = run_uq(sc, 4096, chunk_rows=1000, scheduler=client)
+    for o in a.outputs:
+        np.testing.assert_array_equal(a.outputs[o], b.outputs[o])
+    assert a.sobol == b.sobol and a.summary == b.summary and a.fidelity == b.fidelity
+
+
+def test_run_chunks_order_and_serial():
+    tasks = list(range(7))
+    assert run_chunks(abs, [-t for t in tasks]) == tasks
+
+
+def test_chunks_carry_100ms():
+    sl = chunk_slices(10**6, 1e-7, workers=2)  # 0.1 s total: one chunk
+    assert len(sl) == 1
+    sl = chunk_slices(100, 0.03, workers=2)  # BVP points: >= 4 per chunk, <= 4 chunks per worker
+    assert all(s.stop - s.start >= 4 for s in sl[:-1]) and len(sl) <= 8
+    assert sum(s.stop - s.start for s in sl) == 100
+
+
+@pytest.mark.parametrize("bad", ["remote", "tcp://host", "http://x:1"])
+def test_bad_scheduler(bad):
+    with pytest.raises(ValueError, match="--scheduler must be local or tcp://HOST:PORT"):
+        check_scheduler(bad)
+
+
+def test_import_does_not_load_dask():
+    code = ("import sys, ipmc_asym, ipmc_asym.executors, ipmc_asym.uq, ipmc_asym.calibrate, ipmc_asym.datasets;"
+            "print(any(m == 'dask' or m.startswith(('dask.', 'distributed')) for m in sys.modules))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "False"
