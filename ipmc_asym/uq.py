@@ -302,7 +302,7 @@ class UQResult:
 
 
 def _scene_parts(scene):
-    from .scenes import _parse, load_scene
+    from .scene_schema import load_scene, parse_scene
 
     if not isinstance(scene, dict):
         scene = load_scene(scene)
@@ -317,7 +317,8 @@ def _scene_parts(scene):
             raise ValueError(f"uq: {k} given both in [strip] and [uncertain]")
     if "voltage" in unc and "voltage" not in scene:
         scene["voltage"] = 1.0  # placeholder for the parser; the samples replace it
-    name, model, material, pts, swept, outputs, tol, _ = _parse(scene)
+    sc = parse_scene(scene)
+    name, model, material, pts, outputs, tol = sc.name, sc.model, sc.material, sc.points, sc.outputs, sc.tolerance
     if not isinstance(model, str):
         raise ValueError("uq: model must be constant, linear or affine")
     for o in outputs:

@@ -28,6 +28,8 @@ COMMANDS = {
     "sweep": "sweep",
     "validate": "validate",
     "figures": "figures",
+    "fit": "fit",
+    "uq": "uq",
 }
 
 #: one-line summaries for ``ipmc-asym --help`` without importing every command module
@@ -41,6 +43,8 @@ SUMMARIES = {
     "sweep": "evaluate the strip on a grid of parameters",
     "validate": "each claim of the paper vs our numbers, with a verdict",
     "figures": "regenerate the paper's Figs 4-10 (+ speed/accuracy) as PNG",
+    "fit": "calibrate modulus, c_moy, permittivity on measured deflection/force (profile intervals)",
+    "uq": "uncertainty quantiles and Sobol' indices of a scene's [uncertain] inputs",
 }
 
 

@@ -1,0 +1,70 @@
+"""``ipmc-asym uq``: uncertainty (quantiles) and Sobol' sensitivity of a scene's outputs."""
+
+from __future__ import annotations
+
+import sys
+
+from ..fileio import check_output_path
+from ..jsonio import dumps
+from ..registry import fidelity_names
+from . import SUMMARIES
+from .common import count_type
+
+
+def register(sub):
+    p = sub.add_parser("uq", help=SUMMARIES["uq"],
+                       description="Sample a scene's [uncertain] table (normal, lognormal, uniform, triangular), "
+                                   "report quantiles 2.5/50/97.5 %%, mean, sd and Sobol' first/total indices.")
+    p.add_argument("scene", metavar="SCENE.toml", help="scene with an [uncertain] table (examples/uq_nominal.toml)")
+    p.add_argument("--samples", type=count_type("--samples"), default=10**5,
+                   help="model runs wanted (rounded up to N(D+2), N a power of two; default 1e5)")
+    p.add_argument("--fidelity", default=None, choices=[f for f in fidelity_names() if f != "bvp"],
+                   help="force a fidelity (default: per sample, cheapest meeting the scene's tolerance)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the scrambled Sobol' sequence")
+    p.add_argument("--scheduler", default=None, metavar="local|tcp://HOST:PORT",
+                   help="run the chunks on dask.distributed (default: in this process)")
+    p.add_argument("--out", default=None, metavar="F.nc", help="NetCDF file of samples, outputs and indices")
+    p.add_argument("--plot", default=None, metavar="F.png", help="histograms of the outputs")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+
+
+def run(args) -> int:
+    from ..uq import run_uq
+
+    for opt in ("out", "plot"):
+        if getattr(args, opt):
+            check_output_path(getattr(args, opt), "file", f"--{opt}")
+    if args.scheduler is not None:
+        from ..executors import check_scheduler
+
+        check_scheduler(args.scheduler)
+    res = run_uq(args.scene, args.samples, seed=args.seed, fidelity=args.fidelity, scheduler=args.scheduler)
+    if args.out:
+        from ..datasets import uq_dataset, write_netcdf
+
+        eng = write_netcdf(uq_dataset(res), args.out)
+        sys.stderr.write(f"uq: {res.n_samples} samples -> {args.out} (NetCDF, engine {eng})\n")
+    if args.plot:
+        from ..plotting.uq import plot_uq  # deferred: matplotlib (start-up)
+
+        plot_uq(res, args.plot)
+    if args.json:
+        print(dumps(res.as_dict(), indent=2))
+        return 0
+    fid = ", ".join(f"{k}: {v}" for k, v in res.fidelity.items() if v)
+    print(f"uq of scene {res.scene!r} [{res.model}]: {res.n_samples} runs (N = {res.base_n}), {res.seconds:.3g} s; "
+          f"fidelity per sample: {fid}; thickness is the TOTAL thickness 2e")
+    print(f"{'output':15s} {'unit':5s} {'mean':>11s} {'sd':>10s} {'2.5%':>11s} {'50%':>11s} {'97.5%':>11s}")
+    for o, s in res.summary.items():
+        print(f"{o:15s} {s['unit']:5s} {s['mean']:11.5g} {s['sd']:10.3g} {s['q2.5']:11.5g} {s['q50']:11.5g} "
+              f"{s['q97.5']:11.5g}")
+    print("Sobol' indices (first S1 / total ST, ± 95 % half-width):")
+    for o, sob in res.sobol.items():
+        if sob is None:
+            print(f"  {o}: constant output, no indices")
+            continue
+        print(f"  {o}: " + "; ".join(f"{k} S1={v['S1']:.3f}±{v['S1_conf']:.1g} ST={v['ST']:.3f}±{v['ST_conf']:.1g}"
+                                      for k, v in sob.items()))
+    if args.plot:
+        print(f"figure: {args.plot}")
+    return 0

@@ -1,0 +1,50 @@
+"""Histograms of the UQ outputs with their quantiles (``ipmc-asym uq --plot F.png``)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from . import pyplot, savefig
+
+__all__ = ["plot_uq"]
+
+#: display scale of each output's unit
+_SCALE = {"m": (1e3, "mm"), "N": (1e3, "mN"), "N m": (1e6, "µN m"), "rad": (1.0, "rad"), "1": (1.0, "")}
+
+
+def plot_uq(result, path) -> str:
+    """One panel per output: histogram (density), the 2.5/50/97.5 % quantiles (dashed), and
+    the Sobol' total indices of the two most influential inputs in the title.
+
+    Parameters
+    ----------
+    result : ipmc_asym.uq.UQResult
+    path : str   PNG path (written atomically)
+    """
+    plt = pyplot()
+    outs = list(result.outputs)
+    n = len(outs)
+    cols = min(n, 3)
+    rows = -(-n // cols)
+    fig, axes = plt.subplots(rows, cols, figsize=(4.6 * cols, 3.4 * rows), squeeze=False)
+    for ax, o in zip(axes.flat, outs):
+        s = result.summary[o]
+        f, u = _SCALE.get(s["unit"], (1.0, s["unit"]))
+        y = result.outputs[o] * f
+        ax.hist(y, bins=80, density=True, color="C0", alpha=0.75)
+        for q in ("q2.5", "q50", "q97.5"):
+            ax.axvline(s[q] * f, color="k", ls="--" if q != "q50" else "-", lw=0.9)
+        ax.set_xlabel(f"{o}" + (f" [{u}]" if u else " [-]"))
+        ax.set_ylabel("density")
+        sob = result.sobol.get(o)
+        if sob:
+            top = sorted(sob.items(), key=lambda kv: -kv[1]["ST"])[:2]
+            ax.set_title(", ".join(f"S_T({k}) = {v['ST']:.2f}" for k, v in top), fontsize=9)
+        ax.text(0.02, 0.95, f"mean {s['mean'] * f:.4g}\nsd {s['sd'] * f:.3g}", transform=ax.transAxes,
+                va="top", fontsize=8)
+    for ax in list(axes.flat)[n:]:
+        ax.set_visible(False)
+    fig.suptitle(f"UQ of scene {result.scene!r} [{result.model}]: {result.n_samples} runs; "
+                 f"dashed: 2.5 / 97.5 %, solid: median (thickness = total 2e)", fontsize=10)
+    fig.tight_layout()
+    return savefig(fig, path, dpi=110)
