@@ -206,7 +206,11 @@ def _bvp_sample(model, th, v):
 #: takes ``quick: bool`` and returns ``{"figures": [{"what", "value", "unit", "target", "pass",
 #: "note"}, ...], ...}``: figures measured side by side in one run, as ratios where a target is
 #: a ratio.  Adding a section is adding one line here.
-SECTIONS: dict[str, str] = {"exact_api": "ipmc_asym.bench_exact:section"}
+SECTIONS: dict[str, str] = {
+    "exact_api": "ipmc_asym.bench_exact:section",
+    "uq": "ipmc_asym.uq:bench_section",
+    "distributed": "ipmc_asym.executors:bench_section",
+}
 
 
 def run_sections(names=None, quick: bool = False) -> dict:

@@ -262,3 +262,45 @@ def _env(values):
                 os.environ.pop(k, None)
             else:
                 os.environ[k] = v
+
+
+def bench_section(quick: bool = False) -> dict:
+    """``ipmc-asym bench`` section: a 2-D BVP sweep on a 2-worker LocalCluster vs 1 worker.
+
+    Both runs on fresh LocalClusters (1 and 2 worker processes, one thread each), measured
+    side by side in one run after the parent warmed the kernels; cluster start-up excluded
+    (it is paid once per session); the results are checked identical.
+    """
+    try:
+        import distributed  # deferred: heavy import (start-up), optional extra
+    except ImportError:
+        return {"figures": [{"what": "distributed BVP sweep speed-up", "value": None, "unit": "x", "target": 1.6,
+                             "pass": None, "note": "dask.distributed not installed (pip install \".[dask]\")"}]}
+    from .sweeps import sweep
+
+    nt, nv = (2, 4) if quick else (4, 6)
+    vary = {"thickness": np.geomspace(100e-6, 400e-6, nt), "voltage": np.linspace(0.5, 2.0, nv)}
+    kw = dict(model="constant", fidelity="bvp")
+    warm_kernels()
+    sweep({"thickness": vary["thickness"][:1], "voltage": vary["voltage"][:1]}, progress=False, **kw)
+    times, results = {}, {}
+    for nw in (1, 2):
+        env = _worker_env(1)
+        with _env(env), distributed.LocalCluster(n_workers=nw, threads_per_worker=1, processes=True,
+                                                 dashboard_address=None, env=env) as cl, \
+                distributed.Client(cl) as client:
+            client.run(worker_setup, 1)
+            # one BVP point on every worker first: SciPy's imports and first-call costs
+            client.run(_sweep_task, ({"thickness": vary["thickness"][:1], "voltage": vary["voltage"][:1]},
+                                     dict(kw, progress=False)))
+            t0 = time.perf_counter()
+            results[nw] = sweep_chunked(vary, client, seconds_per_point=0.1, workers=nw, **kw)
+            times[nw] = time.perf_counter() - t0
+    same = all(np.array_equal(results[1][k], results[2][k], equal_nan=results[1].dtype[k].kind == "f")
+               for k in results[1].dtype.names)
+    sp = times[1] / times[2]
+    return {"figures": [
+        {"what": f"distributed BVP sweep {nt}x{nv}: 2 workers vs 1", "value": sp, "unit": "x", "target": 1.6,
+         "pass": bool(sp >= 1.6), "note": f"1 worker {times[1]:.3g} s, 2 workers {times[2]:.3g} s; "
+                                          f"results identical: {same}"},
+    ], "identical": same}

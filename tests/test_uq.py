@@ -94,3 +94,20 @@ def test_bad_uncertain_tables(table, msg):
 def test_uq_refuses_sweeps_and_profiles():
     with pytest.raises(ValueError, match="not available for sampling"):
         run_uq(_scene({"length": {"dist": "uniform", "low": "1cm", "high": "2cm"}}, ["profiles"]), 100)
+
+
+def test_estimators_equal_salib():
+    """The written-out estimators are SALib's first_order/total_order (Saltelli 2010, Jansen)."""
+    from SALib.analyze.sobol import first_order, separate_output_values, total_order
+
+    from ipmc_asym.uq import _saltelli, _sobol_indices
+
+    N, D = 2**10, 3
+    U = _saltelli(D, N, 1)
+    y = np.sin(U[:, 0] * 3) + U[:, 1] ** 2 * U[:, 2]
+    ours = _sobol_indices(y, ["a", "b", "c"], N)
+    z = (y - y.mean()) / y.std()
+    A, B, AB, _ = separate_output_values(z, D, N, False)
+    for j, k in enumerate("abc"):
+        assert ours[k]["S1"] == pytest.approx(float(first_order(A, AB[:, j], B)), rel=1e-12, abs=1e-14)
+        assert ours[k]["ST"] == pytest.approx(float(total_order(A, AB[:, j], B)), rel=1e-12, abs=1e-14)
