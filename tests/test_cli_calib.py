@@ -1,0 +1,82 @@
+"""``ipmc-asym fit`` and ``ipmc-asym uq`` as a user runs them: JSON keys, files, one-line errors."""
+
+import json
+import os
+
+import numpy as np
+import pytest
+
+from ipmc_asym.cli import main
+from ipmc_asym.estimate import evaluate
+from ipmc_asym.params import NAFION_LI, Strip
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+@pytest.fixture(scope="module")
+def data_csv(tmp_path_factory):
+    """Deflection and force of a strip with E = 90 MPa, C_moy = 2900 (quadrature), 2 % noise."""
+    mat = NAFION_LI.with_(E=9e7, c_moy=2900.0)
+    rng = np.random.default_rng(5)
+    lines = ["voltage,thickness,deflection,blocking_force,sigma_deflection,sigma_blocking_force"]
+    for t in ("150um", "250um"):
+        for v in np.linspace(0.2, 0.8, 6):
+            r = evaluate(Strip(length=0.015, thickness=float(t[:-2]) * 1e-6, voltage=float(v)), "constant",
+                         "quadrature", mat)
+            w, f = abs(r["w"]), abs(r["F_block"])
+            lines.append(f"{v:.4f}V,{t},{w * (1 + 0.02 * rng.standard_normal()) * 1e3:.6g}mm,"
+                         f"{f * (1 + 0.02 * rng.standard_normal()) * 1e3:.6g}mN,{0.02 * w:.6g},{0.02 * f:.6g}")
+    p = tmp_path_factory.mktemp("fit") / "data.csv"
+    p.write_text("\n".join(lines) + "\n")
+    return str(p)
+
+
+def test_fit_json_and_plot(data_csv, tmp_path, capsys):
+    png = tmp_path / "fit.png"
+    assert main(["fit", data_csv, "--free", "modulus,c_moy", "--length", "1.5cm", "--json",
+                 "--plot", str(png)]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert set(out) == {"parameters", "correlation", "chi2_red", "n_points", "fidelity", "model"}
+    assert set(out["parameters"]["modulus"]) == {"value", "stderr", "ci95", "identifiable"}
+    assert out["n_points"] == 24
+    for k, true in (("modulus", 9e7), ("c_moy", 2900.0)):
+        p = out["parameters"][k]
+        assert p["identifiable"] and abs(p["value"] / true - 1) < 0.05
+    assert png.stat().st_size > 10_000
+
+
+def test_fit_bad_input_exit_2(data_csv, tmp_path, capsys):
+    assert main(["fit", data_csv, "--free", "stiffness"]) == 2
+    err = capsys.readouterr().err
+    assert "unknown parameter 'stiffness'" in err and err.count("\n") == 1
+    bad = tmp_path / "bad.csv"
+    bad.write_text("voltage,deflection\n1V,12 furlongs\n")
+    assert main(["fit", str(bad), "--free", "modulus"]) == 2
+    err = capsys.readouterr().err
+    assert "row 2, column 'deflection'" in err and err.count("\n") == 1
+    assert main(["fit", data_csv, "--free", "modulus", "--plot", str(tmp_path / "no" / "f.png")]) == 2
+    assert main(["fit", data_csv, "--free", "modulus", "--scheduler", "nowhere"]) == 2
+
+
+def test_uq_json_out_plot(tmp_path, capsys):
+    nc, png = tmp_path / "u.nc", tmp_path / "u.png"
+    scene = os.path.join(ROOT, "examples", "uq_nominal.toml")
+    assert main(["uq", scene, "--samples", "2000", "--json", "--out", str(nc), "--plot", str(png)]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert set(out["summary"]["tip_deflection"]) == {"unit", "mean", "sd", "q2.5", "q50", "q97.5"}
+    assert set(out["sobol"]["rotation"]["modulus"]) == {"S1", "S1_conf", "ST", "ST_conf"}
+    xr = pytest.importorskip("xarray")
+    with xr.open_dataset(nc) as ds:
+        assert ds.sizes["sample"] == out["n_samples"]
+    assert png.stat().st_size > 10_000
+
+
+def test_uq_bad_scene_exit_2(tmp_path, capsys):
+    p = tmp_path / "s.toml"
+    p.write_text('voltage = "1V"\n[uncertain]\nthickness = {dist = "cauchy", loc = 1}\n')
+    assert main(["uq", str(p), "--samples", "100"]) == 2
+    err = capsys.readouterr().err
+    assert "dist must be one of" in err and err.count("\n") == 1
+    with pytest.raises(SystemExit) as ei:  # argparse: one line, status 2
+        main(["uq", str(p), "--samples", "0"])
+    assert ei.value.code == 2
