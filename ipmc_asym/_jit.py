@@ -21,7 +21,7 @@ def hashed_sources() -> list:
     """The modules that define jitted functions (and what they inline: ``settings`` values
     such as ``EXACT_STATED_ERROR`` are frozen into the compiled sweep driver)."""
     here = Path(__file__).resolve().parent
-    return sorted([here / "_jit.py", here / "integral.py", here / "settings.py", here / "uq.py",
+    return sorted([here / "_jit.py", here / "integral.py", here / "integral_samples.py", here / "settings.py",
                    *(here / "kernels").glob("*.py")])
 
 

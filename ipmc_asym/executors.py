@@ -73,11 +73,18 @@ def warm_kernels(fidelities=("leading", "corrected", "quadrature")) -> float:
     from .integral import moment
     from .registry import model_names
 
+    from .integral_samples import moment_samples
+
+    order = {"leading": 1, "corrected": 2, "quadrature": 0}
+    one = np.ones(1)
     for f in fidelities:
         for m in model_names():
             if f == "quadrature" and m != model_names()[0]:
                 continue  # one quadrature kernel serves every model (rho is an argument)
             moment(np.array([200e-6]), np.array([1.0]), m, f)
+        # the per-sample driver of ipmc_asym.uq (same signature for every model)
+        moment_samples(0.01 * one, 40.0 * one, 0.3 * one, 1.0, 0 if f != "quadrature" else -1, order[f], one,
+                       np.empty(1), np.empty(1), np.empty(1))
     return time.perf_counter() - t0
 
 

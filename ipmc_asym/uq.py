@@ -30,8 +30,8 @@ blocking force uses the small-displacement ``3M/(2L)`` where its relative deviat
 the tolerance, the large-displacement root otherwise; the tip deflection is always the arc.
 
 ``C_moy`` per sample changes ``A3`` per sample, which the shared sweep driver takes as a
-scalar: :func:`_moment_samples` is the same loop with ``A3`` an array (it calls the same
-compiled point kernel, :func:`ipmc_asym.integral._point`).
+scalar: :func:`ipmc_asym.integral_samples.moment_samples` is the same loop with ``A3`` an
+array (it calls the same compiled point kernel).
 
 Layer rule: stdlib + numpy + the compiled kernels at import; SciPy statistics, SALib
 deferred.
@@ -45,8 +45,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ._jit import jit_parallel, prange
-from .integral import _point, closed_model_id
+from .integral import closed_model_id
+from .integral_samples import moment_samples
 from .params import moment_scale, second_moment
 from .registry import fidelity_names
 from .settings import CHUNK_ROWS, VALIDITY_LIMIT
@@ -78,16 +78,6 @@ OUTPUT_UNITS = {
     "blocking_force": ("N", "blocking force F"),
 }
 _CLOSED = ("leading", "corrected")
-
-
-@jit_parallel
-def _moment_samples(lam, A2, A3, rho, model_id, order, sign, I, err, core):
-    """The sweep driver of :mod:`ipmc_asym.integral` with ``A3`` per sample (``C_moy`` varies)."""
-    for i in prange(lam.size):
-        Ii, e_i, b1, c = _point(lam[i], A2[i], A3[i], rho, model_id, order)
-        I[i] = sign[i] * Ii
-        err[i] = e_i
-        core[i] = c
 
 
 # ---- scene ----------------------------------------------------------------------------------
@@ -212,7 +202,7 @@ def evaluate_samples(cols: dict, outputs, model, material, tol, fidelity=None):
             break
         mid = closed_model_id(perm, fid)
         Ii, ei, ci = np.empty(todo.size), np.empty(todo.size), np.empty(todo.size)
-        _moment_samples(lam[todo], A2[todo], A3[todo], rho, mid, order[fid], sign[todo], Ii, ei, ci)
+        moment_samples(lam[todo], A2[todo], A3[todo], rho, mid, order[fid], sign[todo], Ii, ei, ci)
         ok = (ei <= tol) & (ei < VALIDITY_LIMIT) & (ci > 0)
         I[todo], err[todo], core[todo] = Ii, ei, ci
         counts[fid] = int(np.count_nonzero(ok))

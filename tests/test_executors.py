@@ -78,3 +78,20 @@ def test_import_does_not_load_dask():
             "print(any(m == 'dask' or m.startswith(('dask.', 'distributed')) for m in sys.modules))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "False"
+
+
+def test_fit_multistart_identical_on_cluster(client):
+    from ipmc_asym.calibrate import CalibrationData, fit, predict
+
+    th = np.repeat([200e-6, 300e-6], 4)
+    v = np.tile(np.linspace(0.3, 1.2, 4), 2)
+    geom = {"length": np.full(8, 0.015), "width": np.full(8, 5e-3), "thickness": th, "voltage": v}
+    out, _, _ = predict({"modulus": 1e8, "c_moy": 2600.0}, geom, "constant", "quadrature")
+    rng = np.random.default_rng(1)
+    meas = {k: out[k] * (1 + 0.02 * rng.standard_normal(8)) for k in out}
+    data = CalibrationData(geom, meas, {k: 0.02 * out[k] for k in out})
+    free = {"modulus": (3e7, 3e8), "c_moy": (1500.0, 5000.0)}
+    a = fit(data, free, multistart=3)
+    b = fit(data, free, multistart=3, scheduler=client)
+    assert a.as_dict() == b.as_dict()
+    assert "best of 4 starts" in b.message
