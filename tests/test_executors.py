@@ -35,9 +35,18 @@ def test_bvp_sweep_2d_identical_on_cluster(client):
                           model="constant", fidelity="bvp")
     assert dist.size == serial.size == 4
     _same(serial, dist)
-    # the work really ran on two worker processes, each set up once
-    info = client.run(lambda: __import__("os").environ.get("OMP_NUM_THREADS"))
+    # both workers were set up: one BLAS/OpenMP thread, Numba threads set explicitly to 1
+    info = client.run(_threads)
     assert len(info) == 2
+    assert all(v == ("1", "1", 1) for v in info.values()), info
+
+
+def _threads():
+    import os
+
+    import numba
+
+    return os.environ.get("OMP_NUM_THREADS"), os.environ.get("OPENBLAS_NUM_THREADS"), numba.get_num_threads()
 
 
 def test_uq_identical_on_cluster(client):
