@@ -8,6 +8,9 @@ from . import pyplot, savefig
 
 __all__ = ["plot_fit"]
 
+#: geometry column -> (display scale, unit, label)
+_AXIS = {"voltage": (1.0, "V", "voltage φ0"), "thickness": (1e6, "µm", "total thickness 2e"),
+         "length": (1e3, "mm", "length L"), "width": (1e3, "mm", "total width 2l")}
 _LABEL = {"deflection": ("tip deflection |w| [mm]", 1e3), "blocking_force": ("blocking force |F| [mN]", 1e3)}
 
 
@@ -26,10 +29,14 @@ def plot_fit(result, path) -> str:
     keys = list(d.measured)
     fig, axes = plt.subplots(2, len(keys), figsize=(5.2 * len(keys), 5.6), squeeze=False,
                              gridspec_kw={"height_ratios": [3, 1.3]}, sharex="col")
-    th = d.geometry["thickness"]
+    # x axis: the first of voltage, thickness, length, width that varies; colour: the next
+    varying = [k for k in ("voltage", "thickness", "length", "width") if np.unique(d.geometry[k]).size > 1]
+    xk = varying[0] if varying else "voltage"
+    ck = varying[1] if len(varying) > 1 else None
+    v = d.geometry[xk]
+    th = d.geometry[ck] if ck else np.zeros(d.n_rows)
     uniq = np.unique(th)
-    colours = {t: f"C{i % 10}" for i, t in enumerate(uniq)}
-    v = d.geometry["voltage"]
+    xs, xu, xl = _AXIS[xk]
     for j, k in enumerate(keys):
         lab, f = _LABEL[k]
         ax, axr = axes[0, j], axes[1, j]
@@ -39,19 +46,20 @@ def plot_fit(result, path) -> str:
         sig = d.sigma[k]
         for t in uniq:
             s = m & (th == t)
-            c = colours[t]
+            c = f"C{list(uniq).index(t) % 10}"
             o = np.argsort(v[s])
-            ax.errorbar(v[s], f * y[s], yerr=None if sig is None else f * sig[s], fmt="o", ms=4, color=c,
-                        label=f"data, 2e = {t * 1e6:.4g} µm")
-            ax.plot(v[s][o], f * pred[s][o], "-", color=c, lw=1.2)
+            lab_c = "data" if ck is None else f"data, {_AXIS[ck][2]} = {t * _AXIS[ck][0]:.4g} {_AXIS[ck][1]}"
+            ax.errorbar(xs * v[s], f * y[s], yerr=None if sig is None else f * sig[s], fmt="o", ms=4, color=c,
+                        label=lab_c)
+            ax.plot(xs * v[s][o], f * pred[s][o], "-", color=c, lw=1.2)
             res = (y[s] - pred[s]) / (sig[s] if sig is not None else y[s])
-            axr.plot(v[s], res, "o", ms=4, color=c)
+            axr.plot(xs * v[s], res, "o", ms=4, color=c)
         ax.set_ylabel(lab)
         ax.set_title(f"{k.replace('_', ' ')}: data (points) vs fit (lines)", fontsize=10)
         ax.legend(fontsize=7)
         axr.axhline(0, color="k", lw=0.8)
         axr.set_ylabel("(data − fit)/σ" if sig is not None else "(data − fit)/data")
-        axr.set_xlabel("voltage φ0 [V]")
+        axr.set_xlabel(f"{xl} [{xu}]")
     pars = ", ".join(
         f"{n} = {p['value']:.4g}" + (f" ± {p['stderr']:.2g}" if p["identifiable"] else " (not identifiable)")
         for n, p in result.parameters.items())
