@@ -30,9 +30,12 @@ relative (residual / |measured|) and the scale is estimated from the residuals
 (``s^2 = chi^2/(n - p)``; covariance scaled by ``s^2``; profile threshold ``t_{0.975,n-p}^2``).
 
 Fidelity: the cheapest rung of ``leading -> corrected -> quadrature -> bvp`` whose error
-estimate at every data point (from :func:`ipmc_asym.integral.moment`, at the fitted
-parameters) is below a tenth of the data's relative error (the smallest
-``sigma/|measured|``, or the fitted relative scale ``s`` without sigma columns).  The closed
+estimate at every data point (from :func:`ipmc_asym.integral.moment`, propagated to each
+output, at the fitted parameters) is below a tenth of the data's relative error (the
+smallest ``sigma/|measured|``, or the fitted relative scale ``s`` without sigma columns),
+and -- because the estimates average over the points while a model error does not -- whose
+worst-case linearised shift of every estimate is below a tenth of its standard error
+(:func:`_bias_check`).  The closed
 forms exist for the paper's permittivity pairs only, so a free ``eps0``/``deps`` starts at
 ``quadrature``.
 
@@ -500,9 +503,13 @@ def fit(data: CalibrationData, free, model="constant", material: Material = NAFI
                       for m in prob.keys)
         else:
             rel = math.sqrt(chi2 / max(n - p, 1))
-        if bool(np.all(valid[rows])) and worst < 0.1 * rel:
+        bias_ok, bias_note = _bias_check(prob, res, out, errs, chi2, n, p, data.has_sigma)
+        if bool(np.all(valid[rows])) and worst < 0.1 * rel and bias_ok:
             chosen = fid
             break
+        if bool(np.all(valid[rows])) and worst < 0.1 * rel:
+            notes.append(f"{fid}: {bias_note}")
+            continue
         notes.append(f"{fid}: error estimate {worst:.2g} not below a tenth of the data's relative error "
                      f"{rel:.2g}" + ("" if np.all(valid[rows]) else " (outside validity)"))
     if chosen is None:
@@ -545,7 +552,8 @@ def fit(data: CalibrationData, free, model="constant", material: Material = NAFI
                 row.append(None)
         corr.append(row)
     out, _, _ = predict(prob.values(res.x), data.geometry, model, chosen, material)
-    msg = f"fidelity {chosen} (cheapest with error estimate < 1/10 of the data's relative error)"
+    msg = (f"fidelity {chosen} (cheapest with error estimate < 1/10 of the data's relative error and a model-error "
+           f"shift < 0.1 standard error on every estimate)")
     if notes:
         msg += "; " + "; ".join(notes)
     from .permittivity import get_model
@@ -553,6 +561,32 @@ def fit(data: CalibrationData, free, model="constant", material: Material = NAFI
     return CalibrationResult(parameters=params, correlation=corr, chi2_red=chi2_red, n_points=n,
                              fidelity=chosen, model=get_model(model).name, success=bool(res.success),
                              message=msg, names=names, predictions=out, data=data)
+
+
+def _bias_check(prob, res, out, errs, chi2, n, p, has_sigma):
+    """Does the model error move the estimates by less than a tenth of their standard error?
+
+    The per-point rule (error < 1/10 of the data's relative error) does not see that the
+    estimates average over ``n`` points while a systematic model error does not average out.
+    Linearised: the shift of the log parameters is ``G r_model`` with ``G = (J^T J)^+ J^T``
+    and ``r_model`` the worst-case weighted model error (error estimate x |prediction| /
+    weight scale, every sign the worst one: ``|G| |r_model|``).
+    """
+    J = np.asarray(res.jac, float)
+    rm = np.concatenate([errs[k][prob.masks[k]] * np.abs(out[k][prob.masks[k]]) / prob.scale[k] for k in prob.keys])
+    if not np.all(np.isfinite(rm)):
+        return False, "model error estimate not finite at some point"
+    JtJ = np.linalg.pinv(J.T @ J)
+    G = JtJ @ J.T
+    s2 = 1.0 if has_sigma else chi2 / max(n - p, 1)
+    sd = np.sqrt(np.clip(np.diag(s2 * JtJ), 0.0, None))
+    bias = np.abs(G) @ np.abs(rm)
+    ok = (sd <= 0) | (bias < 0.1 * sd)
+    if np.all(ok):
+        return True, ""
+    j = int(np.argmax(np.where(sd > 0, bias / np.where(sd > 0, sd, 1.0), 0.0)))
+    return False, (f"model error could shift {prob.names[j]} by {bias[j] / sd[j]:.2g} standard errors "
+                   f"(> 0.1)")
 
 
 def _profile(prob, xhat, j, lo, hi, chi2min, s2, thr, sd):

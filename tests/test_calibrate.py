@@ -134,3 +134,15 @@ def test_unknown_free_parameter():
     with pytest.raises(ValueError, match="unknown parameter 'young'"):
         parse_free("young")
     assert parse_free("modulus=50MPa:500MPa")["modulus"] == pytest.approx((5e7, 5e8))
+
+
+def test_precise_data_escalate_fidelity(truth_rows, tmp_path):
+    """1e-5 data: leading (error ~1e-3) is refused; the estimates then hit the truth to ~1e-5."""
+    d = read_data(_write(tmp_path / "p.csv", truth_rows, 0, noise=1e-5), Strip(width=5e-3))
+    r = fit(d, ["modulus", "c_moy"])
+    assert r.fidelity in ("corrected", "quadrature")
+    assert "leading:" in r.message
+    for k, true in TRUE.items():
+        assert abs(r.parameters[k]["value"] / true - 1) < 1e-3
+        lo, hi = r.parameters[k]["ci95"]
+        assert lo <= true <= hi
