@@ -104,3 +104,19 @@ def test_fit_multistart_identical_on_cluster(client):
     b = fit(data, free, multistart=3, scheduler=client)
     assert a.as_dict() == b.as_dict()
     assert "best of 4 starts" in b.message
+
+
+def _env_of_worker(_):
+    import os
+
+    import numba
+
+    return os.environ.get("OPENBLAS_NUM_THREADS"), os.environ.get("MKL_NUM_THREADS"), numba.get_num_threads()
+
+
+def test_process_pool_fallback_sets_threads():
+    """Without dask, "local" is a spawn process pool; its workers get the same settings."""
+    from ipmc_asym.executors import _on_pool
+
+    out = _on_pool(_env_of_worker, [0, 1, 2], 2, 1, ("leading",))
+    assert out == [("1", "1", 1)] * 3
