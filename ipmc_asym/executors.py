@@ -201,7 +201,9 @@ def run_chunks(func, tasks, scheduler=None, workers: int | None = None, threads:
 
 def _on_client(client, func, tasks, threads, fidelities):
     client.run(worker_setup, threads, fidelities)
-    futures = client.map(func, tasks, pure=False)
+    # the chunks' data go straight to the workers (scatter), not inside the task graph
+    data = client.scatter(tasks)
+    futures = client.map(func, data, pure=False)
     return client.gather(futures)
 
 
