@@ -132,3 +132,10 @@ def test_chunked_sweep_row_order_3d_all_models():
     serial = sweep(vary, model="all", fidelity="corrected", progress=False)
     chunked = sweep_chunked(vary, None, seconds_per_point=0.04, workers=2, model="all", fidelity="corrected")
     _same(serial, chunked)
+
+
+def test_tcp_address_of_an_existing_cluster(client):
+    """``--scheduler tcp://HOST:PORT``: connect to a running scheduler by its address."""
+    addr = client.scheduler.address
+    assert addr.startswith("tcp://")
+    assert run_chunks(abs, [-3, -1, -2], scheduler=addr) == [3, 1, 2]
