@@ -345,6 +345,11 @@ def _saltelli(D, N, seed):
     return np.clip(U, eps, 1.0 - eps)
 
 
+#: rough cost of one sample (moment + beam) by fidelity, s: sizes scheduler chunks (>= 100 ms);
+#: None = per-sample escalation (mostly leading/corrected)
+_SECONDS_PER_SAMPLE = {"leading": 2e-7, "corrected": 2.5e-7, "quadrature": 2e-6, None: 5e-7}
+
+
 #: batches of the batch-means confidence interval of the Sobol' indices
 SOBOL_BATCHES = 32
 
@@ -392,7 +397,7 @@ def _sobol_indices(y, names, N, batches=SOBOL_BATCHES):
 
 
 def run_uq(scene, samples: int = 10**6, *, seed: int = 0, fidelity: str | None = None, scheduler=None,
-           chunk_rows: int = CHUNK_ROWS) -> UQResult:
+           chunk_rows: int | None = None) -> UQResult:
     """Quantiles, moments and Sobol' indices of a scene's outputs under its ``[uncertain]`` inputs.
 
     Parameters
@@ -408,8 +413,10 @@ def run_uq(scene, samples: int = 10**6, *, seed: int = 0, fidelity: str | None =
         Force one rung (e.g. ``"leading"``); default: per-sample escalation by tolerance.
     scheduler : None, "local", "tcp://HOST:PORT" or Client
         Where the chunks run (:func:`ipmc_asym.executors.run_chunks`); results identical.
-    chunk_rows : int
-        Samples per chunk (memory of the temporaries is bounded by this).
+    chunk_rows : int, optional
+        Samples per chunk.  Default: ``settings.CHUNK_ROWS`` in this process (bounds the
+        memory of the temporaries); on a scheduler, chunks of >= 100 ms of work (at most
+        4 per worker, at most 2^20 rows) by :func:`ipmc_asym.executors.chunk_slices`.
 
     Returns
     -------
@@ -435,11 +442,17 @@ def run_uq(scene, samples: int = 10**6, *, seed: int = 0, fidelity: str | None =
     for k in ("length", "width", "thickness", "modulus", "c_moy"):
         if np.any(cols[k] <= 0):
             raise ValueError(f"uq: sampled {k} <= 0 ({int(np.sum(cols[k] <= 0))} samples); narrow its distribution")
-    tasks = []
-    for a in range(0, n, chunk_rows):
-        sl = slice(a, min(a + chunk_rows, n))
-        tasks.append(({k: cols[k][sl] for k in cols}, tuple(outputs), model, material, tol, fidelity))
-    from .executors import run_chunks
+    from .executors import chunk_slices, run_chunks
+
+    if chunk_rows is not None:
+        slices = [slice(a, min(a + int(chunk_rows), n)) for a in range(0, n, int(chunk_rows))]
+    elif scheduler is None:
+        slices = [slice(a, min(a + CHUNK_ROWS, n)) for a in range(0, n, CHUNK_ROWS)]
+    else:
+        import os
+
+        slices = chunk_slices(n, _SECONDS_PER_SAMPLE.get(fidelity, 1e-6), os.cpu_count() or 1, max_items=2**20)
+    tasks = [({k: cols[k][sl] for k in cols}, tuple(outputs), model, material, tol, fidelity) for sl in slices]
 
     t_eval0 = time.perf_counter()
     parts = run_chunks(uq_chunk, tasks, scheduler=scheduler)
