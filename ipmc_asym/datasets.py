@@ -47,8 +47,17 @@ VARIABLES = {
     "error": ("1", "relative error estimate of I"),
     "valid": ("1", "fidelity within its validity (1) or not (0)"),
     "regime": ("", "beam regime (small, large, past-quarter-turn, multi-turn)"),
+    "max_strain": ("1", "largest bending strain e|kappa|"),
+    "fidelity_used": ("", "fidelity the point was computed at (after escalation)"),
+    "escalated": ("1", "escalated above the requested fidelity (1) or not (0)"),
+    "check_electrochemistry": ("1", "check: a valid rung of the fidelity ladder (1) or none (0)"),
+    "check_layer_separation": ("1", "check: electrode layers separated by a neutral core"),
+    "check_beam_regime": ("1", "check: free strip within a quarter turn"),
+    "check_strain": ("1", "check: bending strain within the small-strain limit"),
 }
-_SWEEP_OUT = ("I", "M_A", "theta", "w", "w_small", "F_block", "F_block_small", "B1", "error", "valid", "regime")
+_SWEEP_OUT = ("I", "M_A", "theta", "w", "w_small", "F_block", "F_block_small", "B1", "error", "max_strain",
+              "fidelity_used", "escalated", "regime", "check_electrochemistry", "check_layer_separation",
+              "check_beam_regime", "check_strain", "valid")
 
 
 def _label(da, name):
@@ -109,6 +118,8 @@ def sweep_dataset(arr: np.ndarray, vary: dict, *, base=None, material=None):
         coords[k] = _label(xr.DataArray(a, dims=(k,)), k)
     dv = {}
     for k in _SWEEP_OUT:
+        if k not in arr.dtype.names:
+            continue
         col = arr[k]
         if col.dtype == bool:
             col = col.astype(np.int8)

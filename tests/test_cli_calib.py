@@ -80,3 +80,31 @@ def test_uq_bad_scene_exit_2(tmp_path, capsys):
     with pytest.raises(SystemExit) as ei:  # argparse: one line, status 2
         main(["uq", str(p), "--samples", "0"])
     assert ei.value.code == 2
+
+
+def test_sweep_netcdf_out(tmp_path, capsys):
+    xr = pytest.importorskip("xarray")
+    from ipmc_asym.sweeps import sweep
+
+    nc = tmp_path / "s.nc"
+    assert main(["sweep", "--vary", "thickness=100um:300um:3", "--vary", "voltage=0.5V:2V:2", "--model", "all",
+                 "--fidelity", "corrected", "--out", str(nc), "--no-progress"]) == 0
+    with xr.open_dataset(nc) as ds:
+        # the same grid in the library (the CLI's parsed values, e.g. 100 * 1e-6, from the file)
+        arr = sweep({"thickness": ds["thickness"].values, "voltage": ds["voltage"].values}, "all", "corrected",
+                    progress=False)
+        assert ds["thickness"].attrs["long_name"] == "total thickness 2e"
+        got = ds["I"].sel(model="linear").values.ravel()
+        np.testing.assert_array_equal(got, arr["I"][arr["model"] == "linear"])
+        assert ds.attrs["fidelity"] == "corrected"
+
+
+def test_sweep_scheduler_local_identical_csv(tmp_path, capsys):
+    pytest.importorskip("distributed")
+    a, b = tmp_path / "a.csv", tmp_path / "b.csv"
+    common = ["sweep", "--vary", "thickness=100um:300um:3", "--vary", "voltage=0.5V:2V:3", "--fidelity",
+              "leading", "--no-progress"]
+    assert main(common + ["--out", str(a)]) == 0
+    assert main(common + ["--out", str(b), "--scheduler", "local"]) == 0
+    assert a.read_text() == b.read_text()
+    assert main(common + ["--scheduler", "udp://x"]) == 2

@@ -41,8 +41,11 @@ def register(sub):
     p.add_argument("--max-rows", type=count_type("--max-rows"), default=MAX_ROWS,
                    help=f"refuse a sweep of more rows than this (default {MAX_ROWS:.0e}, settings.MAX_ROWS)")
     p.add_argument("--out", default=None,
-                   help="output file, written in chunks and atomically: .json for JSON, CSV otherwise "
-                        "(SI columns; default: stdout)")
+                   help="output file, written in chunks and atomically: .json for JSON, .nc for a labelled "
+                        "NetCDF dataset (xarray; held in memory), CSV otherwise (SI columns; default: stdout)")
+    p.add_argument("--scheduler", default=None, metavar="local|tcp://HOST:PORT",
+                   help="run the sweep's chunks on dask.distributed (results identical to the serial run; "
+                        "held in memory)")
     p.add_argument("--json", action="store_true",
                    help='JSON {"rows": [...], "fits": [...]} on stdout (with --out F.csv: a summary only)')
     p.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
@@ -106,6 +109,10 @@ def run(args) -> int:
     vary = {k: vary_values(*sp[1:]) for k, sp in specs.items()}
     if args.out:
         check_output_path(args.out, "file")
+    if args.scheduler is not None:
+        from ..executors import check_scheduler
+
+        check_scheduler(args.scheduler)
     # deferred: the compiled kernels load only once the sweep is known to be accepted
     from ..sweeps import iter_sweep, withhold, write_csv, write_json
 
@@ -117,9 +124,23 @@ def run(args) -> int:
     with warnings.catch_warnings(), np.errstate(all="ignore"):
         # no NumPy RuntimeWarning with internal paths: non-finite results are columns/notes
         warnings.simplefilter("ignore", RuntimeWarning)
-        chunks = (withhold(c, copy=False) for c in iter_sweep(vary, args.model, args.fidelity, base, mat, args.tol,
-                                                  escalate=not args.no_escalate, progress=bar,
-                                                  failures=failures))
+        to_nc = bool(args.out) and args.out.lower().endswith(".nc")
+        if args.scheduler is not None or to_nc:
+            # the whole grid in memory: a NetCDF dataset is written at once, and distributed
+            # chunks come back as arrays (refused above --max-rows like every sweep)
+            from ..executors import sweep_chunked
+
+            arr = sweep_chunked(vary, args.scheduler, model=args.model, fidelity=args.fidelity, base=base,
+                                material=mat, tol=args.tol, escalate=not args.no_escalate)
+            bar.update(arr.size)
+            bad = ~arr["check_electrochemistry"]
+            if np.any(bad):
+                failures.append(f"{int(bad.sum())} row(s) with no valid rung of the fidelity ladder")
+            chunks = [withhold(arr, copy=False)]
+        else:
+            chunks = (withhold(c, copy=False) for c in iter_sweep(vary, args.model, args.fidelity, base, mat, args.tol,
+                                                      escalate=not args.no_escalate, progress=bar,
+                                                      failures=failures))
         try:
             fits, notes = _fits(vary, args, base, mat)
 
@@ -127,7 +148,12 @@ def run(args) -> int:
                 return {"fits": fits, "fit_notes": notes, "seconds": time.perf_counter() - t0}
 
             to_json_file = bool(args.out) and args.out.lower().endswith(".json")
-            if args.out and to_json_file:
+            if to_nc:
+                from ..datasets import sweep_dataset, write_netcdf
+
+                write_netcdf(sweep_dataset(chunks[0], vary, base=base, material=mat), args.out)
+                rows = chunks[0].size
+            elif args.out and to_json_file:
                 with atomic_write(args.out) as fh:
                     rows = write_json(chunks, fh, {"n_rows": n}, tail)
             elif args.out:
