@@ -277,7 +277,8 @@ def test_every_command_with_a_voltage_option_accepts_negative_values():
         ap, _ = build_parser(name)
         sub = next(a for a in ap._actions if a.dest == "command").choices[name]
         if any("--voltage" in a.option_strings for a in sub._actions):
-            base = ["scene", "x.toml"] if name == "scene" else [name]
+            # commands with required arguments get them
+            base = {"scene": ["scene", "x.toml"], "fit": ["fit", "d.csv", "--free", "modulus"]}.get(name, [name])
             args = ap.parse_args(join_negative_values(base + ["--voltage", "-1V"]))
             assert args.voltage == -1.0, name
 
