@@ -41,6 +41,8 @@ import time
 
 import numpy as np
 
+from .registry import FIDELITIES, fidelity_names
+
 __all__ = ["run_chunks", "chunk_slices", "warm_kernels", "worker_setup", "BLAS_ENV", "MIN_CHUNK_SECONDS",
            "check_scheduler", "time_per_item", "sweep_chunked"]
 
@@ -63,7 +65,11 @@ def check_scheduler(scheduler):
     raise ValueError(f"--scheduler must be local or tcp://HOST:PORT; got {scheduler!r}")
 
 
-def warm_kernels(fidelities=("leading", "corrected", "quadrature")) -> float:
+#: the compiled rungs (kernel order >= 0 in the registry): what workers may call
+COMPILED = tuple(f for f in fidelity_names() if FIDELITIES[f].order >= 0)
+
+
+def warm_kernels(fidelities=COMPILED) -> float:
     """Compile (or load from the cache) every kernel a chunk may call; returns seconds.
 
     Called in the parent before workers start, so the on-disk Numba cache is complete and
@@ -71,24 +77,23 @@ def warm_kernels(fidelities=("leading", "corrected", "quadrature")) -> float:
     """
     t0 = time.perf_counter()
     from .integral import moment
+    from .integral_samples import moment_samples
     from .registry import model_names
 
-    from .integral_samples import moment_samples
-
-    order = {"leading": 1, "corrected": 2, "quadrature": 0}
     one = np.ones(1)
     for f in fidelities:
         for m in model_names():
-            if f == "quadrature" and m != model_names()[0]:
-                continue  # one quadrature kernel serves every model (rho is an argument)
+            if not FIDELITIES[f].closed_form and m != model_names()[0]:
+                continue  # one kernel serves every model (rho is an argument)
             moment(np.array([200e-6]), np.array([1.0]), m, f)
         # the per-sample driver of ipmc_asym.uq (same signature for every model)
-        moment_samples(0.01 * one, 40.0 * one, 0.3 * one, 1.0, 0 if f != "quadrature" else -1, order[f], one,
+        mid = 0 if FIDELITIES[f].closed_form else -1
+        moment_samples(0.01 * one, 40.0 * one, 0.3 * one, 1.0, mid, FIDELITIES[f].order, one,
                        np.empty(1), np.empty(1), np.empty(1))
     return time.perf_counter() - t0
 
 
-def worker_setup(threads: int = 1, fidelities=("leading", "corrected", "quadrature")) -> dict:
+def worker_setup(threads: int = 1, fidelities=COMPILED) -> dict:
     """Per-worker set-up: thread counts explicit, kernels loaded once (cache read).
 
     On a host whose cache is cold (remote worker), a file lock beside the cache serialises
@@ -151,7 +156,7 @@ def chunk_slices(n: int, seconds_per_item: float, workers: int = 1,
 
 
 def run_chunks(func, tasks, scheduler=None, workers: int | None = None, threads: int = 1,
-               fidelities=("leading", "corrected", "quadrature")) -> list:
+               fidelities=COMPILED) -> list:
     """``[func(t) for t in tasks]`` on ``scheduler`` (see module docstring), in order.
 
     Parameters
@@ -263,8 +268,7 @@ def sweep_chunked(vary: dict, scheduler=None, *, seconds_per_point: float | None
                 sub = {names[0]: first[i:i + 1], names[1]: second[j0:j0 + per]}
                 sub.update({k: axes[k] for k in names[2:]})
                 tasks.append((sub, kw))
-    fids = ("leading", "corrected", "quadrature")
-    parts = run_chunks(_sweep_task, tasks, scheduler, workers=workers, threads=threads, fidelities=fids)
+    parts = run_chunks(_sweep_task, tasks, scheduler, workers=workers, threads=threads)
     if nmod == 1:
         return np.concatenate(parts)
     # several models: each chunk is model-major; regroup so the rows follow the serial order

@@ -22,9 +22,10 @@ Uncertain names: ``length``, ``width`` (TOTAL 2l), ``thickness`` (TOTAL 2e), ``v
 ``modulus``, ``c_moy``.  A normal distribution must keep a positive quantity positive: its
 mean must be >= 6 sd (the 1e-9 tail is then cut by nothing; otherwise refused).
 
-Fidelity: each sample is escalated ``leading -> corrected -> quadrature`` until its error
-estimate is below the scene's ``tolerance`` (like scenes); a sample still outside after
-``quadrature`` is refused (the BVP at 10^6 samples is not an option) with one line.  The
+Fidelity: each sample is escalated along the compiled rungs of the registry
+(``leading -> corrected -> quadrature -> exact``) until its error estimate is below the
+scene's ``tolerance`` (like scenes); a sample still outside is refused with one line (the
+BVP at 10^6 samples is not an option).  The
 blocking force uses the small-displacement ``3M/(2L)`` where its relative deviation
 ``(kappa L)^2/3360`` (times 1.05 to cover the next terms for ``|kappa L| <= 2``) is within
 the tolerance, the large-displacement root otherwise; the tip deflection is always the arc.
@@ -45,11 +46,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .integral import closed_model_id
+from .integral import _ANY_THICKNESS, closed_model_id, validity_limit
 from .integral_samples import moment_samples
 from .params import moment_scale, second_moment
-from .registry import fidelity_names
-from .settings import CHUNK_ROWS, VALIDITY_LIMIT
+from .registry import FIDELITIES, fidelity_names
+from .settings import CHUNK_ROWS
 
 __all__ = ["UNCERTAIN", "DISTRIBUTIONS", "OUTPUT_UNITS", "UQResult", "parse_uncertain", "run_uq",
            "evaluate_samples", "uq_chunk"]
@@ -77,7 +78,8 @@ OUTPUT_UNITS = {
     "rotation": ("rad", "free-end rotation theta"),
     "blocking_force": ("N", "blocking force F"),
 }
-_CLOSED = ("leading", "corrected")
+#: the compiled rungs (a kernel order in the registry), cheapest first: the sampling ladder
+SAMPLING_FIDELITIES = tuple(f for f in fidelity_names() if FIDELITIES[f].order >= 0)
 
 
 # ---- scene ----------------------------------------------------------------------------------
@@ -192,18 +194,21 @@ def evaluate_samples(cols: dict, outputs, model, material, tol, fidelity=None):
     err = np.full(n, np.inf)
     core = np.empty(n)
     todo = np.arange(n)
-    ladder = [fidelity] if fidelity else [f for f in fidelity_names() if f != "bvp"]
+    ladder = [fidelity] if fidelity else list(SAMPLING_FIDELITIES)
     counts = {}
-    order = {"leading": 1, "corrected": 2, "quadrature": 0}
     for fid in ladder:
-        if fid == "bvp":
-            raise ValueError("uq: fidelity 'bvp' is not available for sampling (use quadrature)")
+        if fid not in SAMPLING_FIDELITIES:
+            raise ValueError(f"uq: fidelity {fid!r} is not available for sampling; use one of "
+                             f"{', '.join(SAMPLING_FIDELITIES)}")
         if todo.size == 0:
             break
         mid = closed_model_id(perm, fid)
         Ii, ei, ci = np.empty(todo.size), np.empty(todo.size), np.empty(todo.size)
-        moment_samples(lam[todo], A2[todo], A3[todo], rho, mid, order[fid], sign[todo], Ii, ei, ci)
-        ok = (ei <= tol) & (ei < VALIDITY_LIMIT) & (ci > 0)
+        moment_samples(lam[todo], A2[todo], A3[todo], rho, mid, FIDELITIES[fid].order, sign[todo], Ii, ei, ci)
+        # the same validity as integral.moment: the rung's limit, and separate layers unless
+        # the rung holds at any thickness (exact)
+        with np.errstate(invalid="ignore"):
+            ok = (ei <= tol) & (ei < validity_limit(fid)) & ((ci > 0) | (fid in _ANY_THICKNESS)) & np.isfinite(Ii)
         I[todo], err[todo], core[todo] = Ii, ei, ci
         counts[fid] = int(np.count_nonzero(ok))
         todo = todo[~ok]
@@ -347,7 +352,7 @@ def _saltelli(D, N, seed):
 
 #: rough cost of one sample (moment + beam) by fidelity, s: sizes scheduler chunks (>= 100 ms);
 #: None = per-sample escalation (mostly leading/corrected)
-_SECONDS_PER_SAMPLE = {"leading": 2e-7, "corrected": 2.5e-7, "quadrature": 2e-6, None: 5e-7}
+_SECONDS_PER_SAMPLE = {"leading": 2e-7, "corrected": 2.5e-7, "quadrature": 2e-6, "exact": 2e-5, None: 5e-7}
 
 
 #: batches of the batch-means confidence interval of the Sobol' indices
