@@ -46,7 +46,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .integral import _ANY_THICKNESS, closed_model_id, validity_limit
+from .integral import ANY_THICKNESS, closed_model_id, validity_limit
 from .integral_samples import moment_samples
 from .params import moment_scale, second_moment
 from .registry import FIDELITIES, fidelity_names
@@ -208,7 +208,7 @@ def evaluate_samples(cols: dict, outputs, model, material, tol, fidelity=None):
         # the same validity as integral.moment: the rung's limit, and separate layers unless
         # the rung holds at any thickness (exact)
         with np.errstate(invalid="ignore"):
-            ok = (ei <= tol) & (ei < validity_limit(fid)) & ((ci > 0) | (fid in _ANY_THICKNESS)) & np.isfinite(Ii)
+            ok = (ei <= tol) & (ei < validity_limit(fid)) & ((ci > 0) | (fid in ANY_THICKNESS)) & np.isfinite(Ii)
         I[todo], err[todo], core[todo] = Ii, ei, ci
         counts[fid] = int(np.count_nonzero(ok))
         todo = todo[~ok]
