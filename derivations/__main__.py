@@ -20,9 +20,11 @@ def main(argv=None) -> int:
         if not args.check:  # printing never rewrites the kernels (e.g. inside site-packages)
             return 0
     if args.check:
-        return codegen.check()
+        rc = codegen.check()
+        return codegen.check_charge() or rc  # issue 11: the charge kernels too
     path = codegen.write()
     print(f"wrote {path}")
+    print(f"wrote {codegen.write_charge()}")
     return 0
 
 

@@ -20,7 +20,8 @@ __all__ = ["jit", "jit_parallel", "prange", "CACHE_DIR"]
 def hashed_sources() -> list:
     """The modules that define jitted functions (and what they inline)."""
     here = Path(__file__).resolve().parent
-    return sorted([here / "_jit.py", here / "integral.py", *(here / "kernels").glob("*.py")])
+    return sorted([here / "_jit.py", here / "integral.py", here / "electrode.py", here / "circuit.py",
+                   *(here / "kernels").glob("*.py")])
 
 
 def _cache_dir() -> str:

@@ -1,0 +1,1 @@
+"""Reduced nonlinear-capacitor model (placeholder, filled below)."""
