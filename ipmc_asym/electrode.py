@@ -288,5 +288,8 @@ def _bvp(th, v, perm, mat):
         d1 = (f[1] - f[-1]) / (2 * h)
         d2 = (f[2] - f[-2]) / (4 * h)
         cd[idx] = (4 * d1 - d2) / 3  # Richardson: O(h^4)
-        errc[idx] = abs(d1 - d2) / abs(cd[idx]) / 3 + 4 * BVP_STATED_ERROR * abs(sig[idx] + 1e-300) / (h * abs(cd[idx]))
+        if cd[idx] == 0.0:  # below the resolution of the difference quotient: no relative bound
+            errc[idx] = math.inf
+        else:
+            errc[idx] = (abs(d1 - d2) / 3 + 4 * BVP_STATED_ERROR * abs(sig[idx]) / h) / abs(cd[idx])
     return sig, cd, err, errc, core
