@@ -56,6 +56,7 @@ DYNAMIC_NOTES = (
 
 STEP_FIDELITIES = ("circuit", "pnp")
 WAVEFORMS = ("step", "ramp", "sine")
+FREQ_METHODS = ("pnp-linear", "circuit")
 
 
 def core_resistance(thickness, material: Material = NAFION_LI):
@@ -359,8 +360,10 @@ class FrequencyResult:
     Z : ndarray complex (n,)  impedance of the strip (electrode area 2l L), Ohm
     Z_area : ndarray complex  impedance per unit area, Ohm m^2
     H_w : ndarray complex     tip deflection per volt (small displacements), m/V
-    w_amp, w_phase : ndarray  |H_w| (m/V), arg H_w (rad; w < 0 for phi0 > 0 gives phase pi at DC)
+    w_amp, w_phase : ndarray  |H_w| (m/V), arg H_w (rad; w < 0 for phi0 > 0 gives phase pi at DC);
+                              H_w is the layers' (quasi-static) moment at the layer voltage phi0 - R J
     tau : float ; method : str ; model : str ; notes : list
+    H_w_profiles : ndarray complex or None   pnp-linear only: transfer of the full profile moment
     """
 
     f: np.ndarray
@@ -373,9 +376,10 @@ class FrequencyResult:
     method: str
     model: str
     notes: list
+    H_w_profiles: object = None
 
 
-FREQ_METHODS = ("pnp-linear", "circuit")
+
 
 
 def frequency_response(f, *, strip: Strip | None = None, model="constant", material: Material | None = None,
@@ -414,17 +418,24 @@ def frequency_response(f, *, strip: Strip | None = None, model="constant", mater
     # tip deflection per volt, small displacements: w = -M L^2/(2 E I_p),
     # M per volt = 6 l e^2 C_moy F (1 + A3) * (moment transfer)
     k_w = -s.length**2 / (2.0 * m.E * s.I_p) * 6.0 * s.l * e * e * m.C_moy * m.F * (1.0 + A3)
+    R = float(core_resistance(s.thickness, m))
+    # DC transfer: the static moment slope at 0 V, I(0+) = (1 + A3)(lam coth(1/lam) - lam^2)
+    h0 = k_w * float(GC.moment_transfer_hat(np.array([1e-12]), lam)[0].real)
     if method == "pnp-linear":
         W = omega * e * e / m.D
         Za = (e / kappa) * GC.impedance_hat(W, lam)
-        Hw = k_w * GC.moment_transfer_hat(W, lam)
+        Hprof = k_w * GC.moment_transfer_hat(W, lam)
     else:
-        R = float(core_resistance(s.thickness, m))
         C0 = 0.5 * capacitance_scale(perm, m)
         Za = R + 1.0 / (1j * omega * C0)
-        # DC transfer: the static moment slope at 0 V, I(0+) = (1 + A3)(lam coth(1/lam) - lam^2)
-        h0 = k_w * float(GC.moment_transfer_hat(np.array([1e-12]), lam)[0].real)
-        Hw = h0 / (1.0 + 1j * omega * tau)
+        Hprof = None
+    # the layers' moment follows the voltage across them, u = phi0 - R J = phi0 (1 - R/Z)
+    Hw = h0 * (1.0 - R / Za)
     area = s.width * s.length
+    notes = list(DYNAMIC_NOTES)
+    if Hprof is not None:
+        notes.append("H_w_profiles: the moment of the linearised profiles, p' = (C + A3) E, which adds the pressure "
+                     "gradient of the ohmic core field (-> (1 + A3)/3 per unit psi0 at high frequency, ~1/(3 lambda) "
+                     "times the static slope); with the solvent at rest nothing relaxes it -- water flow would")
     return FrequencyResult(f=f, Z=Za / area, Z_area=Za, H_w=Hw, w_amp=np.abs(Hw), w_phase=np.angle(Hw), tau=tau,
-                           method=method, model=perm.name, notes=list(DYNAMIC_NOTES))
+                           method=method, model=perm.name, notes=notes, H_w_profiles=Hprof)

@@ -70,16 +70,27 @@ def make_fv_mesh(lam: float, A2max: float, rho: float, *, cells_per_debye: float
                  h_core: float = 0.02) -> np.ndarray:
     """Faces ``X`` (ascending, ``X[0] = -1``, ``X[-1] = 1``) graded into both electrode layers.
 
-    Uniform cells ``lambda/cells_per_debye`` over the layer (depletion zone
-    ``lambda sqrt(2 rho (A2 - 1))`` twice, plus 12 Debye lengths), then geometric growth by
-    ``ratio`` up to ``h_core`` in the neutral core.
+    At each face the first cell is ``lambda/(cells_per_debye sqrt(B1))`` (the local Debye
+    length of the accumulation layer, ``B1 = C/C_moy`` at the cathode for ``A2max``), growing
+    by ``1 + (ratio - 1)/2`` to ``lambda/cells_per_debye``, uniform over the depletion zone
+    (``lambda sqrt(2 rho (A2 - 1))``) plus 12 Debye lengths, then growing by ``ratio`` up to
+    ``h_core`` in the neutral core.  Symmetric (either face may be the cathode).
     """
-    h0 = lam / cells_per_debye
+    from .kernels._generated import b1_exact
+
+    b1 = float(b1_exact(A2max, rho)) if A2max > 0 else 1.0
+    h1 = lam / cells_per_debye
+    h = h1 / math.sqrt(max(b1, 1.0))
+    hs = []
+    r_layer = 1.0 + 0.5 * (ratio - 1.0)
+    while h < h1:
+        hs.append(h)
+        h *= r_layer
     width = lam * (2.0 * math.sqrt(2.0 * rho * max(A2max - 1.0, 0.0)) + 12.0)
     width = min(width, 0.4)
-    n0 = int(math.ceil(width / h0))
-    hs = [h0] * n0
-    h = h0
+    n0 = int(math.ceil(max(width - sum(hs), 0.0) / h1))
+    hs += [h1] * n0
+    h = h1
     while h < h_core:
         h = min(h * ratio, h_core)
         hs.append(h)
@@ -108,7 +119,8 @@ class TransientResult:
     M_A_profiles : ndarray (n,)  moment from the transient profiles, ``p' = (C + A3) E`` (N m),
         which includes the pressure gradient of the ohmic core field (see notes)
     total_charge : ndarray (n,)  ``int (c - 1) dx`` (dimensionless; 0 by construction)
-    c : ndarray (n, cells)  concentration profiles ``C/C_moy``; x : ndarray (cells,) centres ``z/e``
+    c : ndarray (n, cells)  concentration profiles ``C/C_moy``; x : ndarray (cells,) centres ``z/e``;
+    faces : ndarray (cells + 1,)  cell faces ``z/e``
     success : bool ; message : str ; extra : dict (mesh, energy balance, nfev, njev)
     """
 
@@ -121,6 +133,7 @@ class TransientResult:
     total_charge: np.ndarray
     c: np.ndarray
     x: np.ndarray
+    faces: np.ndarray
     success: bool
     message: str
     extra: dict = field(default_factory=dict)
@@ -176,7 +189,7 @@ class _Problem:
 
 
 def solve_transient(t, phi0_fun, strip: Strip, model="constant", material: Material = NAFION_LI, *,
-                    cells_per_debye: float = 4.0, ratio: float = 1.08, h_core: float = 0.02,
+                    cells_per_debye: float = 4.0, ratio: float = 1.08, h_core: float = 0.02, refine: float = 1.0,
                     rtol: float = 1e-8, atol: float = 1e-12, method: str = "BDF", energy: bool = False,
                     profiles: bool = False, moment: bool = True) -> TransientResult:
     """Integrate the transient Nernst-Planck/Gauss problem from the uncharged state at ``t = 0``.
@@ -190,6 +203,9 @@ def solve_transient(t, phi0_fun, strip: Strip, model="constant", material: Mater
     strip : Strip ; model : "constant" / "affine" or Permittivity ; material : Material
     cells_per_debye, ratio, h_core : float
         Mesh (:func:`make_fv_mesh`); the layer zone is sized for ``max |phi0|`` on ``t``.
+    refine : float
+        Refines the whole mesh: ``cells_per_debye * refine``, ``(ratio - 1)/refine``,
+        ``h_core/refine`` (self-convergence studies).
     rtol, atol : float
         solve_ivp tolerances (``atol`` on ``S``, in units of ``e``).
     method : {"BDF", "Radau"}
@@ -224,7 +240,9 @@ def solve_transient(t, phi0_fun, strip: Strip, model="constant", material: Mater
     lam = float(debye_length(strip.thickness, perm.eps_moy, m))
     rho = perm.eps0 / perm.eps_moy
     A2max = float(np.max(np.abs(phi0_fun(np.linspace(tt[0], tt[-1], 2001))))) / VT
-    X = make_fv_mesh(lam, A2max, rho, cells_per_debye=cells_per_debye, ratio=ratio, h_core=h_core)
+    check_positive("refine", refine)
+    X = make_fv_mesh(lam, A2max, rho, cells_per_debye=cells_per_debye * refine, ratio=1.0 + (ratio - 1.0) / refine,
+                     h_core=h_core / refine)
     A3 = -m.rho2 * m.Z3 / (m.C_moy * m.F)
 
     def psi0(th):
@@ -246,7 +264,7 @@ def solve_transient(t, phi0_fun, strip: Strip, model="constant", material: Mater
         return TransientResult(t=tt, sigma=np.full(tt.size, np.nan), current_density=np.full(tt.size, np.nan),
                                layer_voltage=np.full(tt.size, np.nan), M_A=np.full(tt.size, np.nan),
                                M_A_profiles=np.full(tt.size, np.nan), total_charge=np.full(tt.size, np.nan),
-                               c=np.empty((0, P.N)), x=P.xc, success=False, message=str(sol.message),
+                               c=np.empty((0, P.N)), x=P.xc, faces=P.X, success=False, message=str(sol.message),
                                extra={"cells": P.N, "seconds": secs})
     sig_scale = e * m.phi4 * m.F * m.C_moy
     nt = tt.size
@@ -311,7 +329,7 @@ def solve_transient(t, phi0_fun, strip: Strip, model="constant", material: Mater
                            "unit": "e phi4 C_moy R T per unit area (J/m^2)",
                            "scale_J_per_m2": e * m.phi4 * m.C_moy * m.R * m.T}
     res = TransientResult(t=tt, sigma=sigma, current_density=Jsi, layer_voltage=u, M_A=np.full(nt, np.nan),
-                          M_A_profiles=Mscale * Mprof, total_charge=qtot, c=cs, x=P.xc, success=True,
+                          M_A_profiles=Mscale * Mprof, total_charge=qtot, c=cs, x=P.xc, faces=P.X, success=True,
                           message=str(sol.message), extra=extra)
     if moment:
         from .circuit import quasi_static_mechanics

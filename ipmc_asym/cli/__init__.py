@@ -28,6 +28,9 @@ COMMANDS = {
     "sweep": "sweep",
     "validate": "validate",
     "figures": "figures",
+    "charge": "charge",
+    "step": "step",
+    "freq": "freq",
 }
 
 #: one-line summaries for ``ipmc-asym --help`` without importing every command module
@@ -41,6 +44,9 @@ SUMMARIES = {
     "sweep": "evaluate the strip on a grid of parameters",
     "validate": "each claim of the paper vs our numbers, with a verdict",
     "figures": "regenerate the paper's Figs 4-10 (+ speed/accuracy) as PNG",
+    "charge": "electrode charge, differential capacitance and apparent permittivity (static)",
+    "step": "charging transient after a voltage step: sigma, current, moment, w vs time",
+    "freq": "small-signal impedance and tip-deflection/voltage transfer function",
 }
 
 
