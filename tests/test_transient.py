@@ -57,14 +57,14 @@ def test_long_time_limit_is_the_static_charge():
 
 
 def test_mesh_self_convergence():
-    """Whole-mesh refinement by 2 and 4: second-order differences, and the limit is the static charge."""
+    """Whole-mesh refinement by 2: second-order convergence to the static charge, and sigma(tau) settles."""
     t = np.array([0.0, TAU, 30 * TAU])
     s = [_pnp(0.1, t, cells_per_debye=1, refine=rf, rtol=1e-10, atol=1e-14).sigma for rf in (1, 2, 4)]
-    d1, d2 = abs(s[0][1] - s[1][1]), abs(s[1][1] - s[2][1])
-    assert d2 < d1 / 3  # ~4 for second order
     ref = float(charge(S0.thickness, 0.1, "constant").sigma)
     e = [abs(x[-1] / ref - 1) for x in s]
-    assert e[2] < e[1] / 3 < e[0] / 9
+    assert e[1] < e[0] / 3 and e[2] < e[1] / 3  # ~4 for second order
+    d1, d2 = abs(s[0][1] - s[1][1]), abs(s[1][1] - s[2][1])
+    assert d2 < d1 / 3
 
 
 def test_time_step_self_convergence():
