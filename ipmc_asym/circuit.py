@@ -330,7 +330,10 @@ def step_response(voltage=1.0, duration=None, *, strip: Strip | None = None, mod
         sigma, J, u = r.sigma, r.current_density, r.layer_voltage
         success, message = r.success, r.message
         extra = r.extra
-        notes.append("pnp: M_A(t) from the transient profiles (p' = (C + A3) E); layer_voltage = phi0 - R J")
+        notes.append("pnp: M_A(t) is the layers' quasi-static moment at V(sigma(t)); the moment of the transient "
+                     "profiles (p' = (C + A3) E, which adds the pressure gradient of the ohmic core field) is in "
+                     "extra['M_A_profiles']")
+        extra = dict(extra, M_A_profiles=r.M_A_profiles)
     if fidelity == "circuit":
         M, th, w, Fb = quasi_static_mechanics(u, s, perm, m)
     else:
@@ -358,7 +361,7 @@ class FrequencyResult:
     Z_area : ndarray complex  impedance per unit area, Ohm m^2
     H_w : ndarray complex     tip deflection per volt (small displacements), m/V
     w_amp, w_phase : ndarray  |H_w| (m/V), arg H_w (rad; w < 0 for phi0 > 0 gives phase pi at DC);
-                              H_w is the layers' (quasi-static) moment at the layer voltage phi0 - R J
+                              H_w is the layers' (quasi-static) moment at the layer voltage V(sigma)
     tau : float ; method : str ; model : str ; notes : list
     H_w_profiles : ndarray complex or None   pnp-linear only: transfer of the full profile moment
     """
@@ -426,8 +429,8 @@ def frequency_response(f, *, strip: Strip | None = None, model="constant", mater
         C0 = 0.5 * capacitance_scale(perm, m)
         Za = R + 1.0 / (1j * omega * C0)
         Hprof = None
-    # the layers' moment follows the voltage across them, u = phi0 - R J = phi0 (1 - R/Z)
-    Hw = h0 * (1.0 - R / Za)
+    # the layers' moment follows their charge: u = V(sigma) = sigma/C_d(0) = J/(i omega C_d(0))
+    Hw = h0 / (1j * omega * 0.5 * capacitance_scale(perm, m) * Za)
     area = s.width * s.length
     notes = list(DYNAMIC_NOTES)
     if Hprof is not None:

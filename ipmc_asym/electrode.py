@@ -38,7 +38,7 @@ from .registry import MODELS as _MODEL_SPECS
 from .registry import check_choice, fidelity_names
 from .settings import BVP_STATED_ERROR, VALIDITY_LIMIT
 
-__all__ = ["ChargeResult", "charge", "charge_scale", "capacitance_scale", "charge_hat_point",
+__all__ = ["ChargeResult", "charge", "layer_voltage", "charge_scale", "capacitance_scale", "charge_hat_point",
            "CLOSED_TRUNCATION"]
 
 #: rounding of the closed forms (B1, Dhat, chat are cancellation-free): relative
@@ -293,3 +293,26 @@ def _bvp(th, v, perm, mat):
         else:
             errc[idx] = (abs(d1 - d2) / 3 + 4 * BVP_STATED_ERROR * abs(sig[idx]) / h) / abs(cd[idx])
     return sig, cd, err, errc, core
+
+
+def layer_voltage(sigma, model="constant", material: Material | None = None):
+    """``V(sigma)``: the static voltage at which the electrode charge is ``sigma`` (C/m^2), vectorised.
+
+    Newton on the closed form from ``V = 0`` (``sigma(V)`` is increasing and concave for
+    ``V > 0``, so the iterates increase monotonically onto the root); odd in ``sigma``.
+    Raises ``ValueError`` where ``|sigma|`` exceeds the saturation charge of the linear model.
+    """
+    perm = get_model(model)
+    mat = NAFION_LI if material is None else material
+    sg = np.asarray(sigma, dtype=float)
+    target = np.abs(sg)
+    if perm.eps0 == 0.0 and np.any(target >= charge_scale(perm, mat)):
+        raise ValueError("sigma must be below the saturation charge S of the linear model")
+    x = np.zeros_like(target)
+    for _ in range(100):
+        r = charge(1.0, x, perm, "corrected", material=mat)
+        dx = (target - r.sigma) / r.C_diff
+        x = x + dx
+        if np.all(np.abs(dx) <= 1e-14 * (1.0 + np.abs(x))):
+            break
+    return np.sign(sg) * x

@@ -71,7 +71,9 @@ def make_fv_mesh(lam: float, A2max: float, rho: float, *, cells_per_debye: float
     """Faces ``X`` (ascending, ``X[0] = -1``, ``X[-1] = 1``) graded into both electrode layers.
 
     At each face the first cell is ``lambda/(cells_per_debye sqrt(B1))`` (the local Debye
-    length of the accumulation layer, ``B1 = C/C_moy`` at the cathode for ``A2max``), growing
+    length of the accumulation layer, ``B1 = C/C_moy`` at the cathode for ``A2max``) -- or, for
+    ``rho = eps0/eps_core < 1``, ``lambda sqrt(rho)/cells_per_debye`` over the depletion zone
+    (where ``eps -> eps0``) --, growing
     by ``1 + (ratio - 1)/2`` to ``lambda/cells_per_debye``, uniform over the depletion zone
     (``lambda sqrt(2 rho (A2 - 1))``) plus 12 Debye lengths, then growing by ``ratio`` up to
     ``h_core`` in the neutral core.  Symmetric (either face may be the cathode).
@@ -80,9 +82,16 @@ def make_fv_mesh(lam: float, A2max: float, rho: float, *, cells_per_debye: float
 
     b1 = float(b1_exact(A2max, rho)) if A2max > 0 else 1.0
     h1 = lam / cells_per_debye
-    h = h1 / math.sqrt(max(b1, 1.0))
-    hs = []
     r_layer = 1.0 + 0.5 * (ratio - 1.0)
+    hs = []
+    if rho < 1.0:
+        # eps -> eps0 in the depletion zone: local Debye length lambda sqrt(rho) over its width
+        hd = lam * math.sqrt(rho) / cells_per_debye
+        wd = lam * (math.sqrt(2.0 * rho * max(A2max - 1.0, 0.0)) + 4.0 * math.sqrt(rho))
+        hs += [hd] * int(math.ceil(wd / hd))
+        h = hd
+    else:
+        h = h1 / math.sqrt(max(b1, 1.0))  # local Debye length of the accumulation layer
     while h < h1:
         hs.append(h)
         h *= r_layer
@@ -114,7 +123,7 @@ class TransientResult:
     t : ndarray (n,) s
     sigma : ndarray (n,)  charge of the face z = -e, C/m^2
     current_density : ndarray (n,)  dsigma/dt, A/m^2
-    layer_voltage : ndarray (n,)  phi0 - R J (V): the voltage left across the layers
+    layer_voltage : ndarray (n,)  V(sigma) (V): the static voltage of the layers carrying sigma
     M_A : ndarray (n,)  quasi-static layer moment at ``layer_voltage`` (N m)
     M_A_profiles : ndarray (n,)  moment from the transient profiles, ``p' = (C + A3) E`` (N m),
         which includes the pressure gradient of the ohmic core field (see notes)
@@ -310,8 +319,9 @@ def solve_transient(t, phi0_fun, strip: Strip, model="constant", material: Mater
     from .circuit import core_resistance
 
     R = float(core_resistance(strip.thickness, m))
-    phi = phi0_fun(tt)
-    u = phi - R * Jsi
+    from .electrode import layer_voltage
+
+    u = layer_voltage(sigma, perm, m)
     Mscale = 6.0 * strip.l * e * e * m.C_moy * m.R * m.T
     extra = {"cells": P.N, "h_min_over_debye": float(P.h.min() / lam), "nfev": int(sol.nfev),
              "njev": int(sol.njev), "seconds": secs, "rtol": rtol, "method": method}
