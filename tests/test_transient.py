@@ -148,3 +148,24 @@ def test_small_signal_against_a_small_sine_in_the_pnp_solver():
 def test_linear_model_refused_by_the_pnp_solver():
     with pytest.raises(ValueError, match="linear"):
         solve_transient(np.array([0.0, TAU]), waveform("step", 1.0), S0, "linear", NAFION_LI)
+
+
+def test_charge_claims_rows_follow_their_criteria():
+    from ipmc_asym.charge_studies import charge_claims
+
+    rows = {r["key"]: r for r in charge_claims()}
+    cap, tim = rows["capacitance_permittivity"], rows["characteristic_time"]
+    for r in (cap, tim):
+        assert r["verdict"] in ("reproduced", "differs") and r["criterion"]
+    e0 = cap["numbers"]["eps_app_0V"]
+    # eps_app(0 V) = eps_core e / lambda_D, independently of the charge code
+    from ipmc_asym.params import debye_length
+
+    for m in ("constant", "linear", "affine"):
+        lam = float(debye_length(S0.thickness, MODELS[m].eps_moy, NAFION_LI))
+        assert e0[m] == pytest.approx(MODELS[m].eps_moy / lam, rel=1e-9)
+    ok = all(1e-4 <= e0[m] <= 1e-2 for m in ("linear", "affine"))
+    assert cap["verdict"] == ("reproduced" if ok else "differs")
+    tau = tim["numbers"]["tau"]["constant"]
+    assert tau == pytest.approx(TAU)
+    assert tim["verdict"] == ("reproduced" if 1 / 3 <= tau <= 3 else "differs")
