@@ -4,7 +4,11 @@ Matched asymptotics of the transient Nernst-Planck/Gauss problem (``ipmc_asym.tr
 the two electrode layers stay quasi-static (each in its static state for the charge it
 carries) while the neutral core carries an ohmic current.  Per unit electrode area::
 
-    R dsigma/dt = phi0(t) - V(sigma),        V = inverse of the static sigma(phi0) (electrode.py)
+    R dsigma_L/dt = phi0(t) - V(sigma_L),     V = inverse of the static sigma(phi0) (electrode.py)
+
+plus the displacement charge of the bulk (a leaky dielectric, relaxation time ``lambda^2 e^2/D``,
+instantaneous on the scale ``tau``): ``sigma = sigma_L + C_g (phi0 - V(sigma_L))``,
+``C_g = eps_core/(2e)`` (``C_g/C_d(0) = lambda``; it is what a step charges at ``t = 0+``).
 
 ``R = 2e/kappa`` with the core conductivity ``kappa = phi4 F^2 D C_moy/(R T)``: the paper's
 Nernst law (seed paper eq. "Nernst", solvent at rest, pressure term neglected as in §5) gives
@@ -266,9 +270,16 @@ def circuit_response(t, phi0_fun, strip: Strip, perm: Permittivity, material: Ma
     rho = perm.eps0 / perm.eps_moy
     _integrate(tt, ps, rho, _model_id(perm, "corrected"), _GL_X, _GL_W, A, s)
     A, s = A[idx], s[idx]
-    sigma = charge_scale(perm, m) * s
     u = VT * A
-    J = (phi0_fun(t) - u) / float(core_resistance(strip.thickness, m))
+    # the bulk is a leaky dielectric: besides the layers' charge the electrodes carry the
+    # displacement charge C_g (phi0 - u) of the core, C_g = eps_core/(2e) (its relaxation time
+    # R C_g = lambda^2 e^2/D is instantaneous on the scale tau); C_g/C_d(0) = lambda
+    Cg = perm.eps_moy / strip.thickness
+    ub = phi0_fun(t) - u
+    sigma = charge_scale(perm, m) * s + Cg * ub
+    J = ub / float(core_resistance(strip.thickness, m))
+    if t.size > 2:
+        J = J + Cg * np.gradient(ub, t)
     return sigma, u, J
 
 
