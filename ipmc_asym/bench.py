@@ -206,7 +206,9 @@ def _bvp_sample(model, th, v):
 #: takes ``quick: bool`` and returns ``{"figures": [{"what", "value", "unit", "target", "pass",
 #: "note"}, ...], ...}``: figures measured side by side in one run, as ratios where a target is
 #: a ratio.  Adding a section is adding one line here.
-SECTIONS: dict[str, str] = {}
+SECTIONS: dict[str, str] = {
+    "charge": "ipmc_asym.charge_studies:bench_section",  # issue 11: charge, step circuit/pnp
+}
 
 
 def run_sections(names=None, quick: bool = False) -> dict:

@@ -41,7 +41,17 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ._jit import jit
-from .electrode import _GL_W, _GL_X, _model_id, capacitance_scale, charge_hat_point, charge_scale
+from .electrode import (
+    _GL_W,
+    _GL_X,
+    _model_id,
+    capacitance_scale,
+    charge_hat_point,
+    charge_scale,
+    core_resistance,
+    layer_voltage,
+    time_constant,
+)
 from .kernels import _generated_charge as GC
 from .params import D_CATION_SOURCE, NAFION_LI, Material, Strip, check_finite, check_positive, debye_length
 from .permittivity import Permittivity, get_model
@@ -61,19 +71,6 @@ DYNAMIC_NOTES = (
 STEP_FIDELITIES = ("circuit", "pnp")
 WAVEFORMS = ("step", "ramp", "sine")
 FREQ_METHODS = ("pnp-linear", "circuit")
-
-
-def core_resistance(thickness, material: Material = NAFION_LI):
-    """``R = 2e/kappa`` (Ohm m^2), ``kappa = phi4 F^2 D C_moy/(R T)`` (S/m); thickness TOTAL 2e."""
-    m = material
-    kappa = m.phi4 * m.F**2 * m.D * m.C_moy / (m.R * m.T)
-    return np.asarray(thickness, dtype=float) / kappa
-
-
-def time_constant(thickness, model="constant", material: Material = NAFION_LI):
-    """``tau = R C_d(0) = e lambda_D / D`` (s); thickness TOTAL 2e."""
-    perm = get_model(model)
-    return core_resistance(thickness, material) * 0.5 * capacitance_scale(perm, material)
 
 
 def waveform(kind, voltage, *, ramp_time=None, frequency=None):
@@ -338,23 +335,15 @@ def step_response(voltage=1.0, duration=None, *, strip: Strip | None = None, mod
         r = solve_transient(tgrid, fun, s, perm, m, **(pnp_options or {}))
         if not r.success:
             raise RuntimeError(f"transient PNP solver failed: {r.message}")
-        sigma, J, u = r.sigma, r.current_density, r.layer_voltage
+        sigma, J = r.sigma, r.current_density
+        u = layer_voltage(sigma, perm, m)
         success, message = r.success, r.message
         extra = r.extra
         notes.append("pnp: M_A(t) is the layers' quasi-static moment at V(sigma(t)); the moment of the transient "
                      "profiles (p' = (C + A3) E, which adds the pressure gradient of the ohmic core field) is in "
                      "extra['M_A_profiles']")
         extra = dict(extra, M_A_profiles=r.M_A_profiles)
-    if fidelity == "circuit":
-        M, th, w, Fb = quasi_static_mechanics(u, s, perm, m)
-    else:
-        M = r.M_A
-        from .beam import blocking_force_large, rotation, tip_deflection
-
-        EI = m.E * s.I_p
-        th = np.asarray(rotation(M, s.length, EI), dtype=float)
-        w = np.asarray(tip_deflection(M, s.length, EI), dtype=float)
-        Fb = np.asarray(blocking_force_large(M, s.length, EI), dtype=float)
+    M, th, w, Fb = quasi_static_mechanics(u, s, perm, m)
     return StepResult(t=tgrid, phi0=fun(tgrid), sigma=sigma, current_density=J, layer_voltage=u, M_A=M,
                       theta=th, w=w, F_block=Fb, tau=tau, R=R, C_d0=0.5 * capacitance_scale(perm, m),
                       fidelity=fidelity, model=perm.name, notes=notes, success=success, message=message,

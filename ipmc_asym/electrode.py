@@ -38,7 +38,7 @@ from .registry import MODELS as _MODEL_SPECS
 from .registry import check_choice, fidelity_names
 from .settings import BVP_STATED_ERROR, VALIDITY_LIMIT
 
-__all__ = ["ChargeResult", "charge", "layer_voltage", "charge_scale", "capacitance_scale", "charge_hat_point",
+__all__ = ["ChargeResult", "charge", "layer_voltage", "core_resistance", "time_constant", "charge_scale", "capacitance_scale", "charge_hat_point",
            "CLOSED_TRUNCATION"]
 
 #: rounding of the closed forms (B1, Dhat, chat are cancellation-free): relative
@@ -316,3 +316,16 @@ def layer_voltage(sigma, model="constant", material: Material | None = None):
         if np.all(np.abs(dx) <= 1e-14 * (1.0 + np.abs(x))):
             break
     return np.sign(sg) * x
+
+
+def core_resistance(thickness, material: Material = NAFION_LI):
+    """``R = 2e/kappa`` (Ohm m^2), ``kappa = phi4 F^2 D C_moy/(R T)`` (S/m); thickness TOTAL 2e."""
+    m = material
+    kappa = m.phi4 * m.F**2 * m.D * m.C_moy / (m.R * m.T)
+    return np.asarray(thickness, dtype=float) / kappa
+
+
+def time_constant(thickness, model="constant", material: Material = NAFION_LI):
+    """``tau = R C_d(0) = e lambda_D / D`` (s); thickness TOTAL 2e."""
+    perm = get_model(model)
+    return core_resistance(thickness, material) * 0.5 * capacitance_scale(perm, material)

@@ -124,7 +124,6 @@ class TransientResult:
     sigma : ndarray (n,)  charge of the face z = -e, C/m^2
     current_density : ndarray (n,)  dsigma/dt, A/m^2
     layer_voltage : ndarray (n,)  V(sigma) (V): the static voltage of the layers carrying sigma
-    M_A : ndarray (n,)  quasi-static layer moment at ``layer_voltage`` (N m)
     M_A_profiles : ndarray (n,)  moment from the transient profiles, ``p' = (C + A3) E`` (N m),
         which includes the pressure gradient of the ohmic core field (see notes)
     total_charge : ndarray (n,)  ``int (c - 1) dx`` (dimensionless; 0 by construction)
@@ -137,7 +136,6 @@ class TransientResult:
     sigma: np.ndarray
     current_density: np.ndarray
     layer_voltage: np.ndarray
-    M_A: np.ndarray
     M_A_profiles: np.ndarray
     total_charge: np.ndarray
     c: np.ndarray
@@ -224,7 +222,7 @@ def solve_transient(t, phi0_fun, strip: Strip, model="constant", material: Mater
     profiles : bool
         Keep ``c`` at every output time.
     moment : bool
-        Compute the moments (needs the closed-form moment at the layer voltage).
+        Compute ``layer_voltage`` = V(sigma) (closed-form inversion); the profile moment is always computed.
 
     Returns
     -------
@@ -271,7 +269,7 @@ def solve_transient(t, phi0_fun, strip: Strip, model="constant", material: Mater
     secs = time.perf_counter() - t0
     if not sol.success or sol.y.shape[1] != tt.size:
         return TransientResult(t=tt, sigma=np.full(tt.size, np.nan), current_density=np.full(tt.size, np.nan),
-                               layer_voltage=np.full(tt.size, np.nan), M_A=np.full(tt.size, np.nan),
+                               layer_voltage=np.full(tt.size, np.nan),
                                M_A_profiles=np.full(tt.size, np.nan), total_charge=np.full(tt.size, np.nan),
                                c=np.empty((0, P.N)), x=P.xc, faces=P.X, success=False, message=str(sol.message),
                                extra={"cells": P.N, "seconds": secs})
@@ -316,12 +314,9 @@ def solve_transient(t, phi0_fun, strip: Strip, model="constant", material: Mater
             cs[k] = c
     sigma = sig_scale * d0
     Jsi = sig_scale * J / tscale
-    from .circuit import core_resistance
-
-    R = float(core_resistance(strip.thickness, m))
     from .electrode import layer_voltage
 
-    u = layer_voltage(sigma, perm, m)
+    u = layer_voltage(sigma, perm, m) if moment else np.full(nt, np.nan)
     Mscale = 6.0 * strip.l * e * e * m.C_moy * m.R * m.T
     extra = {"cells": P.N, "h_min_over_debye": float(P.h.min() / lam), "nfev": int(sol.nfev),
              "njev": int(sol.njev), "seconds": secs, "rtol": rtol, "method": method}
@@ -338,11 +333,7 @@ def solve_transient(t, phi0_fun, strip: Strip, model="constant", material: Mater
                            "relative_residual": abs(supplied - stored - dissipated) / abs(supplied),
                            "unit": "e phi4 C_moy R T per unit area (J/m^2)",
                            "scale_J_per_m2": e * m.phi4 * m.C_moy * m.R * m.T}
-    res = TransientResult(t=tt, sigma=sigma, current_density=Jsi, layer_voltage=u, M_A=np.full(nt, np.nan),
+    res = TransientResult(t=tt, sigma=sigma, current_density=Jsi, layer_voltage=u,
                           M_A_profiles=Mscale * Mprof, total_charge=qtot, c=cs, x=P.xc, faces=P.X, success=True,
                           message=str(sol.message), extra=extra)
-    if moment:
-        from .circuit import quasi_static_mechanics
-
-        res.M_A = quasi_static_mechanics(u, strip, perm, m)[0]
     return res
