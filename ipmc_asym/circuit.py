@@ -49,7 +49,6 @@ from .electrode import (
     charge_hat_point,
     charge_scale,
     core_resistance,
-    layer_voltage,
     time_constant,
 )
 from .kernels import _generated_charge as GC
@@ -112,7 +111,7 @@ class StepResult:
     phi0 : ndarray (n,)           applied voltage, V
     sigma : ndarray (n,)          charge of the face z = -e, C/m^2
     current_density : ndarray     dsigma/dt, A/m^2
-    layer_voltage : ndarray       voltage across the two electrode layers, V (circuit: V(sigma))
+    layer_voltage : ndarray       voltage across the two electrode layers, V (circuit: V(sigma_L); pnp: phi0 - R J)
     M_A, theta, w, F_block : ndarray   moment (N m), rotation (rad), tip deflection (m),
                                   blocking force (N), quasi-static
     tau : float                   linear time constant R C_d(0), s
@@ -336,10 +335,12 @@ def step_response(voltage=1.0, duration=None, *, strip: Strip | None = None, mod
         if not r.success:
             raise RuntimeError(f"transient PNP solver failed: {r.message}")
         sigma, J = r.sigma, r.current_density
-        u = layer_voltage(sigma, perm, m)
+        # the voltage left across the layers: phi0 minus the ohmic drop of the core (exact at
+        # t = 0+ and t -> infinity; the bulk's displacement current is O(lambda) of J)
+        u = fun(tgrid) - core_resistance(s.thickness, m) * J
         success, message = r.success, r.message
         extra = r.extra
-        notes.append("pnp: M_A(t) is the layers' quasi-static moment at V(sigma(t)); the moment of the transient "
+        notes.append("pnp: M_A(t) is the layers' quasi-static moment at the layer voltage phi0 - R J; the moment of the transient "
                      "profiles (p' = (C + A3) E, which adds the pressure gradient of the ohmic core field) is in "
                      "extra['M_A_profiles']")
         extra = dict(extra, M_A_profiles=r.M_A_profiles)
