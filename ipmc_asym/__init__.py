@@ -32,6 +32,9 @@ __all__ = [
     "solve_beam",
     "run_scene",
     "sweep",
+    "charge",
+    "step_response",
+    "frequency_response",
 ]
 
 _LAZY = {
@@ -49,6 +52,9 @@ _LAZY = {
     "solve_beam": ("ipmc_asym.beam", "solve_beam"),
     "run_scene": ("ipmc_asym.scenes", "run_scene"),
     "sweep": ("ipmc_asym.sweeps", "sweep"),
+    "charge": ("ipmc_asym.electrode", "charge"),
+    "step_response": ("ipmc_asym.circuit", "step_response"),
+    "frequency_response": ("ipmc_asym.circuit", "frequency_response"),
 }
 
 

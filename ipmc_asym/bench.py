@@ -210,6 +210,7 @@ SECTIONS: dict[str, str] = {
     "exact_api": "ipmc_asym.bench_exact:section",
     "uq": "ipmc_asym.uq:bench_section",
     "distributed": "ipmc_asym.executors:bench_section",
+    "charge": "ipmc_asym.charge_studies:bench_section",  # issue 11: charge, step circuit/pnp
 }
 
 

@@ -28,6 +28,8 @@ from .units import parse_pressure
 
 __all__ = [
     "C_MOY_PAPER",
+    "D_CATION_DEFAULT",
+    "D_CATION_SOURCE",
     "Material",
     "Strip",
     "Groups",
@@ -43,6 +45,16 @@ __all__ = [
     "MATERIAL_KEYS",
     "material_from_spec",
 ]
+
+#: Default cation diffusion coefficient (m^2/s) of the ``nafion-li`` preset and its source.
+D_CATION_DEFAULT = 1.0e-10
+D_CATION_SOURCE = (
+    "D = 1e-10 m^2/s: order of the measured self-diffusion coefficients of alkali cations in "
+    "fully hydrated Nafion 117 (radiotracer: A. Goswami et al., J. Phys. Chem. B 105 (2001) "
+    "9196; Li+ taken equal to Na+ within that order) and of the values used in PNP models of "
+    "Nafion IPMCs (S. Nemat-Nasser, J. Y. Li, J. Appl. Phys. 87 (2000) 3321); uncertain by a "
+    "factor ~3 either way: every dynamic time scales as 1/D"
+)
 
 #: The value the paper states (section 4) and uses; the formula with the quoted data gives
 #: about 3162 mol/m^3 (docs/design.md, slip 1).
@@ -83,6 +95,10 @@ class Material:
     T : float    absolute temperature, K
     F : float    Faraday constant, C/mol
     R : float    gas constant, J/(mol K)
+    D : float    diffusion coefficient of the cations in the liquid phase, m^2/s (not in the
+                 paper, which names it in its Nernst law but gives no value; used only by the
+                 dynamic models).  Default :data:`D_CATION_DEFAULT`, source
+                 :data:`D_CATION_SOURCE`.
     """
 
     Z3: float = -9.0e4
@@ -93,6 +109,7 @@ class Material:
     T: float = 300.0
     F: float = 96487.0
     R: float = 8.31
+    D: float = D_CATION_DEFAULT
     c_moy: object = "paper"
     name: str = "nafion-li"
 
@@ -109,6 +126,7 @@ class Material:
         check_positive("temperature T", self.T, "K")
         check_positive("Faraday constant F", self.F, "C/mol")
         check_positive("gas constant R", self.R, "J/(mol K)")
+        check_positive("cation diffusion coefficient D", self.D, "m^2/s")
         if isinstance(self.c_moy, str):
             if self.c_moy not in ("paper", "formula"):
                 raise ValueError(

@@ -537,6 +537,23 @@ def _none(why):
     return f
 
 
+def _charge_claim(key):
+    """Ours for the charge claims of issue 11 (:func:`ipmc_asym.charge_studies.charge_claims`)."""
+
+    def f(ctx):
+        from .charge_studies import charge_claims
+
+        rows = {r["key"]: r for r in charge_claims(ctx.m, ctx.s)}
+        r = rows[key]
+        if key == "capacitance_permittivity":
+            value = {mm: r["numbers"]["eps_app_0V"][mm] for mm in ("linear", "affine")}
+        else:
+            value = dict(r["numbers"]["tau"])
+        return Ours(value, r["ours"])
+
+    return f
+
+
 # the paper's numbers that several claims share
 CLAIM_PAPER = {"lit_w": (0.5, 1.5), "lit_F": (0.6, 1.3), "block_1pct": 0.01}
 
@@ -630,6 +647,16 @@ CLAIMS = (
     Claim("affine_zero", "§6.3", "affine model: the curves do not tend to 0 as phi0 -> 0", None, _affine_zero,
           Criterion("at_least", 0.5, "a nonzero limit leaves M_A nearly unchanged when phi0 -> phi0/10 near 0; "
                     "M_A ~ phi0 scales it by the same factor")),
+    # issue 11: what a capacitance measurement and a step would show
+    Claim("capacitance_permittivity", "§5",
+          "permittivity deduced from capacitance measurements ~{} F/m, of the order of the linear/affine values",
+          1e-3, _charge_claim("capacitance_permittivity"),
+          Criterion("factor", 10.0, "'of the order of': within a factor 10 of what a capacitance measurement on "
+                    "the modelled strip reports, eps_app = C_d 2e (small signal at 0 V)"), " F/m", over="model"),
+    Claim("characteristic_time", "introduction", "characteristic time of about {} s", 1.0,
+          _charge_claim("characteristic_time"),
+          Criterion("factor", 3.0, "'about one second': within a factor 3; tau = R C_d(0) = e lambda_D/D of the "
+                    "reduced model, D = Material.D (not in the paper: tau ~ 1/D)"), " s", over="model"),
 )
 
 

@@ -30,6 +30,9 @@ COMMANDS = {
     "figures": "figures",
     "fit": "fit",
     "uq": "uq",
+    "charge": "charge",
+    "step": "step",
+    "freq": "freq",
 }
 
 #: one-line summaries for ``ipmc-asym --help`` without importing every command module
@@ -45,6 +48,9 @@ SUMMARIES = {
     "figures": "regenerate the paper's Figs 4-10 (+ speed/accuracy) as PNG",
     "fit": "calibrate modulus, c_moy, permittivity on measured deflection/force (profile intervals)",
     "uq": "uncertainty quantiles and Sobol' indices of a scene's [uncertain] inputs",
+    "charge": "electrode charge, differential capacitance and apparent permittivity (static)",
+    "step": "charging transient after a voltage step: sigma, current, moment, w vs time",
+    "freq": "small-signal impedance and tip-deflection/voltage transfer function",
 }
 
 

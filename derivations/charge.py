@@ -1,0 +1,259 @@
+"""Electrode charge, differential capacitance and the small-signal response (issue 11).
+
+Seed paper section 4: Gauss's law ``dD_z/dz = rho Z``, ``D_z = eps E_z``; blocking electrodes
+carry the surface charge ``sigma = D_z(-e)`` (anode face, where ``phi0`` is applied; the
+cathode carries ``-D_z(e) = -sigma`` since ``D_z(e) = D_z(-e)``).  In the paper's scaling
+``D_bar = D_z/(e phi4 F C_moy)`` (``model.py``).  Results derived and checked here
+(``python -m derivations.charge``):
+
+1. The face induction terminates at first order in lambda (neutral core, K = 0):
+   ``D_bar(+-1) = lambda Dhat(Yc)`` EXACTLY, ``Dhat = sqrt(2 Hhat)`` (no lambda^2 term, unlike
+   the moment ``I = lambda J1 + lambda^2 J2``).  Hence
+   ``sigma = S Dhat(ln B1)``, ``S = e phi4 F C_moy lambda = sqrt(phi4 C_moy eps_core R T)``
+   (C/m^2): independent of the thickness (up to ``exp(-core/lambda)``).
+2. ``dDhat/dY = chat(Y) sign(Y)`` with the LAYER CAPACITANCE ``chat(Y) = exprel(Y) w(Y)``
+   (``w`` the layer integrand of ``model.py``; ``chat(0) = 1``; linear model ``chat = e^Y``),
+   and electroneutrality ``Hhat(Yc) = Hhat(Yc - A2)`` gives
+   ``dYc/dA2 = chat_a / (chat_c + chat_a)``.  So the differential capacitance per area is
+   two layers in series:  ``C_d = dsigma/dphi0 = (eps_core/lambda_D) Cdhat``,
+   ``Cdhat = chat_c chat_a / (chat_c + chat_a)``, ``lambda_D = lambda e``;
+   ``Cdhat -> 1/2`` (Debye-Hueckel: ``C_d = eps_core/(2 lambda_D)``).
+3. Linear model exactly (``model.linear_exact_solution``): ``D_bar(1) = z0 (B1 - 1) coth(1/z0)``,
+   ``B1 - 1 = tanh(A2/2)``: the closed form is ``lambda tanh(A2/2)``, off by
+   ``coth(1/lambda) - 1 ~ 2 exp(-2/lambda)``; ``Cdhat = sech^2(A2/2)/2``.
+4. Large voltage (``e^{-A2} -> 0`` at the anode): ``Dhat^2 -> (1 - rho) + 2 rho (A2 - 1 - ln B1)``
+   (the paper's table value of ``D(+-1)``): ``sigma ~ S sqrt(2 A2)`` for the constant model
+   (depletion zone, ``sigma ~ phi0^{1/2}``), ``S sqrt(2 rho A2)`` for the affine one, ``S`` for the
+   linear one (saturation).
+5. Small signal about zero volts, constant permittivity in the core (linearised Nernst-Planck
+   + Gauss, thermal scaling ``psi = F phi/(R T)``, time ``t D/e^2``, frequency ``W``): with
+   ``k^2 = 1/lambda^2 + i W`` the induction is ``d = J/k^2 + A cosh(k x)`` and
+   ``Zhat = psi0/J = (2/lambda^2) [1/k^2 + (1/(iW) - 1/k^2) tanh(k)/k]``;
+   SI: ``Z = (e/kappa) Zhat`` with the core conductivity ``kappa = phi4 F^2 D C_moy/(R T)``.
+   The moment ``int p z dz`` linearises to ``(1 + A3)/lambda^2 int d (1 - x^2)/2 dx`` (thermal
+   units), also closed form (``moment_transfer``).
+"""
+
+from __future__ import annotations
+
+import sympy as sp
+
+from . import model as M
+from .kernel import Kernel
+
+# ---- symbols -------------------------------------------------------------------------
+Y, y, A2, rho, lam = M.Y, M.y, M.A2, M.rho, M.lam
+B1 = M.B1
+W = sp.symbols("W", positive=True)  # dimensionless angular frequency  omega e^2 / D
+x = sp.symbols("x", real=True)
+Jc = sp.symbols("J")  # total current (complex amplitude)
+
+
+def face_induction():
+    """D(1)^2 = 2 H(Yc)/A2 (K = 0) equals lambda^2 * 2 Hhat(Yc): D(1) = lambda Dhat exactly."""
+    C = sp.exp(Y)
+    H = M.H_of_C(C)
+    Hhat = H.subs({M.A0: 1 - rho, M.A1: rho})
+    lam2 = (M.A0 + M.A1) / A2
+    lhs = 2 * H / A2
+    rhs = lam2 * 2 * Hhat
+    # with A0 = (A0 + A1)(1 - rho), A1 = (A0 + A1) rho
+    s = sp.symbols("s", positive=True)
+    check = sp.simplify((lhs - rhs).subs({M.A0: s * (1 - rho), M.A1: s * rho}).subs(
+        {rho: sp.Rational(1, 3)}))
+    assert check == 0
+    return sp.sqrt(2 * Hhat)
+
+
+def sigma_scale_check():
+    """e phi4 F C_moy lambda = sqrt(phi4 C_moy eps_core R T) with lambda^2 = eps_core R T/(e^2 phi4 F^2 C_moy)."""
+    e, phi4, F, Cm, eps, R, T = sp.symbols("e phi4 F C_moy eps R T", positive=True)
+    lamv = sp.sqrt(eps * R * T / (e**2 * phi4 * F**2 * Cm))
+    assert sp.simplify(e * phi4 * F * Cm * lamv - sp.sqrt(phi4 * Cm * eps * R * T)) == 0
+    # C_d scale: S F/(R T) = eps/lambda_D
+    lD = lamv * e
+    assert sp.simplify(sp.sqrt(phi4 * Cm * eps * R * T) * F / (R * T) - eps / lD) == 0
+    return True
+
+
+def layer_capacitance():
+    """chat(y) = exprel(y) w(y) and the check dDhat/dY = sign(Y) chat(Y) (Y != 0)."""
+    w, Q = M.w_layer()
+    chat = M.exprel(y) * w
+    # check against the derivative of Dhat = sqrt(2 Hhat), with the primitives expanded
+    Hhat = M.H_of_C(sp.exp(y)).subs({M.A0: 1 - rho, M.A1: rho})
+    dD = sp.diff(sp.sqrt(2 * Hhat), y)
+    chat_f = chat.subs({M.exprel(y): M.EXPREL_DEF, M.e2rel(y): M.E2REL_DEF})
+    for yv in (sp.Rational(-7, 2), sp.Rational(-1, 5), sp.Rational(3, 10), sp.Rational(5, 2)):
+        for rv in (0, sp.Rational(1, 3), 1):
+            sgn = 1 if yv > 0 else -1
+            r = (dD - sgn * chat_f).subs({y: yv, rho: rv})
+            assert abs(complex(sp.N(r, 30))) < 1e-25, (yv, rv)
+    # linear model: chat = e^y
+    lin = chat_f.subs(rho, 0)
+    for yv in (sp.Rational(-9, 2), sp.Rational(-1, 7), sp.Rational(2, 3), sp.Rational(7, 2)):
+        assert abs(complex(sp.N((lin - sp.exp(y)).subs(y, yv), 30))) < 1e-25
+    assert sp.limit(chat_f.subs(rho, sp.Rational(1, 3)), y, 0) == 1
+    return chat
+
+
+def series_capacitance():
+    """dYc/dA2 = chat_a/(chat_c + chat_a) from Hhat(Yc) = Hhat(Yc - A2); Cdhat = chat_c chat_a/(chat_c + chat_a)."""
+    cc, ca = sp.symbols("chat_c chat_a", positive=True)
+    # implicit differentiation with dHhat/dY = Dhat chat sign(Y) and Dhat(Yc) = Dhat(Ya):
+    # Dhat chat_c dYc = -Dhat chat_a (dYc - dA2)
+    dYc = sp.symbols("dYc")
+    sol = sp.solve(sp.Eq(cc * dYc, -ca * (dYc - 1)), dYc)[0]
+    assert sp.simplify(sol - ca / (cc + ca)) == 0
+    return (cc, ca), cc * sol
+
+
+def linear_exact():
+    """Linear model: exact D(1) and C_d from model.linear_exact_solution; closed-form ratio."""
+    Cz, b1, _ = M.linear_exact_solution()
+    z0 = [s for s in Cz.free_symbols if s.name == "z0"][0]
+    D = z0**2 * sp.diff(Cz, M.z)  # D = z0^2 C' in the linear model
+    D1 = sp.simplify(D.subs(M.z, 1).subs(B1, b1))
+    tanh_form = z0 * sp.tanh(A2 / 2) / sp.tanh(1 / z0)
+    assert sp.simplify((D1 - tanh_form).rewrite(sp.exp)) == 0
+    cd = sp.simplify(sp.diff(sp.tanh(A2 / 2), A2))
+    assert sp.simplify(cd - sp.sech(A2 / 2) ** 2 / 2) == 0
+    return D1.subs(z0, lam), tanh_form.subs(z0, lam)
+
+
+def large_voltage():
+    """Dhat^2 at the anode with C(-1) = B1 e^{-A2} -> 0 (ln C(-1) = ln B1 - A2 kept)."""
+    Bs = sp.symbols("B1", positive=True)
+    ca = sp.symbols("c_a", positive=True)
+    Hhat_a = (1 - rho) * (ca - 1) ** 2 / 2 + rho * (ca - 1 - (sp.log(Bs) - A2))
+    d2 = sp.expand(2 * Hhat_a.subs(ca, 0))
+    # the paper's table value D(+-1)^2 (model.table_of_values) divided by lambda^2
+    paper = (M.A0 + 2 * M.A1 * (A2 - 1 - sp.log(Bs))) / A2
+    s = sp.symbols("s", positive=True)
+    assert sp.simplify(paper.subs({M.A0: s * (1 - rho), M.A1: s * rho}) / (s / A2) - d2) == 0
+    # B1 in the same limit: constant A2, linear 2, affine the paper's root
+    b_inf = {
+        "constant": A2,
+        "linear": sp.Integer(2),
+        "affine": (1 - 2 * rho) / (1 - rho) * (1 + sp.sqrt(1 + 2 * A2 * rho * (1 - rho) / (1 - 2 * rho) ** 2)),
+    }
+    return d2, Bs, b_inf
+
+
+def large_voltage_sigma(model: str):
+    """(Dhat_inf(A2), dDhat_inf/dA2) for one model (rho fixed), SymPy expressions in A2."""
+    from .kernels_spec import MODEL_RHO
+
+    d2, Bs, b_inf = large_voltage()
+    r = MODEL_RHO[model]
+    expr = sp.sqrt(d2.subs(rho, r).subs(Bs, b_inf[model].subs(rho, r)))
+    return expr, sp.diff(expr, A2)
+
+
+def debye_hueckel_series(model: str, order: int = 5):
+    """Series of Dhat(ln B1(A2)) in A2 about 0 (B1 from the exact electroneutrality)."""
+    from .kernels_spec import MODEL_RHO
+
+    r = MODEL_RHO[model]
+    q, a, b, c = M.b1_quadratic_rho()
+    a, b, c = (sp.simplify(v.subs(rho, r)) for v in (a, b, c))
+    if a == 0:
+        root = -c / b
+    elif c == 0:
+        root = -b / a
+    else:
+        root = (-b + sp.sqrt(b**2 - 4 * a * c)) / (2 * a)
+    root = root.subs(q, 1 - sp.exp(-A2))
+    Hhat = M.H_of_C(sp.exp(Y)).subs({M.A0: 1 - r, M.A1: r})
+    # Dhat = sqrt(2 Hhat(Y)) = Y sqrt(2 Hhat/Y^2) for Y > 0 (cathode, Yc > 0 for A2 > 0)
+    Yc = sp.log(root)
+    g = sp.series(2 * Hhat / Y**2, Y, 0, order + 1).removeO()
+    Ys = sp.series(Yc, A2, 0, order + 1).removeO()
+    dh = sp.series(Ys * sp.sqrt(g.subs(Y, Ys)), A2, 0, order + 1).removeO()
+    return sp.expand(dh)
+
+
+def small_signal():
+    """Linearised PNP about zero volts: (Zhat(W), moment transfer Mhat(W)) per unit psi0.
+
+    d'' = k^2 d - J, d(+-1) = J/(iW) (blocking: N = J - iW d = 0 at the faces), d even.
+    Zhat = psi0/J with psi0 = int d dx / lambda^2.  The moment integral per unit psi0 in
+    thermal units: ``m = (1 + A3)/lambda^2 int d (1 - x^2)/2 dx / psi0``.
+    """
+    k = sp.symbols("k")
+    A = (Jc / (sp.I * W) - Jc / k**2) / sp.cosh(k)
+    d = Jc / k**2 + A * sp.cosh(k * x)
+    # checks: the ODE and the boundary values
+    assert sp.simplify(sp.diff(d, x, 2) - (k**2 * d - Jc)) == 0
+    assert sp.simplify(d.subs(x, 1) - Jc / (sp.I * W)) == 0
+    psi0 = sp.simplify(sp.integrate(d, (x, -1, 1), conds="none") / lam**2)
+    Zhat = sp.simplify(psi0 / Jc)
+    ref = (2 / lam**2) * (1 / k**2 + (1 / (sp.I * W) - 1 / k**2) * sp.tanh(k) / k)
+    for kv, lv, wv in ((sp.Rational(3, 2) + sp.I / 3, sp.Rational(1, 5), sp.Rational(7, 3)),
+                       (sp.Integer(4) + 2 * sp.I, sp.Rational(1, 9), sp.Rational(1, 2))):
+        r = (Zhat - ref).subs({k: kv, lam: lv, W: wv})
+        assert abs(complex(sp.N(r, 30))) < 1e-20
+    mom = sp.simplify(sp.integrate(d * (1 - x**2) / 2, (x, -1, 1), conds="none") / lam**2 / psi0)
+    # the same in tanh form (no e^{2k} overflow for k ~ 1/lambda ~ 1e3): a = A cosh(k)/J
+    a = 1 / (sp.I * W) - 1 / k**2
+    mom_stable = ((sp.Rational(2, 3) / k**2 + 2 * a * (1 / k**2 - sp.tanh(k) / k**3))
+                  / (2 / k**2 + 2 * a * sp.tanh(k) / k))
+    for kv, wv in ((sp.Rational(3, 2) + sp.I / 3, sp.Rational(7, 3)), (sp.Integer(4) + 2 * sp.I, sp.Rational(1, 2))):
+        r = (mom - mom_stable).subs({k: kv, W: wv, lam: sp.Rational(1, 5)})
+        assert abs(complex(sp.N(r, 30))) < 1e-20
+    return k, ref, mom_stable
+
+
+def small_signal_kernels():
+    """(name, args, expression, doc) of the small-signal closed forms (complex, NumPy)."""
+    k, Z, mom = small_signal()
+    kk = sp.sqrt(1 / lam**2 + sp.I * W)
+    return [
+        ("impedance_hat", (W, lam), Z.subs(k, kk),
+         "Zhat(W) = psi0/J of the linearised PNP about 0 V (constant core permittivity); Z = (e/kappa) Zhat."),
+        ("moment_transfer_hat", (W, lam), mom.subs(k, kk),
+         "int d (1 - x^2)/2 dx / (lambda^2 psi0): the moment integral per unit psi0 is (1 + A3) times this."),
+    ]
+
+
+def kernels():
+    """Charge kernels: layer capacitance (generic and per model) and the series capacitance."""
+    from .kernels_spec import MODEL_RHO
+
+    chat = layer_capacitance()
+    ks = [Kernel("layer_capacitance", (y, rho), (chat,),
+                 "Layer capacitance chat(y) = exprel(y) w(y) = |dDhat/dY| (chat(0) = 1).",
+                 "derivations.charge:layer_capacitance")]
+    for name, r in MODEL_RHO.items():
+        c = chat.subs(rho, r)
+        if r == 0:
+            c = sp.exp(y)  # exprel(y) w(y) = e^y exactly (checked in layer_capacitance)
+        ks.append(Kernel(f"layer_capacitance_{name}", (y,), (c,),
+                         f"Layer capacitance chat(y), {name} model (rho = {r}).",
+                         "derivations.charge:layer_capacitance"))
+    (cc, ca), cd = series_capacitance()
+    ks.append(Kernel("series_capacitance", (cc, ca), (cd,),
+                     "Cdhat = dDhat(ln B1)/dA2 = chat_c chat_a/(chat_c + chat_a) (layers in series).",
+                     "derivations.charge:series_capacitance"))
+    return ks
+
+
+def main():
+    print("face induction: D(+-1) = lambda * Dhat(Yc), Dhat =", face_induction())
+    print("sigma scale  e phi4 F C_moy lambda = sqrt(phi4 C_moy eps_core R T):", sigma_scale_check())
+    print("layer capacitance chat(y) =", layer_capacitance())
+    print("series: Cdhat =", series_capacitance()[1])
+    print("linear exact D(1) =", linear_exact()[0])
+    d2, _, _ = large_voltage()
+    print("large voltage Dhat^2 ->", d2)
+    for m in ("constant", "linear", "affine"):
+        print(f"  {m}: Dhat_inf =", large_voltage_sigma(m)[0])
+    print("Debye-Hueckel series (constant):", debye_hueckel_series("constant", 5))
+    k, Z, mom = small_signal()
+    print("small signal Zhat =", Z, " k^2 = 1/lam^2 + i W")
+    print("  low frequency: Zhat * iW ->", sp.limit((Z * sp.I * W).subs(k, sp.sqrt(1 / lam**2 + sp.I * W)), W, 0))
+    print("moment per psi0 =", mom)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,167 @@
+"""Static electrode charge and capacitance (issue 11): exact limits, the BVP, the derivation."""
+
+import math
+
+import mpmath as mp
+import numpy as np
+import pytest
+import sympy as sp
+
+import ipmc_asym
+from derivations import charge as DC
+from ipmc_asym.electrode import charge, charge_scale
+from ipmc_asym.kernels import _generated_charge as GC
+from ipmc_asym.params import NAFION_LI, debye_length
+from ipmc_asym.permittivity import MODELS
+
+M = NAFION_LI
+VT = M.R * M.T / M.F
+MODELS3 = ("constant", "linear", "affine")
+CLOSED = ("leading", "corrected", "quadrature")
+
+
+def test_public_functions_are_not_shadowed_by_submodules():
+    import importlib
+    import pkgutil
+
+    for mod in pkgutil.walk_packages(ipmc_asym.__path__, "ipmc_asym."):
+        if not mod.name.endswith("__main__"):
+            importlib.import_module(mod.name)
+    from ipmc_asym import circuit, electrode
+
+    assert ipmc_asym.charge is electrode.charge
+    assert ipmc_asym.step_response is circuit.step_response
+    assert ipmc_asym.frequency_response is circuit.frequency_response
+    assert callable(ipmc_asym.charge)
+
+
+rng = np.random.default_rng(11)
+
+
+@pytest.mark.parametrize("i", range(8))
+def test_layer_capacitance_kernel_matches_sympy(i):
+    chat = DC.layer_capacitance().subs({DC.M.exprel(DC.y): DC.M.EXPREL_DEF, DC.M.e2rel(DC.y): DC.M.E2REL_DEF})
+    yv = float(rng.uniform(-60, 6))
+    r = float(rng.uniform(0, 1))
+    ref = complex(chat.subs({DC.y: sp.Float(yv, 40), DC.rho: sp.Float(r, 40)}).evalf(30)).real
+    assert GC.layer_capacitance(yv, r) == pytest.approx(ref, rel=1e-12)
+    # and the derivative identity it encodes: |dDhat/dY| by a high-precision difference
+    Hh = lambda Y: mp.sqrt(2 * ((1 - r) * (mp.e**Y - 1) ** 2 / 2 + r * (mp.e**Y - 1 - Y)))  # noqa: E731
+    mp.mp.dps = 40
+    d = abs(mp.diff(Hh, mp.mpf(yv)))
+    assert GC.layer_capacitance(yv, r) == pytest.approx(float(d), rel=1e-11)
+
+
+@pytest.mark.parametrize("model", MODELS3)
+def test_debye_hueckel_limit_exact(model):
+    """C_d -> eps_core/(2 lambda_D) and sigma -> the SymPy series in A2 at small voltage."""
+    perm = MODELS[model]
+    lamD = float(debye_length(200e-6, perm.eps_moy, M)) * 100e-6
+    r = charge(200e-6, 1e-7, model, "corrected")
+    assert float(r.C_diff) == pytest.approx(perm.eps_moy / (2 * lamD), rel=1e-9)
+    assert float(r.eps_app) == pytest.approx(perm.eps_moy / (2 * lamD) * 200e-6, rel=1e-9)
+    ser = sp.lambdify(DC.A2, DC.debye_hueckel_series(model, 5))
+    for v in (1e-3, 5e-3, 2e-2):
+        A2 = v / VT
+        s = float(charge(200e-6, v, model).sigma) / charge_scale(perm, M)
+        assert s == pytest.approx(ser(A2), rel=3 * A2**6 + 1e-13)
+
+
+def test_linear_model_exact_solution():
+    """sigma = S tanh(A2/2) coth(1/lambda) (exact, any thickness); C_d = (S/V_T) sech^2(A2/2)/2."""
+    exact, _ = DC.linear_exact()
+    f = sp.lambdify((DC.A2, DC.lam), exact, "mpmath")
+    perm = MODELS["linear"]
+    S = charge_scale(perm, M)
+    for th in (50e-6, 200e-6, 1e-3):
+        lam = float(debye_length(th, perm.eps_moy, M))
+        for v in (0.01, 0.2, 1.0, -0.7):
+            A2 = abs(v) / VT
+            ref = math.copysign(S * float(f(mp.mpf(A2), mp.mpf(lam))) / lam, v)
+            for fid in CLOSED:
+                r = charge(th, v, "linear", fid)
+                assert float(r.sigma) == pytest.approx(ref, rel=max(float(r.error), 1e-13))
+            cd = S / VT * 0.5 / math.cosh(A2 / 2) ** 2
+            assert float(charge(th, v, "linear").C_diff) == pytest.approx(cd, rel=1e-12)
+
+
+@pytest.mark.parametrize("model", MODELS3)
+def test_large_voltage_asymptotics(model):
+    """Dhat^2 -> (1 - 3 rho) + 2 rho (A2 - ln B1) (the paper's table D(+-1)) when e^{-A2} -> 0."""
+    expr, dexpr = DC.large_voltage_sigma(model)
+    f = sp.lambdify(DC.A2, expr, "mpmath")
+    df = sp.lambdify(DC.A2, dexpr, "mpmath")
+    perm = MODELS[model]
+    S = charge_scale(perm, M)
+    for v in (2.0, 5.0, 10.0):
+        A2 = v / VT
+        r = charge(200e-6, v, model, "corrected")
+        assert float(r.sigma) / S == pytest.approx(float(f(mp.mpf(A2))), rel=1e-12)
+        if model != "linear":  # linear: C_d ~ 2 e^{-A2}, beyond the e^{-A2} -> 0 limit
+            assert float(r.C_diff) / (S / VT) == pytest.approx(float(df(mp.mpf(A2))), rel=1e-10)
+    if model == "constant":  # sigma ~ S sqrt(2 A2): the depletion zone, sigma ~ phi0^{1/2}
+        A2 = 1e4
+        s = float(charge(200e-6, A2 * VT, model).sigma) / S
+        assert s / math.sqrt(2 * A2) == pytest.approx(1 - (1 + math.log(A2)) / (2 * A2), rel=1e-5)
+
+
+@pytest.mark.parametrize("model", MODELS3)
+def test_every_fidelity_against_the_bvp_at_nominal(model):
+    ref = charge(200e-6, 1.0, model, "bvp")
+    for fid in CLOSED:
+        r = charge(200e-6, 1.0, model, fid)
+        assert abs(float(r.sigma) / float(ref.sigma) - 1) <= 1e-8
+        assert abs(float(r.sigma) / float(ref.sigma) - 1) <= float(r.error) + float(ref.error)
+        assert bool(r.valid)
+        if bool(ref.valid):  # linear at 1 V: C_d ~ 1e-13 F/m^2, below the BVP difference quotient
+            assert abs(float(r.C_diff) / float(ref.C_diff) - 1) <= float(ref.error_C_diff) + 1e-13
+
+
+@pytest.mark.parametrize("th,v", [(50e-6, 0.05), (1e-3, -3.0)])
+def test_sigma_within_stated_error_of_the_bvp(th, v):
+    for model in MODELS3:
+        ref = charge(th, v, model, "bvp")
+        for fid in CLOSED:
+            r = charge(th, v, model, fid)
+            rel = abs(float(r.sigma) / float(ref.sigma) - 1)
+            assert rel <= float(r.error) + float(ref.error)
+
+
+def test_odd_even_and_zero_volts():
+    v = np.array([-2.0, -0.3, 0.0, 0.3, 2.0])
+    for model in MODELS3:
+        r = charge(200e-6, v, model)
+        assert np.allclose(r.sigma, -r.sigma[::-1], rtol=1e-15, atol=0)
+        assert np.allclose(r.C_diff, r.C_diff[::-1], rtol=1e-15, atol=0)
+        assert r.sigma[2] == 0.0
+        assert r.Q[3] == pytest.approx(r.sigma[3] * 5e-3 * 0.02, rel=1e-15)
+
+
+def test_closed_form_is_the_layer_integral_on_a_grid():
+    """The quadrature rung (int_0^Yc chat dy, generic rho) reproduces Dhat(ln B1) closed forms."""
+    v = np.geomspace(1e-3, 10, 40)
+    for model in MODELS3:
+        a = charge(200e-6, v, model, "corrected").sigma
+        b = charge(200e-6, v, model, "quadrature").sigma
+        assert np.max(np.abs(a / b - 1)) < 1e-12
+
+
+def test_capacitance_is_the_derivative_of_the_charge():
+    """Analytic C_d against a Richardson difference quotient of the closed-form sigma."""
+    for model in MODELS3:
+        for v in (0.02, 0.3, 1.0):
+            h = 1e-4
+            s = {k: float(charge(200e-6, v + k * h, model).sigma) for k in (-2, -1, 1, 2)}
+            d = (8 * (s[1] - s[-1]) - (s[2] - s[-2])) / (12 * h)
+            assert float(charge(200e-6, v, model).C_diff) == pytest.approx(d, rel=1e-7)
+
+
+@pytest.mark.parametrize("kw,msg", [(dict(thickness=-1.0), "thickness"), (dict(fidelity="exactly"), "fidelity"),
+                                    (dict(width=0.0), "width"), (dict(voltage=float("nan")), "voltage")])
+def test_bad_input_one_line(kw, msg):
+    args = dict(thickness=200e-6, voltage=1.0)
+    args.update(kw)
+    th, v = args.pop("thickness"), args.pop("voltage")
+    with pytest.raises(ValueError, match=msg) as ei:
+        charge(th, v, **args)
+    assert "\n" not in str(ei.value)

@@ -1,0 +1,64 @@
+"""The charge/step/freq commands as a user runs them (issue 11)."""
+
+import csv
+import json
+
+import pytest
+
+from ipmc_asym.cli import main
+from ipmc_asym.electrode import charge
+
+
+def test_charge_json_keys_and_values(capsys):
+    assert main(["charge", "--json", "--voltage", "500mV", "--thickness", "150um"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["inputs"]["thickness_total"] == 150e-6 and out["inputs"]["half_thickness_e"] == 75e-6
+    assert [r["model"] for r in out["results"]] == ["constant", "linear", "affine"]
+    for r in out["results"]:
+        assert {"sigma", "Q", "C_diff", "eps_app"} <= set(r)
+        ref = charge(150e-6, 0.5, r["model"], "corrected")
+        assert r["sigma"] == pytest.approx(float(ref.sigma), rel=1e-14)
+        assert r["Q"] == pytest.approx(float(ref.sigma) * 5e-3 * 0.02, rel=1e-14)
+        assert r["eps_app"] == pytest.approx(float(ref.C_diff) * 150e-6, rel=1e-14)
+
+
+def test_step_json_and_csv(tmp_path, capsys):
+    assert main(["step", "--voltage", "0.5V", "--points", "50", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    for k in ("t", "phi0", "sigma", "current_density", "M_A", "theta", "w", "tau"):
+        assert k in out
+    assert len(out["t"]) == 50 and out["t"][-1] == pytest.approx(5 * out["tau"])
+    assert any("Darcy" in n for n in out["notes"]) and any("D = " in n for n in out["notes"])
+    f = tmp_path / "s.csv"
+    assert main(["step", "--voltage", "1V", "--duration", "20ms", "--points", "30", "--out", str(f)]) == 0
+    rows = list(csv.reader(f.open()))
+    assert rows[0][0].startswith("# tau =")
+    assert rows[1] == ["t", "phi0", "sigma", "current_density", "M_A", "theta", "w"]
+    assert len(rows) == 32 and float(rows[-1][0]) == pytest.approx(0.02)
+
+
+def test_freq_json(capsys):
+    assert main(["freq", "--from", "0.1Hz", "--to", "1kHz", "--points", "5", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    for k in ("f", "Z_re", "Z_im", "w_amp", "w_phase"):
+        assert len(out[k]) == 5
+    assert out["f"][0] == pytest.approx(0.1) and out["f"][-1] == pytest.approx(1e3)
+
+
+@pytest.mark.parametrize("args,word", [
+    (["charge", "--thickness", "0"], "thickness"),
+    (["charge", "--fidelity", "exact-ish"], "fidelity"),
+    (["step", "--duration", "-1s"], "duration"),
+    (["step", "--fidelity", "pnp", "--model", "linear", "--points", "3"], "linear"),
+    (["step", "--out", "/nonexistent-dir/x.csv"], "--out"),
+    (["freq", "--from", "10Hz", "--to", "1Hz"], "--to"),
+    (["freq", "--from", "0", "--to", "1Hz"], "--from"),
+    (["freq", "--to", "1Hz"], "--from"),
+])
+def test_bad_input_exit_2_one_line(args, word, capsys):
+    with pytest.raises(SystemExit) as ei:
+        rc = main(args)
+        raise SystemExit(rc)
+    assert ei.value.code == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and word in err
