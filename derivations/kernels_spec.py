@@ -84,6 +84,12 @@ def model_kernels():
         ks.append(Kernel(f"b1_{name}", (A2, em1), (root,),
                          f"Exact B1, {name} model (rho = {r}); em1 = expm1(-A2).",
                          "derivations.model:b1_quadratic_rho"))
+        # per-model Dhat(Y): used by the electrode charge (sigma = lam Dhat(ln B1))
+        dh = sp.simplify(M.dhat_stable().subs(M.rho, r))
+        if r == 0:
+            dh = sp.Abs(expm1(Y))  # |Y| exprel(Y) = |e^Y - 1|
+        ks.append(Kernel(f"dhat_{name}", (Y,), (dh,), f"Dhat(Y) = sqrt(2 Hhat(Y)), {name} model.",
+                         "derivations.model:dhat_stable"))
         # the same Dhat from C = B1 directly (no exp): sqrt(2 Hhat(C)), fine when C - 1 is not small
         Cs = sp.Symbol("C", positive=True)
         Hc = M.H_of_C(Cs).subs({M.A0: 1 - r, M.A1: r})

@@ -33,7 +33,6 @@ from .kernels import _generated_charge as GC
 from .kernels.special import gauss_legendre
 from .params import NAFION_LI, Material, Strip, check_positive
 from .permittivity import MODELS, Permittivity, get_model
-from .registry import FIDELITIES as _FIDELITY_SPECS
 from .registry import MODELS as _MODEL_SPECS
 from .registry import check_choice, fidelity_names
 from .settings import BVP_STATED_ERROR, VALIDITY_LIMIT

@@ -10,7 +10,6 @@ import json
 import math
 import os
 import pkgutil
-import resource
 import subprocess
 import sys
 import textwrap

@@ -306,6 +306,24 @@ def dhat(Y, rho):
 
 
 @jit
+def dhat_affine(Y):
+    """Dhat(Y) = sqrt(2 Hhat(Y)), affine model.
+
+    Derived in ``derivations.model:dhat_stable``.
+    """
+    return (1.0/201.0)*14.177446878757825*math.sqrt(e2rel(Y) + 200.0*exprel(Y)*exprel(Y))*abs(Y)
+
+
+@jit
+def dhat_constant(Y):
+    """Dhat(Y) = sqrt(2 Hhat(Y)), constant model.
+
+    Derived in ``derivations.model:dhat_stable``.
+    """
+    return math.sqrt(e2rel(Y))*abs(Y)
+
+
+@jit
 def dhat_from_c_affine(C, Y):
     """Dhat = sqrt(2 Hhat(C)) with C = e^Y given (use when |Y| > 1/2), affine model.
 
@@ -331,6 +349,15 @@ def dhat_from_c_linear(C, Y):
     Derived in ``derivations.model:H_of_C``.
     """
     return abs(C - 1.0)
+
+
+@jit
+def dhat_linear(Y):
+    """Dhat(Y) = sqrt(2 Hhat(Y)), linear model.
+
+    Derived in ``derivations.model:dhat_stable``.
+    """
+    return abs(math.expm1(Y))
 
 
 @jit
