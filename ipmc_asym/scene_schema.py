@@ -54,8 +54,9 @@ OUTPUTS = ("I", "moment", "tip_deflection", "rotation", "blocking_force", "profi
 #: the strip parameters a point has (SI; width and thickness TOTAL)
 AXES = ("length", "width", "thickness", "voltage")
 _DEFAULT_OUTPUTS = ("I", "moment", "tip_deflection", "rotation", "blocking_force")
+#: "uncertain" is read by ``ipmc-asym uq`` (ipmc_asym.uq); a plain scene evaluates the nominal values
 _TOP = {"name", "model", "voltage", "voltages", "sweep", "outputs", "tolerance", "strip", "material",
-        "profile_arrays"}
+        "profile_arrays", "uncertain"}
 _STRIP = ("length", "width", "thickness")
 _SWEEP = ("thickness", "voltage", "length", "width")
 _RANGE = {"start", "stop", "n", "log"}

@@ -155,6 +155,8 @@ def run_scene(scene) -> dict:
                         "c_moy": str(material.c_moy), "phi4": material.phi4},
            "swept": list(sc.swept),
            "defaults_used": {k: float(pts[k][0]) for k in defaults},
+           "notes": (["the [uncertain] table is for `ipmc-asym uq`; this scene is evaluated at the "
+                      "nominal values"] if isinstance(raw, dict) and "uncertain" in raw else []),
            "point_units": {"length": "m", "width": "m, TOTAL width 2l", "thickness": "m, TOTAL thickness 2e",
                            "voltage": "V"},
            "points": [{k: float(pts[k][i]) for k in ("length", "width", "thickness", "voltage")}

@@ -177,3 +177,14 @@ def test_only_requested_outputs():
     r = run_scene({"voltage": 1, "outputs": ["rotation"]})
     assert list(r["outputs"]) == ["rotation"]
     assert math.isfinite(r["outputs"]["rotation"]["values"][0])
+
+
+def test_a_uq_scene_runs_as_a_plain_scene_at_its_nominal_values():
+    """examples/uq_nominal.toml: `scene` evaluates the nominal strip and says the table is for uq."""
+    from ipmc_asym import moment_integral
+
+    res = run_scene(str(Path(__file__).resolve().parents[1] / "examples" / "uq_nominal.toml"))
+    assert any("uncertain" in n for n in res["notes"])
+    p = res["points"][0]
+    ref = moment_integral(p["thickness"], p["voltage"], res["model"], "quadrature")
+    assert res["outputs"]["I"]["values"][0] == pytest.approx(ref, rel=2 * res["tolerance"])

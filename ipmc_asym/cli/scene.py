@@ -29,6 +29,8 @@ def run(args) -> int:
     for k, x in res.get("defaults_used", {}).items():
         label = {"thickness": "total thickness 2e", "width": "total width 2l"}.get(k, k)
         print(f"  note: [strip].{k} not given: using the default {label} = {fmt_length(x)}")
+    for note in res.get("notes", []):
+        print(f"  note: {note}")
     lab = {"length": "L", "width": "2l", "thickness": "2e", "voltage": "phi0"}
 
     def where(i):
