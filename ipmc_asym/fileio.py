@@ -11,6 +11,13 @@ import contextlib
 import os
 import tempfile
 
+
+def _umask_mode() -> int:
+    """The mode a plain ``open(path, "w")`` would give (mkstemp makes files 0600)."""
+    mask = os.umask(0)
+    os.umask(mask)
+    return 0o666 & ~mask
+
 __all__ = ["check_output_path", "atomic_write"]
 
 
@@ -77,6 +84,7 @@ def atomic_write(path, mode: str = "w", **open_kw):
             open_kw.setdefault("newline", "")
         with os.fdopen(fd, mode, **open_kw) as fh:
             yield fh
+        os.chmod(tmp, _umask_mode())
         os.replace(tmp, p)
     except BaseException:
         with contextlib.suppress(OSError):
@@ -103,6 +111,7 @@ class _AtomicPath:
 
     def __exit__(self, et, ev, tb):
         if et is None:
+            os.chmod(self.tmp, _umask_mode())
             os.replace(self.tmp, self.path)
         else:
             with contextlib.suppress(OSError):

@@ -13,6 +13,7 @@ import pkgutil
 import subprocess
 import sys
 import textwrap
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -351,3 +352,19 @@ def test_readme_python_blocks_run():
     assert blocks
     for b in blocks:
         exec(compile(b, "README.md", "exec"), {})
+
+
+def test_atomic_files_get_the_usual_permissions(tmp_path):
+    """mkstemp makes 0600 files; a written result must be readable like any file (umask)."""
+    from ipmc_asym.fileio import atomic_path, atomic_write
+
+    mask = os.umask(0o022)
+    try:
+        with atomic_write(tmp_path / "a.txt") as fh:
+            fh.write("x")
+        with atomic_path(tmp_path / "b.png") as tmp:
+            Path(tmp).write_bytes(b"x")
+    finally:
+        os.umask(mask)
+    for name in ("a.txt", "b.png"):
+        assert (tmp_path / name).stat().st_mode & 0o777 == 0o644
