@@ -24,7 +24,7 @@ from .params import NAFION_LI, Material, Strip, debye_length
 from .permittivity import MODELS, get_model
 from .registry import FIDELITIES as _FIDELITY_SPECS
 from .registry import check_choice, fidelity_names
-from .settings import OUTSIDE_REGIMES, STRAIN_LIMIT, VALIDITY_LIMIT
+from .settings import OUTSIDE_REGIMES, STRAIN_LIMIT, VALIDATED_VOLTAGE, VALIDITY_LIMIT
 
 __all__ = ["evaluate", "estimate_rows", "RESULT_KEYS", "CHECKS", "moment_escalating", "Escalated",
            "check_tol", "FREE_STRIP_KEYS", "MECHANICAL_KEYS"]
@@ -245,6 +245,10 @@ def evaluate(strip: Strip, model="constant", fidelity="quadrature", material: Ma
                             "free-strip outputs withheld (blocking forces kept: the strip is held straight)")
         if used != fidelity:
             warnings.append(f"escalated from {fidelity!r} to {used!r} (first rung valid here)")
+    if abs(strip.voltage) > VALIDATED_VOLTAGE:
+        warnings.append(f"|voltage| {abs(strip.voltage):g} V > {VALIDATED_VOLTAGE:g} V: beyond the range the toolkit "
+                        "is validated on, and far beyond water electrolysis (~1.23 V), which this "
+                        "blocking-electrode model leaves out; the numbers solve the equations, not the device")
     valid = all(checks.values())
     if not valid and on_invalid == "raise":
         raise ValueError(f"model {perm.name}: " + next(w for w in warnings[::-1] if "withheld" in w))

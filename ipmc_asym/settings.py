@@ -34,6 +34,11 @@ BVP_MAX_NODES_FIRST = 30_000
 #: same continuum equations) describes it; every command refuses at once (docs/design.md)
 MIN_THICKNESS = 100e-9
 
+#: largest |voltage| (V) the toolkit is validated on (1e-4 - 20 V against the BVP).  The model
+#: has blocking electrodes and no electrode reactions, while water electrolyses above ~1.23 V
+#: (IPMCs are driven at a few volts): above this voltage every result carries a warning
+VALIDATED_VOLTAGE = 20.0
+
 #: relative rounding floor of the error estimate of corrected / quadrature (the two terms are
 #: assembled with cancellations; measured <= 2.3e-12 against the BVP on 1 um - 10 mm x 0.1 mV - 20 V)
 ROUNDING_ERROR = 1e-11

@@ -368,3 +368,14 @@ def test_atomic_files_get_the_usual_permissions(tmp_path):
         os.umask(mask)
     for name in ("a.txt", "b.png"):
         assert (tmp_path / name).stat().st_mode & 0o777 == 0o644
+
+
+def test_voltage_beyond_the_validated_range_is_never_silent(capsys):
+    """9.5: at 1000 V the linear model used to print a clean table."""
+    from ipmc_asym.settings import VALIDATED_VOLTAGE
+
+    assert main(["estimate", "--model", "linear", "--voltage", f"{50 * VALIDATED_VOLTAGE:g}V"]) in (0, 2)
+    cap = capsys.readouterr()
+    assert "validated" in (cap.out + cap.err)
+    assert main(["estimate", "--model", "linear", "--voltage", f"{VALIDATED_VOLTAGE / 2:g}V"]) == 0
+    assert "validated" not in capsys.readouterr().out
