@@ -291,7 +291,7 @@ def _env(values):
                 os.environ[k] = v
 
 
-def bench_section(quick: bool = False) -> dict:
+def bench_section(quick: bool = False, shape: tuple | None = None, repeats: int | None = None) -> dict:
     """``ipmc-asym bench`` section: a 2-D BVP sweep on a 2-worker LocalCluster vs 1 worker.
 
     LocalClusters of 1 and 2 worker processes (one thread each), started and warmed first;
@@ -301,11 +301,13 @@ def bench_section(quick: bool = False) -> dict:
     try:
         import distributed  # deferred: heavy import (start-up), optional extra
     except ImportError:
-        return {"figures": [{"what": "distributed BVP sweep speed-up", "value": None, "unit": "x", "target": 1.6,
+        return {"figures": [{"what": "distributed BVP sweep speed-up", "value": None, "unit": "x", "target": 1.7,
                              "pass": None, "note": "dask.distributed not installed (pip install \".[dask]\")"}]}
     from .sweeps import sweep
 
-    nt, nv = (2, 4) if quick else (4, 6)
+    # 200 points (10 x 20), the size issue 10 states its target for; few chunks of a tiny
+    # sweep cannot balance two workers, so a smaller grid understates the speed-up
+    nt, nv = shape if shape is not None else ((2, 4) if quick else (10, 20))
     vary = {"thickness": np.geomspace(100e-6, 400e-6, nt), "voltage": np.linspace(0.5, 2.0, nv)}
     kw = dict(model="constant", fidelity="bvp")
     warm_kernels()
@@ -324,7 +326,7 @@ def bench_section(quick: bool = False) -> dict:
             clients[nw].run(_sweep_task, warm_task)  # SciPy imports, first-call costs on every worker
         # alternate 1 / 2 workers and keep the best of each: the machine is shared, and a
         # burst of someone else's load should not decide the ratio
-        for _ in range(1 if quick else 3):
+        for _ in range(repeats if repeats is not None else (1 if quick else 2)):
             for nw in (1, 2):
                 t0 = time.perf_counter()
                 # the same chunks for both (sized for 2 workers)
@@ -334,7 +336,7 @@ def bench_section(quick: bool = False) -> dict:
                for k in results[1].dtype.names)
     sp = times[1] / times[2]
     return {"figures": [
-        {"what": f"distributed BVP sweep {nt}x{nv}: 2 workers vs 1", "value": sp, "unit": "x", "target": 1.6,
-         "pass": bool(sp >= 1.6), "note": f"1 worker {times[1]:.3g} s, 2 workers {times[2]:.3g} s; "
+        {"what": f"distributed BVP sweep {nt}x{nv}: 2 workers vs 1", "value": sp, "unit": "x", "target": 1.7,
+         "pass": bool(sp >= 1.7), "note": f"1 worker {times[1]:.3g} s, 2 workers {times[2]:.3g} s; "
                                           f"results identical: {same}"},
     ], "identical": same}
