@@ -36,7 +36,7 @@ import numpy as np
 
 from .registry import model_names
 
-__all__ = ["run_bench", "load_bench", "run_sections", "SECTIONS", "sample_points", "format_table", "TARGETS", "MODELS", "ERR_FLOOR"]
+__all__ = ["run_bench", "bare_driver", "load_bench", "run_sections", "SECTIONS", "sample_points", "format_table", "TARGETS", "MODELS", "ERR_FLOOR"]
 
 MODELS = model_names()
 FAST = ("leading", "corrected", "quadrature")
@@ -92,10 +92,16 @@ def sample_points(n: int, seed: int = 0, layout: str = "random"):
     return th, v
 
 
-def _time_driver(fidelity, model, th, v, threads, repeats):
-    """Best-of-``repeats`` seconds per point of the sweep driver with ``threads`` threads."""
-    import numba
+def bare_driver(fidelity, model, th, v):
+    """The compiled sweep driver on precomputed groups: the kernel cost with no API around it.
 
+    Returns
+    -------
+    call : callable
+        Runs the driver once over all points.
+    outs : list of ndarray, shape (n,)
+        Its outputs ``I, error, B1, core``.
+    """
     from .integral import _ORDER, _sweep, closed_model_id, groups_arrays
     from .params import NAFION_LI
     from .permittivity import get_model
@@ -109,6 +115,14 @@ def _time_driver(fidelity, model, th, v, threads, repeats):
     def call():
         _sweep(lam, A2, A3, rho, mid, order, sign, *outs)
 
+    return call, outs
+
+
+def _time_driver(fidelity, model, th, v, threads, repeats):
+    """Best-of-``repeats`` seconds per point of the sweep driver with ``threads`` threads."""
+    import numba
+
+    call, outs = bare_driver(fidelity, model, th, v)
     old = numba.get_num_threads()
     numba.set_num_threads(max(1, min(int(threads), numba.config.NUMBA_NUM_THREADS)))
     try:
@@ -120,7 +134,7 @@ def _time_driver(fidelity, model, th, v, threads, repeats):
             best = min(best, time.perf_counter() - t0)
     finally:
         numba.set_num_threads(old)
-    return best / lam.size, int(np.count_nonzero(~np.isfinite(outs[0])))
+    return best / outs[0].size, int(np.count_nonzero(~np.isfinite(outs[0])))
 
 
 _COMPILE_SNIPPET = """

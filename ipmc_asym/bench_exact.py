@@ -100,20 +100,12 @@ def exact_timing(n: int = 3000, bvp_n: int = 2, repeats: int = 3, seed: int = 0)
 
 def api_vs_kernel(n: int = 10**7, repeats: int = 3, threads: int = 2) -> dict:
     """``moment()`` vs the bare driver on precomputed groups, ``leading``, constant model."""
-    from .integral import _ORDER, _sweep, closed_model_id, groups_arrays, moment
-    from .params import NAFION_LI
-    from .permittivity import get_model
+    from .bench import bare_driver
+    from .integral import moment
 
     th = np.exp(np.linspace(np.log(10e-6), np.log(4e-3), n))
     v = np.exp(np.linspace(np.log(1e-3), np.log(10.0), n))[::-1].copy()
-    perm = get_model("constant")
-    lam, A2, A3, rho, sign = groups_arrays(th, v, perm, NAFION_LI)
-    lam, A2, sign = (np.ascontiguousarray(a) for a in (lam, A2, sign))
-    outs = [np.empty(n) for _ in range(4)]
-    mid, order = closed_model_id(perm, "leading"), _ORDER["leading"]
-
-    def kernel():
-        _sweep(lam, A2, A3, rho, mid, order, sign, *outs)
+    kernel, _ = bare_driver("leading", "constant", th, v)
 
     def api():
         moment(th, v, "constant", "leading")

@@ -57,7 +57,6 @@ _ORDER = {k: f.order for k, f in _FIDELITY_SPECS.items() if f.order >= 0}
 #: fidelities valid at every thickness (no neutral core assumed): ``core`` is informative only
 #: rungs that hold whatever the thickness (overlapping layers, non-neutral core)
 ANY_THICKNESS = ("exact", "bvp")
-_ANY_THICKNESS = ANY_THICKNESS
 
 
 def check_fidelity(fidelity: str) -> str:
@@ -265,7 +264,7 @@ def _driver_constants(perm: Permittivity, mat: Material, fidelity: str) -> tuple
     lamc = float(debye_length(1.0, eps_core, mat))  # lam * thickness (lam ~ 1/e)
     return (lamc, mat.F / (mat.R * mat.T),
             -mat.rho2 * mat.Z3 / (mat.C_moy * mat.F), perm.eps0 / eps_core,
-            closed_model_id(perm, fidelity), _ORDER[fidelity], fidelity in _ANY_THICKNESS,
+            closed_model_id(perm, fidelity), _ORDER[fidelity], fidelity in ANY_THICKNESS,
             validity_limit(fidelity))
 
 
@@ -352,7 +351,7 @@ def moment(thickness, voltage, model="constant", fidelity="quadrature", *, mater
     B1 = np.empty(shape)
     core = np.empty(shape)
     success, message = _bvp_loop(thickness, voltage, perm, mat, I, err, B1, core, progress)
-    valid = (err < validity_limit(fidelity)) & ((core > 0) | (fidelity in _ANY_THICKNESS)) & success
+    valid = (err < validity_limit(fidelity)) & ((core > 0) | (fidelity in ANY_THICKNESS)) & success
     return MomentResult(I=I, error=err, B1=B1, core=core, lam=lam, A2=A2, valid=valid,
                         fidelity=fidelity, model=perm.name, success=success, message=message)
 

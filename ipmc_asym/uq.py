@@ -46,6 +46,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .datasets import VARIABLES
 from .integral import ANY_THICKNESS, closed_model_id, validity_limit
 from .integral_samples import moment_samples
 from .params import moment_scale, second_moment
@@ -55,15 +56,8 @@ from .settings import CHUNK_ROWS
 __all__ = ["UNCERTAIN", "DISTRIBUTIONS", "OUTPUT_UNITS", "UQResult", "parse_uncertain", "run_uq",
            "evaluate_samples", "uq_chunk"]
 
-#: uncertain names -> (unit, long name)
-UNCERTAIN = {
-    "length": ("m", "strip length L"),
-    "width": ("m", "total width 2l"),
-    "thickness": ("m", "total thickness 2e"),
-    "voltage": ("V", "voltage phi0"),
-    "modulus": ("Pa", "Young's modulus E"),
-    "c_moy": ("mol/m^3", "mean cation concentration C_moy"),
-}
+#: uncertain names -> (unit, long name), as the datasets label them
+UNCERTAIN = {k: VARIABLES[k] for k in ("length", "width", "thickness", "voltage", "modulus", "c_moy")}
 DISTRIBUTIONS = {
     "normal": ("mean", "sd"),
     "lognormal": ("median", "sigma"),
