@@ -73,6 +73,7 @@ __all__ = [
     "KL_BLOCK_MAX",
     "DEFAULT_SMALL_TOL",
     "REGIMES",
+    "regime_code",
     "BeamResult",
     "rotation",
     "curvature",
@@ -629,16 +630,17 @@ def regime(M, L, EI, tol=None):
         (``pi/2 < |theta| <= 2 pi``: the arc curls back, ``w`` not monotone in ``M``),
         ``"multi-turn"`` (``|theta| > 2 pi``: ``w`` periodic in ``M``).
     """
+    lab = np.asarray(REGIMES)[regime_code(M, L, EI, tol)]  # one gather of labels
+    return str(lab) if lab.ndim == 0 else lab
+
+
+def regime_code(M, L, EI, tol=None):
+    """:func:`regime` as indices into :data:`REGIMES` (int array; cheap to compare)."""
     tol = DEFAULT_SMALL_TOL if tol is None else float(tol)
     M, L, EI = _mLEI(M, L, EI)
     th = np.abs(M * L / EI)
     err = _u2_over_sin2_minus_1(0.5 * th)
-    lab = np.where(
-        th > 2.0 * np.pi,
-        REGIMES[3],
-        np.where(th > 0.5 * np.pi, REGIMES[2], np.where(err <= tol, REGIMES[0], REGIMES[1])),
-    )
-    return str(lab) if lab.ndim == 0 else lab
+    return np.where(th > 2.0 * np.pi, 3, np.where(th > 0.5 * np.pi, 2, np.where(err <= tol, 0, 1)))
 
 
 @dataclass
@@ -669,6 +671,8 @@ class BeamResult:
         ``e |M|/EI`` if the half thickness ``e`` was given.
     warnings : list of str
         One-line messages about points outside the model's comfortable range.
+    regime_code : int or ndarray of int or None
+        ``regime`` as indices into :data:`REGIMES`.
     """
 
     theta: object
@@ -683,6 +687,7 @@ class BeamResult:
     block_error: object
     max_strain: object = None
     warnings: list = field(default_factory=list)
+    regime_code: object = None
 
 
 def _where_msg(mask, values, n):
@@ -728,7 +733,9 @@ def solve_beam(M, L, EI, *, tol=None, e=None) -> BeamResult:
     Fs = 1.5 * M / L
     berr = np.abs(1.5 - psi) / psi
     serr = _u2_over_sin2_minus_1(0.5 * ath)
-    reg = regime(M, L, EI, tol_v)
+    code = regime_code(M, L, EI, tol_v)
+    reg = np.asarray(REGIMES)[code]
+    reg = str(reg) if reg.ndim == 0 else reg
     n = max(1, M.size)
     warns = []
     flat_th = ath.reshape(-1)
@@ -778,6 +785,7 @@ def solve_beam(M, L, EI, *, tol=None, e=None) -> BeamResult:
         F_block=_out(Fb),
         F_block_small=_out(Fs),
         regime=reg,
+        regime_code=int(code) if np.ndim(code) == 0 else code,
         small_error=_out(serr),
         block_error=_out(berr),
         max_strain=eps,

@@ -23,7 +23,7 @@ import sys
 
 import numpy as np
 
-from .beam import max_strain, solve_beam
+from .beam import REGIMES, max_strain, solve_beam
 from .estimate import check_tol, moment_escalating
 from .fileio import atomic_write
 from .integral import check_fidelity
@@ -135,50 +135,89 @@ def iter_sweep(vary: dict, model="constant", fidelity="quadrature", base: Strip 
                     cols[c] = axes[j][idx[j]]
                 else:
                     cols[c] = np.full(k, float(const[c]))
-            yield _chunk(cols, perm, fidelity, material, tol, escalate, failures)
+            yield _chunk(cols, perm, fidelity, material, tol, escalate, failures, _pair_code(names, axes, idx, k))
             if progress is not None:
                 progress.update(k)
 
 
-def _chunk(cols, perm, fidelity, material, tol, escalate, failures):
+def _pair_code(names, axes, idx, k):
+    """Integer code of each row's (thickness, voltage) grid pair: equal codes, equal ``I``."""
+    code = np.zeros(k, dtype=np.int64)
+    for c in ("thickness", "voltage"):
+        if c in names:
+            j = names.index(c)
+            code = code * axes[j].size + idx[j]
+    return code
+
+
+def _distinct(code):
+    """``(first, inverse)``: rows holding each distinct code, and each row's distinct index;
+    ``(None, None)`` when every row is distinct.
+
+    Rows come in C order, so when thickness and voltage are the fastest-varying axes (or the
+    only ones) every code is new and nothing is sorted or gathered.
+    """
+    if code.size < 2 or bool(np.all(code[1:] > code[:-1])):
+        return None, None
+    _, first, inv = np.unique(code, return_index=True, return_inverse=True)
+    return first, np.asarray(inv).reshape(-1)
+
+
+def _chunk(cols, perm, fidelity, material, tol, escalate, failures, code=None):
     k = cols["length"].size
     A5 = moment_scale(cols["width"], cols["thickness"], cols["voltage"], material.F, material.C_moy)
     EI = cols["modulus"] * second_moment(cols["width"], cols["thickness"])
-    # I depends on (thickness, voltage) only: evaluate each distinct pair once
-    tv = np.stack([cols["thickness"], cols["voltage"]], axis=1)
-    uniq, inv = np.unique(tv, axis=0, return_inverse=True)
-    inv = np.asarray(inv).reshape(-1)
-    r = moment_escalating(uniq[:, 0], uniq[:, 1], perm, fidelity, material, tol=tol, escalate=escalate,
-                          progress=False)
+    # I depends on (thickness, voltage) only: evaluate each distinct pair once (by grid code:
+    # an integer sort at most, not a row-wise sort of float pairs)
+    if code is None:
+        code = np.unique(np.stack([cols["thickness"], cols["voltage"]], axis=1), axis=0, return_inverse=True)[1]
+        code = np.asarray(code).reshape(-1)
+    first, inv = _distinct(code)
+
+    def rows(a):  # per-distinct-pair values -> per-row values
+        return a if inv is None else a[inv]
+
+    def pairs(a):  # per-row values -> one per distinct pair
+        return a if first is None else a[first]
+
+    r = moment_escalating(pairs(cols["thickness"]), pairs(cols["voltage"]), perm, fidelity, material, tol=tol,
+                          escalate=escalate, progress=False)
     arr = np.empty(k, dtype=DTYPE)
     for c in VARIABLES:
         arr[c] = cols[c]
     arr["model"] = perm.name
     arr["fidelity"] = fidelity
-    used = r.fidelity_used[inv]
+    used = rows(r.fidelity_used)
     arr["fidelity_used"] = used
     arr["escalated"] = (used != fidelity) & (used != "")
-    ok = r.valid[inv]
-    I = r.I[inv]
-    M = np.where(ok, A5 * np.where(ok, I, 0.0), np.nan)
+    ok = rows(r.valid)
+    all_ok = bool(np.all(ok))
+    I = rows(r.I)
+    Mok = A5 * I if all_ok else np.where(ok, A5 * np.where(ok, I, 0.0), 0.0)
     with np.errstate(all="ignore"):
-        b = solve_beam(np.where(ok, M, 0.0), cols["length"], EI, tol=tol)
-        strain = np.asarray(max_strain(np.where(ok, M, 0.0), EI, 0.5 * cols["thickness"]))
+        b = solve_beam(Mok, cols["length"], EI, tol=tol)
+        strain = np.asarray(max_strain(Mok, EI, 0.5 * cols["thickness"]))
+
+    def masked(x, fill):  # outputs only where a rung is valid
+        x = np.broadcast_to(np.asarray(x), (k,))
+        return x if all_ok else np.where(ok, x, fill)
+
     arr["I"] = I
-    arr["M_A"] = M
+    arr["M_A"] = masked(Mok, np.nan)
     for c in _MECH:
-        arr[c] = np.where(ok, np.broadcast_to(np.asarray(getattr(b, c), dtype=float), (k,)), np.nan)
-    arr["regime"] = np.where(ok, np.broadcast_to(np.asarray(b.regime), (k,)), "")
-    arr["max_strain"] = np.where(ok, strain, np.nan)
-    arr["B1"] = r.B1[inv]
-    arr["error"] = r.error[inv]
-    arr["check_electrochemistry"] = r.electrochemistry[inv]
-    arr["check_layer_separation"] = r.layer_separation[inv]
-    arr["check_beam_regime"] = ok & ~np.isin(arr["regime"], OUTSIDE_REGIMES)
+        arr[c] = masked(np.asarray(getattr(b, c), dtype=float), np.nan)
+    arr["regime"] = masked(b.regime, "")
+    arr["max_strain"] = masked(strain, np.nan)
+    arr["B1"] = rows(r.B1)
+    arr["error"] = rows(r.error)
+    arr["check_electrochemistry"] = rows(r.electrochemistry)
+    arr["check_layer_separation"] = rows(r.layer_separation)
+    outside = np.isin(b.regime_code, [REGIMES.index(o) for o in OUTSIDE_REGIMES])  # ints, not strings
+    arr["check_beam_regime"] = ok & ~outside
     arr["check_strain"] = ok & (strain <= STRAIN_LIMIT)
     arr["valid"] = (arr["check_electrochemistry"] & arr["check_layer_separation"] & arr["check_beam_regime"]
                     & arr["check_strain"])
-    if failures is not None and not np.all(ok):
+    if failures is not None and not all_ok:
         failures.append(r.message)
     return arr
 
