@@ -10,11 +10,12 @@ from __future__ import annotations
 
 import hashlib
 import os
+import types
 from pathlib import Path
 
 import numba as nb
 
-__all__ = ["jit", "jit_parallel", "prange", "CACHE_DIR"]
+__all__ = ["jit", "jit_parallel", "prange", "CACHE_DIR", "interpreted"]
 
 
 def hashed_sources() -> list:
@@ -67,3 +68,62 @@ def jit_parallel(func=None, **kw):
     if func is None:
         return lambda f: nb.jit(f, **opts)
     return nb.jit(func, **opts)
+
+
+# --------------------------------------------------------------------------------------
+# Interpreted twins: the same source run by the Python interpreter
+# --------------------------------------------------------------------------------------
+#: twin of each jitted function (by id of its Python function) and twin globals of each module
+_TWINS: dict = {}
+_TWIN_GLOBALS: dict = {}
+_PACKAGE = __name__.rsplit(".", 1)[0] + "."
+
+
+def _is_jitted(obj) -> bool:
+    return isinstance(obj, nb.core.dispatcher.Dispatcher)
+
+
+class _TwinModule:
+    """A module of this package seen from a twin: its jitted attributes are twins too."""
+
+    def __init__(self, module):
+        self._module = module
+
+    def __getattr__(self, name):
+        value = getattr(self._module, name)
+        return interpreted(value) if _is_jitted(value) else value
+
+
+def _fill_twin_globals(g: dict) -> None:
+    """Replace, in a module's twin globals ``g``, jitted functions and package modules by twins."""
+    for k, v in list(g.items()):
+        if _is_jitted(v):
+            g[k] = interpreted(v)
+        elif isinstance(v, types.ModuleType) and v.__name__.startswith(_PACKAGE):
+            g[k] = _TwinModule(v)
+
+
+def interpreted(func):
+    """The jitted ``func`` as plain Python: its own source, run by the interpreter, calling
+    the twins of the jitted functions it calls (nothing is compiled or loaded from the cache).
+
+    Why: loading one compiled driver from the cache costs a fresh process ~0.5 s (Numba's
+    typing and target registries, and SciPy's BLAS that Numba's array library imports),
+    ~1000x the interpreted cost of a few closed-form points.  Semantics differ from the
+    compiled code only where that returns inf/NaN without complaint: the interpreter raises
+    (``ZeroDivisionError``, ``OverflowError``, ``ValueError`` from ``math``, or
+    ``FloatingPointError`` under ``np.errstate(all="raise")``), and the caller then uses the
+    compiled function.  Not jitted: ``func`` itself.
+    """
+    if not _is_jitted(func):
+        return func
+    py = func.py_func
+    twin = _TWINS.get(id(py))
+    if twin is None:
+        fresh = id(py.__globals__) not in _TWIN_GLOBALS
+        g = _TWIN_GLOBALS.setdefault(id(py.__globals__), dict(py.__globals__))
+        twin = _TWINS[id(py)] = types.FunctionType(py.__code__, g, py.__name__, py.__defaults__, py.__closure__)
+        twin.__doc__ = py.__doc__
+        if fresh:  # after registering the twin: the module's other functions may call it
+            _fill_twin_globals(g)
+    return twin

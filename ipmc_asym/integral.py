@@ -36,7 +36,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._jit import jit, jit_parallel, prange
+from ._jit import interpreted, jit, jit_parallel, prange
 from .kernels.closed import moment_closed
 from .kernels.exact import moment_exact
 from .kernels.quadrature import moment_quadrature
@@ -46,10 +46,11 @@ from .progress import progress as _progress_bar
 from .registry import FIDELITIES as _FIDELITY_SPECS
 from .registry import MODELS as _MODEL_SPECS
 from .registry import check_choice, fidelity_names
-from .settings import BVP_STATED_ERROR, EXACT_STATED_ERROR, MIN_THICKNESS, ROUNDING_ERROR, VALIDITY_LIMIT
+from .settings import (BVP_STATED_ERROR, EXACT_STATED_ERROR, INTERPRET_BUDGET_S, MIN_THICKNESS, ROUNDING_ERROR,
+                       VALIDITY_LIMIT)
 
 __all__ = ["FIDELITIES", "MomentResult", "moment_integral", "moment", "groups_arrays", "check_fidelity",
-           "check_min_thickness", "invalid_message", "validity_limit"]
+           "check_min_thickness", "invalid_message", "validity_limit", "interpret_small"]
 
 FIDELITIES = fidelity_names()
 #: order argument of the sweep driver: 1 leading, 2 corrected, 0 quadrature, 3 exact
@@ -212,42 +213,55 @@ def _groups_point(t, vv, lamc, a2c):
 
 @jit_parallel
 def _sweep_fused(th, v, lamc, a2c, A3, rho, model_id, order, any_thickness, limit,
-                 I, err, B1, core, lam_o, A2_o, valid):
+                 I, err, B1, core, lam_o, A2_o, valid, nan_invalid=False):
     """The fused sweep driver: groups, sign and validity computed inside the parallel loop.
 
     ``th``, ``v``: flat arrays of the output size or of size 1 (broadcast); the outputs are
-    flat views of the result arrays, so nothing else is allocated.  Returns the counts of
-    bad thicknesses (not finite or <= 0) and bad voltages (not finite); those points are
-    left as NaN and the caller raises.
+    flat views of the result arrays, so nothing else is allocated.  ``I`` and ``valid`` are
+    always written; the other outputs only if they have the size of ``I`` (pass empty arrays
+    for those not wanted: :func:`moment_integral` needs ``I`` and ``valid`` only), and
+    ``nan_invalid`` puts NaN in ``I`` where the point is invalid (no second pass over the
+    arrays).  Returns the counts of bad thicknesses (not finite or <= 0), of bad voltages
+    (not finite) -- those points are left as NaN and the caller raises -- and of invalid points.
     """
     n = I.size
     sth = th.size > 1
     sv = v.size > 1
+    full = err.size == n  # bookkeeping outputs wanted (all or none)
     bad_th = 0
     bad_v = 0
+    n_invalid = 0
     for i in prange(n):
         t = th[i] if sth else th[0]
         vv = v[i] if sv else v[0]
-        if not (math.isfinite(t) and t > 0.0):
-            bad_th += 1
-            I[i] = err[i] = B1[i] = core[i] = lam_o[i] = A2_o[i] = math.nan
+        bad_t = not (math.isfinite(t) and t > 0.0)
+        if bad_t or not math.isfinite(vv):
+            if bad_t:
+                bad_th += 1
+            else:
+                bad_v += 1
+            I[i] = math.nan
             valid[i] = False
-            continue
-        if not math.isfinite(vv):
-            bad_v += 1
-            I[i] = err[i] = B1[i] = core[i] = lam_o[i] = A2_o[i] = math.nan
-            valid[i] = False
+            n_invalid += 1
+            if full:
+                err[i] = B1[i] = core[i] = lam_o[i] = A2_o[i] = math.nan
             continue
         lam, A2 = _groups_point(t, vv, lamc, a2c)
         Ii, e_i, b1, c = _point(lam, A2, A3, rho, model_id, order)
-        I[i] = Ii if vv >= 0.0 else -Ii
-        err[i] = e_i
-        B1[i] = b1
-        core[i] = c
-        lam_o[i] = lam
-        A2_o[i] = A2
-        valid[i] = (e_i < limit) and (c > 0.0 or any_thickness)
-    return bad_th, bad_v
+        ok = (e_i < limit) and (c > 0.0 or any_thickness)
+        valid[i] = ok
+        if ok or not nan_invalid:
+            I[i] = Ii if vv >= 0.0 else -Ii
+        else:
+            I[i] = math.nan
+            n_invalid += 1
+        if full:
+            err[i] = e_i
+            B1[i] = b1
+            core[i] = c
+            lam_o[i] = lam
+            A2_o[i] = A2
+    return bad_th, bad_v, n_invalid
 
 
 @jit
@@ -277,6 +291,35 @@ def validity_limit(fidelity: str) -> float:
     ``exact`` is the method that holds there.
     """
     return min(VALIDITY_LIMIT, _FIDELITY_SPECS[fidelity].ceiling)
+
+
+#: interpret small inputs (see :func:`interpret_small`); off: always the compiled drivers
+_INTERPRET = [False]
+
+
+def interpret_small(enabled: bool = True) -> None:
+    """Evaluate small inputs with the interpreted twins of the drivers (``_jit.interpreted``)
+    as long as the compiled driver is not loaded in this process.
+
+    For one-shot processes (``ipmc-asym estimate``): a few points cost ~30 us each
+    interpreted, against ~0.5 s to load the compiled driver from the cache.  Same source,
+    same operations: the results are those of the compiled driver (tested bit for bit);
+    where the interpreter would raise (an inf or NaN on the way), the compiled driver runs.
+    "Small" is ``points x registry interpreted_s <= settings.INTERPRET_BUDGET_S``.
+    """
+    _INTERPRET[0] = bool(enabled)
+
+
+def _run_driver(driver, n: int, fidelity: str, args):
+    """``driver(*args)``, or its interpreted twin where :func:`interpret_small` says so."""
+    cost = _FIDELITY_SPECS[fidelity].interpreted_s
+    if _INTERPRET[0] and not driver.signatures and 0.0 < n * cost <= INTERPRET_BUDGET_S:
+        try:
+            with np.errstate(all="raise", under="ignore"):  # underflow: the same 0 compiled
+                return interpreted(driver)(*args)
+        except (ArithmeticError, ValueError):  # the compiled code returns inf/NaN there
+            pass
+    return driver(*args)
 
 
 #: (model name, fidelity) -> driver constants of the default material (scalar fast path)
@@ -335,9 +378,9 @@ def moment(thickness, voltage, model="constant", fidelity="quadrature", *, mater
         I, err, B1, core, lam, A2 = (np.empty(shape) for _ in range(6))
         valid = np.empty(shape, dtype=np.bool_)
         check_min_thickness(th)
-        bad_th, bad_v = _sweep_fused(_flat_input(th, shape), _flat_input(v, shape),
-                                     *_driver_constants(gperm, mat, fidelity),
-                                     *(a.reshape(-1) for a in (I, err, B1, core, lam, A2, valid)))
+        bad_th, bad_v, _ = _run_driver(_sweep_fused, I.size, fidelity, (
+            _flat_input(th, shape), _flat_input(v, shape), *_driver_constants(gperm, mat, fidelity),
+            *(a.reshape(-1) for a in (I, err, B1, core, lam, A2, valid))))
         if bad_th:
             raise ValueError("thickness (total, 2e) must be finite and > 0 m")
         if bad_v:
@@ -447,9 +490,24 @@ def moment_integral(thickness, voltage, model="constant", fidelity="quadrature",
             consts = _SCALAR_CACHE[(model, fidelity)] = _driver_constants(get_model(model), NAFION_LI, fidelity)
         t, vv = float(thickness), float(voltage)
         if consts is not None and t >= MIN_THICKNESS and math.isfinite(t) and math.isfinite(vv):
-            Ii, ok = _scalar_point(t, vv, *consts)
+            Ii, ok = _run_driver(_scalar_point, 1, fidelity, (t, vv, *consts))
             if ok:
                 return Ii
+    lean = _lean_integral(thickness, voltage, model, fidelity, material, material_kw)
+    if lean is not None:  # I and valid only; the bookkeeping of moment() for invalid points only
+        I, valid, n_invalid = lean
+        if n_invalid:  # I is NaN there already
+            bad = ~valid
+            if on_invalid in ("raise", "warn"):
+                shape = I.shape
+                sub = moment(np.broadcast_to(np.asarray(thickness, float), shape)[bad],
+                             np.broadcast_to(np.asarray(voltage, float), shape)[bad], model, fidelity,
+                             material=material, **material_kw)
+                msg = invalid_message(sub, total=I.size)
+                if on_invalid == "raise":
+                    raise ValueError(msg)
+                warnings.warn(msg, RuntimeWarning, stacklevel=2)
+        return float(I) if I.ndim == 0 else I
     r = moment(thickness, voltage, model, fidelity, material=material, **material_kw)
     bad = ~np.asarray(r.valid)
     I = np.array(r.I, dtype=float)
@@ -463,14 +521,41 @@ def moment_integral(thickness, voltage, model="constant", fidelity="quadrature",
     return float(I) if I.ndim == 0 else I
 
 
-def invalid_message(r: MomentResult) -> str:
-    """One line: where and why ``r`` is outside its validity."""
+def _lean_integral(thickness, voltage, model, fidelity, material, material_kw):
+    """``(I, valid, n_invalid)`` from the fused driver with no bookkeeping outputs (9 bytes a
+    point; NaN in ``I`` where invalid), or None where :func:`moment` is needed (BVP, custom
+    eps(C), bad input: its messages)."""
+    if fidelity not in _ORDER or not (isinstance(model, str) or isinstance(model, Permittivity)):
+        return None
+    perm = get_model(model)
+    if perm.is_custom:
+        return None
+    mat = _material(material, material_kw)
+    th = np.asarray(thickness, dtype=np.float64)
+    v = np.asarray(voltage, dtype=np.float64)
+    shape = np.broadcast_shapes(th.shape, v.shape)
+    I = np.empty(shape)
+    valid = np.empty(shape, dtype=np.bool_)
+    check_min_thickness(th)
+    none = np.empty(0)
+    bad_th, bad_v, n_invalid = _run_driver(_sweep_fused, I.size, fidelity, (
+        _flat_input(th, shape), _flat_input(v, shape), *_driver_constants(perm, mat, fidelity),
+        I.reshape(-1), none, none, none, none, none, valid.reshape(-1), True))
+    if bad_th or bad_v:
+        return None
+    return I, valid, n_invalid
+
+
+def invalid_message(r: MomentResult, total: int | None = None) -> str:
+    """One line: where and why ``r`` is outside its validity (``total``: the number of points
+    of the call, when ``r`` holds only some of them)."""
     bad = ~np.asarray(r.valid)
     n = int(bad.sum())
+    total = bad.size if total is None else int(total)
     if r.fidelity == "bvp" and r.message:
-        return f"{r.message}; no valid result at {n} of {bad.size} point(s)"
+        return f"{r.message}; no valid result at {n} of {total} point(s)"
     e = np.asarray(r.error)
     worst = float(np.max(np.where(bad, e, 0.0))) if n else 0.0
-    return (f"fidelity {r.fidelity!r} is outside its validity at {n} of {bad.size} point(s) "
+    return (f"fidelity {r.fidelity!r} is outside its validity at {n} of {total} point(s) "
             f"(error estimate up to {worst:.2g} > {validity_limit(r.fidelity):g}, or electrode layers "
             "overlapping); use a higher fidelity ('exact' where layers overlap), or ipmc_asym.evaluate, which escalates")

@@ -57,6 +57,8 @@ class FidelitySpec(NamedTuple):
     stated_error : str    how the rung bounds its error
     ceiling : float       advertised worst relative error of a result called valid
     closed_form : bool    closed form in lambda (the paper's three models only)
+    interpreted_s : float  measured seconds per point of its interpreted twin (0: none), for
+                           ``settings.INTERPRET_BUDGET_S``
     """
 
     name: str
@@ -65,6 +67,7 @@ class FidelitySpec(NamedTuple):
     stated_error: str
     ceiling: float
     closed_form: bool
+    interpreted_s: float = 0.0
 
 
 MODELS = {
@@ -79,18 +82,18 @@ MODELS = {
 FIDELITIES = {
     "leading": FidelitySpec(
         "leading", 1, "lambda J1: the O(lambda) term of the layer expansion, closed form",
-        "the next term lambda^2 |J2| / |I| plus truncation and core interaction", 1e-2, True),
+        "the next term lambda^2 |J2| / |I| plus truncation and core interaction", 1e-2, True, 3e-5),
     "corrected": FidelitySpec(
         "corrected", 2, "lambda J1 + lambda^2 J2, closed form (the lambda-expansion stops there)",
-        "truncation of the layer functions plus the core interaction ~4 exp(-core/lambda)", 1e-8, True),
+        "truncation of the layer functions plus the core interaction ~4 exp(-core/lambda)", 1e-8, True, 3e-5),
     "quadrature": FidelitySpec(
         "quadrature", 0, "the same two terms, layer functions by compiled Gauss-Legendre panels",
-        "settings.ROUNDING_ERROR plus the core interaction ~4 exp(-core/lambda)", 1e-8, False),
+        "settings.ROUNDING_ERROR plus the core interaction ~4 exp(-core/lambda)", 1e-8, False, 4e-4),
     "exact": FidelitySpec(
         "exact", 3, "nothing neglected, any thickness: first integral, exact B1, K from the thickness "
         "constraint (Newton on ln K), moments by compiled Gauss-Legendre panels",
         "settings.EXACT_STATED_ERROR (measured <= 3e-12 against the BVP, the exact linear solution "
-        "and an ODE reference)", 1e-2, False),
+        "and an ODE reference)", 1e-2, False, 1.5e-3),
     "bvp": FidelitySpec(
         "bvp", -1, "the full nonlinear BVP (scipy.integrate.solve_bvp, graded mesh)",
         "settings.BVP_STATED_ERROR (solve_bvp tolerance 1e-10; measured ~1e-12)", 1e-2, False),

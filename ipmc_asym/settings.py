@@ -65,3 +65,9 @@ CHUNK_ROWS = 2**18
 
 #: beam regimes outside the model (fits leave these points out)
 OUTSIDE_REGIMES = ("past-quarter-turn", "multi-turn")
+
+# Interpreted twins (``_jit.interpreted``, ``integral.interpret_small``): in a one-shot command
+# a handful of points is cheaper interpreted than after loading the compiled driver from the
+# cache (~0.5 s in a fresh process): interpret while points x the rung's interpreted cost per
+# point (``registry.FIDELITIES[...].interpreted_s``) stays within this budget.
+INTERPRET_BUDGET_S = 0.05

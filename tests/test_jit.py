@@ -20,3 +20,90 @@ def test_flags_set_in_one_place():
     offenders = [p.name for p in root.rglob("*.py") if p.name != "_jit.py"
                  and re.search(r"numba\.(n)?jit\(|@(nb|numba)\.(n)?jit", p.read_text())]
     assert offenders == []
+
+
+# --------------------------------------------------------------------------------------
+# Interpreted twins (start-up of one-shot commands): same source, same numbers
+# --------------------------------------------------------------------------------------
+import subprocess  # noqa: E402
+import sys  # noqa: E402
+
+import numpy as np  # noqa: E402
+import pytest  # noqa: E402
+
+from ipmc_asym import integral  # noqa: E402
+from ipmc_asym.params import NAFION_LI  # noqa: E402
+from ipmc_asym.permittivity import get_model  # noqa: E402
+
+
+def _points(n, seed):
+    rng = np.random.default_rng(seed)
+    th = np.exp(rng.uniform(np.log(1e-6), np.log(1e-2), n))
+    v = np.exp(rng.uniform(np.log(1e-4), np.log(20.0), n)) * rng.choice([-1.0, 1.0], n)
+    v[:2] = 0.0, -0.0  # zero volts: the early return
+    return th, v
+
+
+@pytest.mark.parametrize("fidelity", ["leading", "corrected", "quadrature", "exact"])
+@pytest.mark.parametrize("model", ["constant", "linear", "affine"])
+def test_interpreted_driver_is_the_compiled_one_bit_for_bit(fidelity, model):
+    """The twin runs the driver's own source in the interpreter: every output equal, bit for bit,
+    to the compiled driver's (or the twin raises where the compiled code meets inf/NaN)."""
+    n = 12 if fidelity == "exact" else 40
+    th, v = _points(n, 3)
+    consts = integral._driver_constants(get_model(model), NAFION_LI, fidelity)
+    a = [np.empty(n) for _ in range(6)] + [np.empty(n, bool)]
+    b = [np.empty(n) for _ in range(6)] + [np.empty(n, bool)]
+    integral._sweep_fused(th, v, *consts, *a)
+    try:
+        with np.errstate(all="raise", under="ignore"):
+            _jit.interpreted(integral._sweep_fused)(th, v, *consts, *b)
+    except (ArithmeticError, ValueError):
+        pytest.skip("the interpreter met an inf/NaN the compiled code returns: the caller falls back")
+    for x, y in zip(a, b):
+        assert np.array_equal(x, y, equal_nan=True)
+
+
+def test_interpreted_twins_call_twins_not_dispatchers():
+    twin = _jit.interpreted(integral._sweep_fused)
+    assert not _jit._is_jitted(twin)
+    assert not _jit._is_jitted(twin.__globals__["_point"])
+    assert _jit.interpreted(len) is len  # not jitted: itself
+
+
+def test_estimate_interprets_a_few_points_and_loads_nothing_compiled():
+    """``estimate`` (one-shot) runs its three points interpreted: no compiled driver is loaded
+    (that load is what made start-up 2.6x ``import numba``); ``--compiled`` loads it; same output."""
+    code = ("import sys; from ipmc_asym.cli import main; from ipmc_asym import integral; "
+            "rc = main(['estimate', '--fidelity', 'leading', '--json'] + sys.argv[1:]); "
+            "sys.stderr.write('LOADED %d' % len(integral._sweep_fused.signatures))")
+    out = {}
+    for extra in ([], ["--compiled"]):
+        p = subprocess.run([sys.executable, "-c", code, *extra], capture_output=True, text=True, timeout=600)
+        assert p.returncode == 0, p.stderr
+        out[bool(extra)] = (p.stdout, int(p.stderr.rsplit("LOADED", 1)[1]))
+    assert out[False][1] == 0 and out[True][1] >= 1
+    drop = re.compile(r'"seconds": [^,\n]*')  # wall times differ, nothing else may
+    assert drop.sub("", out[False][0]) == drop.sub("", out[True][0])
+
+
+def test_interpret_small_respects_the_budget(monkeypatch):
+    """Twins only while points x interpreted cost <= ``settings.INTERPRET_BUDGET_S`` and the
+    compiled driver is not loaded yet; never for a rung without an interpreted cost."""
+    used = []
+    monkeypatch.setattr(integral, "interpreted", lambda f: (lambda *a: used.append("twin")))
+    monkeypatch.setattr(integral, "_INTERPRET", [True])
+
+    class Driver:
+        def __init__(self, signatures):
+            self.signatures = signatures
+
+        def __call__(self, *a):
+            used.append("compiled")
+
+    n_ok = int(integral.INTERPRET_BUDGET_S / integral._FIDELITY_SPECS["leading"].interpreted_s)
+    integral._run_driver(Driver([]), n_ok, "leading", ())
+    integral._run_driver(Driver([]), n_ok + 1, "leading", ())
+    integral._run_driver(Driver(["loaded"]), 1, "leading", ())
+    integral._run_driver(Driver([]), 1, "bvp", ())
+    assert used == ["twin", "compiled", "compiled", "compiled"]
