@@ -35,7 +35,8 @@ from .settings import CHUNK_ROWS, MAX_ROWS, OUTSIDE_REGIMES, STRAIN_LIMIT
 from .units import SWEEP_VARIABLES as VARIABLES
 from .units import parse_vary, parse_vary_spec, vary_values
 
-__all__ = ["VARIABLES", "DTYPE", "LABELS", "CHECK_COLS", "parse_vary", "parse_vary_spec", "vary_values", "sweep", "iter_sweep", "count_rows",
+__all__ = ["VARIABLES", "DTYPE", "LABELS", "CHECK_COLS", "parse_vary", "parse_vary_spec", "vary_values", "sweep", "iter_sweep",
+           "prefetched", "count_rows",
            "withhold", "format_chunk", "csv_header", "write_csv", "write_json", "rows_as_dicts"]
 
 
@@ -138,6 +139,53 @@ def iter_sweep(vary: dict, model="constant", fidelity="quadrature", base: Strip 
             yield _chunk(cols, perm, fidelity, material, tol, escalate, failures, _pair_code(names, axes, idx, k))
             if progress is not None:
                 progress.update(k)
+
+
+def prefetched(chunks, depth: int = 1):
+    """``chunks`` computed one step ahead in a background thread.
+
+    The consumer (formatting and writing a chunk, compiled and without the GIL) then runs on
+    one core while the next chunk is computed on the other; memory grows by ``depth`` chunks.
+    An exception in the producer is raised in the consumer, at the chunk where it happened.
+    Only the producer calls the parallel kernels (Numba's workqueue layer is not re-entrant).
+    """
+    import contextvars
+    import queue
+    import threading
+
+    q: queue.Queue = queue.Queue(maxsize=max(1, int(depth)))
+    done = object()
+    stop = threading.Event()
+
+    def produce():
+        try:
+            for c in chunks:
+                while not stop.is_set():
+                    try:
+                        q.put((c, None), timeout=0.1)
+                        break
+                    except queue.Full:
+                        continue
+                if stop.is_set():
+                    return
+            q.put((done, None))
+        except BaseException as exc:  # noqa: BLE001 -- re-raised in the consumer
+            q.put((done, exc))
+
+    # the caller's context (NumPy's errstate lives in a context variable)
+    ctx = contextvars.copy_context()
+    t = threading.Thread(target=ctx.run, args=(produce,), name="ipmc-sweep-producer", daemon=True)
+    t.start()
+    try:
+        while True:
+            c, exc = q.get()
+            if c is done:
+                if exc is not None:
+                    raise exc
+                return
+            yield c
+    finally:
+        stop.set()
 
 
 def _pair_code(names, axes, idx, k):

@@ -4,7 +4,7 @@ import pytest
 from ipmc_asym.estimate import evaluate
 from ipmc_asym.fits import fit_power_law, sweep_fits
 from ipmc_asym.params import Strip
-from ipmc_asym.sweeps import parse_vary, sweep
+from ipmc_asym.sweeps import iter_sweep, parse_vary, sweep
 
 
 def test_parse_vary():
@@ -76,3 +76,50 @@ def test_cli_sweep_json(capsys):
     assert len(d["rows"]) == 3 and {"length", "I", "w", "F_block", "regime"} <= set(d["rows"][0])
     assert any(f["quantity"] == "w_small" for f in d["fits"])
     assert main(["sweep", "--vary", "bogus=1:2:3"]) == 2
+
+
+def test_prefetched_keeps_order_raises_and_stops():
+    """The background producer changes nothing but timing: same chunks in the same order, the
+    producer's exception surfaces in the consumer, and a consumer that stops early stops it."""
+    import threading
+
+    from ipmc_asym.sweeps import prefetched
+
+    assert list(prefetched(iter(range(50)))) == list(range(50))
+
+    def failing():
+        yield 1
+        raise ValueError("voltage must be finite (volts)")
+
+    got = []
+    with pytest.raises(ValueError, match="voltage"):
+        for c in prefetched(failing()):
+            got.append(c)
+    assert got == [1]
+
+    produced = []
+
+    def endless():
+        k = 0
+        while True:
+            produced.append(k)
+            yield k
+            k += 1
+
+    g = prefetched(endless())
+    assert next(g) == 0
+    g.close()
+    for t in threading.enumerate():
+        if t.name == "ipmc-sweep-producer":
+            t.join(timeout=5)
+            assert not t.is_alive()
+    assert len(produced) < 10
+
+
+def test_prefetched_sweep_identical_to_serial():
+    from ipmc_asym.sweeps import prefetched
+
+    vary = {"thickness": np.linspace(50e-6, 500e-6, 7), "voltage": np.linspace(-2.0, 3.0, 9)}
+    a = np.concatenate(list(iter_sweep(vary, "all", "leading", chunk_rows=10)))
+    b = np.concatenate(list(prefetched(iter_sweep(vary, "all", "leading", chunk_rows=10))))
+    assert a.tobytes() == b.tobytes()
