@@ -23,7 +23,7 @@ def hashed_sources() -> list:
     such as ``EXACT_STATED_ERROR`` are frozen into the compiled sweep driver)."""
     here = Path(__file__).resolve().parent
     return sorted([here / "_jit.py", here / "integral.py", here / "integral_samples.py", here / "settings.py",
-                   here / "electrode.py", here / "circuit.py",
+                   here / "electrode.py", here / "circuit.py", here / "textfmt.py",
                    *(here / "kernels").glob("*.py")])
 
 

@@ -32,6 +32,7 @@ from .permittivity import get_model
 from .progress import progress as progress_bar
 from .registry import model_names
 from .settings import CHUNK_ROWS, MAX_ROWS, OUTSIDE_REGIMES, STRAIN_LIMIT
+from .textfmt import format_table
 from .units import SWEEP_VARIABLES as VARIABLES
 from .units import parse_vary, parse_vary_spec, vary_values
 
@@ -323,10 +324,12 @@ def withhold(arr: np.ndarray, copy: bool = True) -> np.ndarray:
     above the strain limit; everything computed where no rung is valid (already NaN).
     """
     out = arr.copy() if copy else arr
-    for c in _FREE:
-        out[c] = np.where(arr["check_beam_regime"], arr[c], np.nan)
-    for c in _MECH:
-        out[c] = np.where(arr["check_strain"], out[c], np.nan)
+    for check, cols in (("check_beam_regime", _FREE), ("check_strain", _MECH)):
+        bad = ~out[check]
+        if bad.any():  # only the rows concerned are written (strided fields are slow to sweep)
+            idx = np.flatnonzero(bad)
+            for c in cols:
+                out[c][idx] = np.nan
     return out
 
 
@@ -371,9 +374,40 @@ def _pieces(arr):
 
 
 def format_chunk(arr: np.ndarray, kind: str = "csv") -> str:
-    """Text of one chunk (no header), one line per row, built per column with ``tolist``
-    and one ``%`` format per row in C (``np.savetxt`` style): non-finite floats become an
-    empty CSV field / JSON ``null``, booleans ``True``/``False`` (CSV) or ``true``/``false``."""
+    """Text of one chunk (no header), one line per row: floats ``%.10g`` (CSV) or ``%.17g``
+    (JSON, round-trip), non-finite floats an empty CSV field / JSON ``null``, booleans
+    ``True``/``False`` (CSV) or ``true``/``false`` (JSON).
+
+    Written by the compiled formatter (:mod:`ipmc_asym.textfmt`), byte for byte the text of
+    one Python ``%`` per row (:func:`_format_chunk_python`, tested equal), which remains the
+    fallback where a rounding is too close for the compiled one to call.
+    """
+    text = _format_chunk_compiled(arr, kind)
+    return _format_chunk_python(arr, kind) if text is None else text
+
+
+def _format_chunk_compiled(arr: np.ndarray, kind: str):
+    names = arr.dtype.names
+    csv = kind == "csv"
+    cols = []
+    for c in names:
+        a = arr[c]
+        if a.dtype.kind == "f":
+            cols.append(("f", a))
+        elif a.dtype.kind == "b":
+            cols.append(("s", (a.view(np.uint8), ["False", "True"] if csv else ["false", "true"])))
+        else:
+            cols.append(("u", a))
+    if csv:
+        return format_table(cols, [""] + [","] * (len(names) - 1), 10, nonfinite="", row_sep="\n")
+    keys = [f'"{LABELS.get(c, c)}": ' for c in names]
+    return format_table(cols, keys[:1] + [", " + k for k in keys[1:]], 17, nonfinite="null", row_start="{",
+                        row_end="}", row_sep=",\n", quote_strings=True)
+
+
+def _format_chunk_python(arr: np.ndarray, kind: str = "csv") -> str:
+    """:func:`format_chunk` with one ``%`` format per row (``np.savetxt`` style): the reference
+    the compiled formatter is tested against, and its fallback."""
     names = arr.dtype.names
     cols = []
     for c in names:

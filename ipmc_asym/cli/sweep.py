@@ -143,9 +143,17 @@ def run(args) -> int:
                 vary, args.model, args.fidelity, base, mat, args.tol, escalate=not args.no_escalate,
                 progress=bar, failures=failures))
         try:
-            fits, notes = _fits(vary, args, base, mat)
+            # the fits after the rows: their (small) sweeps would otherwise run while the
+            # producer thread is computing chunks, two parallel kernels at once
+            fitted: list = []
+
+            def fits_and_notes():
+                if not fitted:
+                    fitted.append(_fits(vary, args, base, mat))
+                return fitted[0]
 
             def tail():
+                fits, notes = fits_and_notes()
                 return {"fits": fits, "fit_notes": notes, "seconds": time.perf_counter() - t0}
 
             to_json_file = bool(args.out) and args.out.lower().endswith(".json")
@@ -165,6 +173,7 @@ def run(args) -> int:
                 rows = write_csv(chunks, "-")
         finally:
             bar.close()
+        fits, notes = fits_and_notes()
     dt = time.perf_counter() - t0
     if args.out:
         sys.stderr.write(f"sweep: {rows} rows in {dt:.3g} s -> {args.out}\n")
