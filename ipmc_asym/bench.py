@@ -225,6 +225,7 @@ SECTIONS: dict[str, str] = {
     "uq": "ipmc_asym.uq:bench_section",
     "distributed": "ipmc_asym.executors:bench_section",
     "charge": "ipmc_asym.charge_studies:bench_section",  # issue 11: charge, step circuit/pnp
+    "commands": "ipmc_asym.bench_commands:section",  # issue 10: sweep --out 10^6 rows, figures
 }
 
 

@@ -8,6 +8,8 @@ Every figure is measured side by side in one run, as a ratio where the target is
 * the API (``moment_integral``, fused driver) vs the bare sweep driver on precomputed groups
   at ``10^7`` points (``leading``, 1 thread), ``moment()`` beside it, and the API's 2-thread
   speed-up;
+* ``leading`` / ``corrected`` API time per point (``moment_integral``, 1 thread, each model)
+  over a compiled loop of 7 transcendental calls per point (:mod:`ipmc_asym.kernels.reference`);
 * temporaries of one ``moment()`` call beyond its inputs and outputs (tracemalloc peak),
   bytes per point;
 * one scalar ``moment_integral(2e-4, 1.0, fidelity="leading")`` call (warm), and its ratio to
@@ -27,13 +29,14 @@ import time
 
 import numpy as np
 
-__all__ = ["section", "exact_sample", "api_vs_kernel", "temporaries_per_point", "scalar_call",
-           "startup_ratio"]
+__all__ = ["section", "exact_sample", "api_vs_kernel", "api_vs_transcendentals", "temporaries_per_point",
+           "scalar_call", "startup_ratio"]
 
 EXACT_THICKNESS = (1e-6, 1e-2)
 EXACT_VOLTAGE = (1e-4, 20.0)
 TARGETS = {"exact_seconds_per_point": 30e-6, "exact_speedup_vs_bvp": 1e3, "exact_rel_error": 1e-11,
            "api_over_kernel": 1.15, "api_two_thread_speedup": 1.8, "temporary_bytes_per_point": 16.0,
+           "leading_over_loop": 1.5, "corrected_over_loop": 2.0,
            "scalar_call_s": 2e-6, "startup_over_import_numba": 2.0}
 
 
@@ -136,6 +139,35 @@ def api_vs_kernel(n: int = 10**7, repeats: int = 3, threads: int = 2) -> dict:
             "kernel_parallel_s": tk2, "threads": threads}
 
 
+def api_vs_transcendentals(n: int = 10**7, repeats: int = 3) -> dict:
+    """Seconds per point, 1 thread, of ``moment_integral`` (``leading``, ``corrected``; each
+    model) and of the 7-transcendental reference loop (:mod:`ipmc_asym.kernels.reference`),
+    on the points of :func:`api_vs_kernel`, interleaved (same machine load)."""
+    from .integral import moment_integral
+    from .kernels.reference import seven_transcendentals
+
+    th = np.exp(np.linspace(np.log(10e-6), np.log(4e-3), n))
+    v = np.exp(np.linspace(np.log(1e-3), np.log(10.0), n))[::-1].copy()
+    out = np.empty(n)
+    calls = {"loop": lambda: seven_transcendentals(th, v, out)}
+    for fid in ("leading", "corrected"):
+        for model in ("constant", "linear", "affine"):
+            calls[(fid, model)] = (lambda f=fid, m=model: moment_integral(th, v, m, f, on_invalid="nan"))
+    old = _threads(1)
+    try:
+        best = {}
+        for k, f in calls.items():
+            f()
+            best[k] = math.inf
+        for _ in range(repeats):
+            for k, f in calls.items():
+                best[k] = min(best[k], _best(f, 1))
+    finally:
+        _threads(old)
+    return {"points": n, "loop_s_per_point": best.pop("loop") / n,
+            "api_s_per_point": {f"{f}/{m}": t / n for (f, m), t in best.items()}}
+
+
 def temporaries_per_point(n: int = 10**6) -> float:
     """Peak bytes allocated by one ``moment()`` call beyond its outputs, per point (tracemalloc)."""
     import tracemalloc
@@ -197,6 +229,7 @@ def section(quick: bool = False) -> dict:
     T = TARGETS
     ex = exact_timing(n=200 if quick else 3000, bvp_n=1 if quick else 2)
     ak = api_vs_kernel(n=2 * 10**5 if quick else 10**7)
+    tl = api_vs_transcendentals(n=2 * 10**5 if quick else 10**7)
     tmp = temporaries_per_point(n=10**5 if quick else 10**6)
     sc = scalar_call(number=2000 if quick else 20000)
     st = startup_ratio(repeats=1 if quick else 3)
@@ -224,6 +257,12 @@ def section(quick: bool = False) -> dict:
                      T["api_two_thread_speedup"], r2 >= T["api_two_thread_speedup"],
                      f"bare driver: {ak['kernel_s'] / ak['kernel_parallel_s']:.2f}x; machine shared: "
                      "other load lowers both"))
+    for key, t in tl["api_s_per_point"].items():
+        fid, model = key.split("/")
+        r = t / tl["loop_s_per_point"]
+        tgt = T[f"{fid}_over_loop"]
+        figs.append(_fig(f"{fid} API / 7-transcendental loop, {model} (1 thread, {tl['points']:.0e} points)", r, "x",
+                         tgt, r <= tgt, f"{t * 1e9:.1f} ns vs {tl['loop_s_per_point'] * 1e9:.1f} ns a point"))
     figs.append(_fig("temporaries of moment() beyond inputs and outputs", tmp, "bytes/point",
                      T["temporary_bytes_per_point"], tmp <= T["temporary_bytes_per_point"], "tracemalloc peak"))
     figs.append(_fig("scalar moment_integral(2e-4, 1.0, fidelity='leading')", sc["api_s"], "s",
@@ -233,5 +272,5 @@ def section(quick: bool = False) -> dict:
     figs.append(_fig("warm `estimate --fidelity leading` / `python -c 'import numba'`", rs, "x",
                      T["startup_over_import_numba"], rs <= T["startup_over_import_numba"],
                      f"{st['estimate_s']:.2f} s vs {st['import_numba_s']:.2f} s"))
-    return {"figures": figs, "raw": {"exact": ex, "api": ak, "temporaries_bytes_per_point": tmp,
+    return {"figures": figs, "raw": {"exact": ex, "api": ak, "transcendental_loop": tl, "temporaries_bytes_per_point": tmp,
                                      "scalar": sc, "startup": st}}
