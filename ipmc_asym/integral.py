@@ -37,7 +37,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._jit import interpreted, jit, jit_parallel, prange
-from .kernels.closed import moment_closed
+from .kernels.closed import closed_b1, closed_finish, layer_closed, moment_closed
 from .kernels.exact import moment_exact
 from .kernels.quadrature import moment_quadrature
 from .params import NAFION_LI, Material, Strip, debye_length
@@ -174,33 +174,87 @@ def _point(lam, A2, A3, rho, model_id, order):
         return Ii, EXACT_STATED_ERROR, b1, c
     if order == 0:
         Ii, J1, J2, b1, c = moment_quadrature(lam, A2, A3, rho)
-        e_i = ROUNDING_ERROR
-    else:
-        Ii, e_i, b1, c = moment_closed(lam, A2, A3, rho, model_id, order)
-        # The kernel keeps ~20 lam of exponential tails in its core; the layer width the
-        # quadrature measures (to |y| = 1) is the depletion width +- 0.5 lam (measured on
-        # 1 um - 10 mm x 0.1 mV - 20 V), so 2 - dep - lam is a conservative core and the
-        # core interaction 4 exp(-core/lam) below is no longer overstated by ~e^19
-        # (``corrected`` was flagged invalid at 10 um while accurate to ~1e-9).
-        c = c + 19.0 * lam
-        if order == 1:
-            # the kernel states t = |lam J2 / J1| (+ truncation), relative to the leading
-            # term; relative to I = lam J1 (1 + lam J2/J1) the error is at most t / (1 - t)
-            e_i = e_i / (1.0 - e_i) if e_i < 1.0 else math.inf
-        e_i = max(e_i, ROUNDING_ERROR)
+        return Ii, ROUNDING_ERROR + _core_error(c, lam), b1, c
+    return _closed_post(lam, order, *moment_closed(lam, A2, A3, rho, model_id, order))
+
+
+@jit
+def _closed_post(lam, order, Ii, e_i, b1, c):
+    """The closed forms' ``(I, error, B1, core)`` as :func:`_point` returns them."""
+    # The kernel keeps ~20 lam of exponential tails in its core; the layer width the
+    # quadrature measures (to |y| = 1) is the depletion width +- 0.5 lam (measured on
+    # 1 um - 10 mm x 0.1 mV - 20 V), so 2 - dep - lam is a conservative core and the
+    # core interaction 4 exp(-core/lam) below is no longer overstated by ~e^19
+    # (``corrected`` was flagged invalid at 10 um while accurate to ~1e-9).
+    c = c + 19.0 * lam
+    if order == 1:
+        # the kernel states t = |lam J2 / J1| (+ truncation), relative to the leading
+        # term; relative to I = lam J1 (1 + lam J2/J1) the error is at most t / (1 - t)
+        e_i = e_i / (1.0 - e_i) if e_i < 1.0 else math.inf
+    e_i = max(e_i, ROUNDING_ERROR)
     # neglected core interaction: exponentially small in core/lambda
     return Ii, e_i + _core_error(c, lam), b1, c
 
 
+#: points per block of the closed-form drivers (a few kB of temporaries per thread)
+BLOCK = 1024
+
+
+@jit
+def _closed_block(lam, A2, A3, rho, model_id, order, I, err, B1, core):
+    """:func:`_point` for the closed forms over a block of points (A2 > 0), stage by stage.
+
+    Why: one point is a chain of dependent calls (exp, log, a polynomial, square roots) whose
+    latency, not the number of operations, sets its cost; run stage by stage over a block,
+    consecutive points are independent and the processor overlaps them.  The operations are
+    those of :func:`moment_closed`, in the same order: the results are bit for bit the same
+    (tested).  ``I``, ``err``, ``B1``, ``core``: outputs of the block's length, also used as
+    the stage-1 and layer temporaries.
+    """
+    m = lam.size
+    em = np.empty(m)
+    yc = np.empty(m)
+    w0a = np.empty(m)
+    w1a = np.empty(m)
+    acc = 2 if order == 2 else 1
+    for k in range(m):
+        em[k], B1[k], yc[k] = closed_b1(A2[k], model_id)
+    for k in range(m):  # the cathode layer functions, held in I and err until stage 3
+        I[k], err[k] = layer_closed(yc[k], model_id, acc)
+    for k in range(m):
+        w0a[k], w1a[k] = layer_closed(yc[k] - A2[k], model_id, acc)
+    for k in range(m):
+        Ii, e_i, b1, c = closed_finish(lam[k], A2[k], A3, rho, model_id, order, em[k], B1[k], yc[k], I[k], err[k],
+                                       w0a[k], w1a[k])
+        I[k], err[k], B1[k], core[k] = _closed_post(lam[k], order, Ii, e_i, b1, c)
+
+
 @jit_parallel
 def _sweep(lam, A2, A3, rho, model_id, order, sign, I, err, B1, core):
-    """The one sweep driver (prange): ``order`` 1 leading, 2 corrected, 0 quadrature, 3 exact."""
-    for i in prange(lam.size):
-        Ii, e_i, b1, c = _point(lam[i], A2[i], A3, rho, model_id, order)
-        I[i] = sign[i] * Ii
-        err[i] = e_i
-        B1[i] = b1
-        core[i] = c
+    """The bare sweep driver on precomputed groups (prange; the bench's kernel cost):
+    ``order`` 1 leading, 2 corrected (blocks, as in :func:`_sweep_fused`), 0 quadrature, 3 exact."""
+    n = lam.size
+    if order == 1 or order == 2:
+        for b in prange((n + BLOCK - 1) // BLOCK):
+            i0 = b * BLOCK
+            i1 = min(n, i0 + BLOCK)
+            ab = A2[i0:i1].copy()
+            for k in range(i1 - i0):
+                if not ab[k] > 0.0:  # zero volts: stand-in, overwritten below
+                    ab[k] = 1.0
+            _closed_block(lam[i0:i1], ab, A3, rho, model_id, order, I[i0:i1], err[i0:i1], B1[i0:i1], core[i0:i1])
+            for i in range(i0, i1):
+                if A2[i] == 0.0:
+                    I[i], err[i], B1[i], core[i] = 0.0, 0.0, 1.0, 2.0
+                else:
+                    I[i] = sign[i] * I[i]
+    else:
+        for i in prange(n):
+            Ii, e_i, b1, c = _point(lam[i], A2[i], A3, rho, model_id, order)
+            I[i] = sign[i] * Ii
+            err[i] = e_i
+            B1[i] = b1
+            core[i] = c
 
 
 
@@ -211,7 +265,7 @@ def _groups_point(t, vv, lamc, a2c):
     return lamc / t, a2c * abs(vv)
 
 
-@jit_parallel
+@jit
 def _sweep_fused(th, v, lamc, a2c, A3, rho, model_id, order, any_thickness, limit,
                  I, err, B1, core, lam_o, A2_o, valid, nan_invalid=False):
     """The fused sweep driver: groups, sign and validity computed inside the parallel loop.
@@ -224,6 +278,89 @@ def _sweep_fused(th, v, lamc, a2c, A3, rho, model_id, order, any_thickness, limi
     arrays).  Returns the counts of bad thicknesses (not finite or <= 0), of bad voltages
     (not finite) -- those points are left as NaN and the caller raises -- and of invalid points.
     """
+    if order == 1 or order == 2:  # closed forms: blocks of points, stage by stage
+        return _fused_blocks(th, v, lamc, a2c, A3, rho, model_id, order, any_thickness, limit,
+                             I, err, B1, core, lam_o, A2_o, valid, nan_invalid)
+    return _fused_points(th, v, lamc, a2c, A3, rho, model_id, order, any_thickness, limit,
+                         I, err, B1, core, lam_o, A2_o, valid, nan_invalid)
+
+
+@jit_parallel
+def _fused_blocks(th, v, lamc, a2c, A3, rho, model_id, order, any_thickness, limit,
+                  I, err, B1, core, lam_o, A2_o, valid, nan_invalid):
+    """:func:`_sweep_fused` for the closed forms: blocks of ``BLOCK`` points, stage by stage
+    (:func:`_closed_block`); bit for bit the per-point results."""
+    n = I.size
+    sth = th.size > 1
+    sv = v.size > 1
+    full = err.size == n  # bookkeeping outputs wanted (all or none)
+    nb = (n + BLOCK - 1) // BLOCK
+    counts = np.zeros((nb, 3), np.int64)  # per block: bad thickness, bad voltage, invalid
+    for b in prange(nb):
+        i0 = b * BLOCK
+        m = min(n, i0 + BLOCK) - i0
+        lam = np.empty(m)
+        A2 = np.empty(m)
+        bI = np.empty(m)
+        be = np.empty(m)
+        bb = np.empty(m)
+        bc = np.empty(m)
+        for k in range(m):
+            t = th[i0 + k] if sth else th[0]
+            vv = v[i0 + k] if sv else v[0]
+            lam[k], A2[k] = 1e-3, 1.0  # stand-ins where a point is handled apart (below)
+            if math.isfinite(t) and t > 0.0 and math.isfinite(vv):
+                lk, ak = _groups_point(t, vv, lamc, a2c)
+                if ak > 0.0:
+                    lam[k], A2[k] = lk, ak
+        _closed_block(lam, A2, A3, rho, model_id, order, bI, be, bb, bc)
+        lb_th = 0
+        lb_v = 0
+        lb_inv = 0
+        for k in range(m):
+            i = i0 + k
+            t = th[i] if sth else th[0]
+            vv = v[i] if sv else v[0]
+            bad_t = not (math.isfinite(t) and t > 0.0)
+            if bad_t or not math.isfinite(vv):
+                if bad_t:
+                    lb_th += 1
+                else:
+                    lb_v += 1
+                I[i] = math.nan
+                valid[i] = False
+                lb_inv += 1
+                if full:
+                    err[i] = B1[i] = core[i] = lam_o[i] = A2_o[i] = math.nan
+                continue
+            lk, ak = _groups_point(t, vv, lamc, a2c)
+            if ak == 0.0:  # zero volts: I = 0 exactly, as _point says
+                Ii, e_i, b1, c = 0.0, 0.0, 1.0, 2.0
+            else:
+                Ii, e_i, b1, c = bI[k], be[k], bb[k], bc[k]
+            ok = (e_i < limit) and (c > 0.0 or any_thickness)
+            valid[i] = ok
+            if ok or not nan_invalid:
+                I[i] = Ii if vv >= 0.0 else -Ii
+            else:
+                I[i] = math.nan
+                lb_inv += 1
+            if full:
+                err[i] = e_i
+                B1[i] = b1
+                core[i] = c
+                lam_o[i] = lk
+                A2_o[i] = ak
+        counts[b, 0] = lb_th
+        counts[b, 1] = lb_v
+        counts[b, 2] = lb_inv
+    return counts[:, 0].sum(), counts[:, 1].sum(), counts[:, 2].sum()
+
+
+@jit_parallel
+def _fused_points(th, v, lamc, a2c, A3, rho, model_id, order, any_thickness, limit,
+                  I, err, B1, core, lam_o, A2_o, valid, nan_invalid):
+    """:func:`_sweep_fused` point by point (``quadrature``, ``exact``)."""
     n = I.size
     sth = th.size > 1
     sv = v.size > 1

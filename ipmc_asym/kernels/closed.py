@@ -12,7 +12,7 @@ import math
 from .._jit import jit
 from . import _generated as G
 
-__all__ = ["layer_closed", "moment_closed", "TRUNCATION"]
+__all__ = ["layer_closed", "moment_closed", "closed_b1", "closed_finish", "TRUNCATION"]
 
 
 #: truncation of the patches (18 terms at ratio <= 1/6 of the radius) and of the
@@ -65,6 +65,8 @@ def layer_closed(Y, model_id, need_w1):
     ``need_w1``: 2 = full accuracy for both; 1 = the order-1 (``leading``) accuracy: W0 to
     ~1e-7 and W1 to ~1e-4 (for the error estimate only).
     """
+    if not Y == Y:  # NaN: no table row to look up
+        return math.nan, math.nan
     if Y < 2.0 * _KMIN - 1.0:
         if model_id == 0:
             return G.depletion_constant(Y)
@@ -88,20 +90,8 @@ def layer_closed(Y, model_id, need_w1):
 
 
 @jit
-def moment_closed(lam, A2, A3, rho, model_id, order):
-    """``I`` at order 1 (``leading``: lam J1) or 2 (``corrected``: lam J1 + lam^2 J2).
-
-    ``rho`` must be the model's own (``A1/(A0+A1)``: 1, 0, 5/1005); the per-model kernels
-    have it built in and the caller (:func:`ipmc_asym.integral.moment`) guarantees it.
-
-    Returns
-    -------
-    I, error, B1, core : floats
-        ``error`` is a relative estimate: the first neglected term (``lam^2 |J2|``, only at
-        order 1, estimated from the closed form of ``J2``) plus the truncation of the layer
-        functions.  ``core`` (the neutral core length) is estimated from the depletion
-        width ``lam * sqrt(2 (|Ya| - 1))`` and ``~ 10 lam`` per layer.
-    """
+def closed_b1(A2, model_id):
+    """Stage 1 of :func:`moment_closed`: ``(e^{-A2}, B1, ln B1)``."""
     if A2 > 1.0:  # e^{-A2} - 1 <= -0.63: no cancellation, and exp is cheaper than expm1
         em = math.exp(-A2)
         em1 = em - 1.0
@@ -114,13 +104,15 @@ def moment_closed(lam, A2, A3, rho, model_id, order):
         B1 = G.b1_linear(A2, em1)
     else:
         B1 = G.b1_affine(A2, em1)
-    Yc = math.log(B1)
+    return em, B1, math.log(B1)
+
+
+@jit
+def closed_finish(lam, A2, A3, rho, model_id, order, em, B1, Yc, W0c, W1c, W0a, W1a):
+    """Stage 3 of :func:`moment_closed`: ``(I, error, B1, core)`` from the stage-1 values and
+    the layer functions at the cathode (``W0c, W1c``) and the anode (``W0a, W1a``)."""
     Ya = Yc - A2
     cm = B1 * em
-    # at order 1, J2 only feeds the error estimate: W1 to ~1e-6 is enough
-    acc = 2 if order == 2 else 1
-    W0c, W1c = layer_closed(Yc, model_id, acc)
-    W0a, W1a = layer_closed(Ya, model_id, acc)
     # Dhat: straight from C = B1 when C - 1 is not small (no exp, no cancellation), else the
     # Taylor series of sqrt(Qhat) at 0 (no exp either)
     big = Yc > 0.5
@@ -146,3 +138,29 @@ def moment_closed(lam, A2, A3, rho, model_id, order):
     dep = lam * math.sqrt(2.0 * rho * max(-Ya - 1.0, 0.0))
     core = 2.0 - dep - 20.0 * lam
     return I, err, B1, core
+
+
+@jit
+def moment_closed(lam, A2, A3, rho, model_id, order):
+    """``I`` at order 1 (``leading``: lam J1) or 2 (``corrected``: lam J1 + lam^2 J2).
+
+    ``rho`` must be the model's own (``A1/(A0+A1)``: 1, 0, 5/1005); the per-model kernels
+    have it built in and the caller (:func:`ipmc_asym.integral.moment`) guarantees it.
+    Three stages (:func:`closed_b1`, :func:`layer_closed` at both faces,
+    :func:`closed_finish`), which the block drivers of :mod:`ipmc_asym.integral` run stage by
+    stage over a block of points: the same operations, bit for bit.
+
+    Returns
+    -------
+    I, error, B1, core : floats
+        ``error`` is a relative estimate: the first neglected term (``lam^2 |J2|``, only at
+        order 1, estimated from the closed form of ``J2``) plus the truncation of the layer
+        functions.  ``core`` (the neutral core length) is estimated from the depletion
+        width ``lam * sqrt(2 (|Ya| - 1))`` and ``~ 10 lam`` per layer.
+    """
+    em, B1, Yc = closed_b1(A2, model_id)
+    # at order 1, J2 only feeds the error estimate: W1 to ~1e-6 is enough
+    acc = 2 if order == 2 else 1
+    W0c, W1c = layer_closed(Yc, model_id, acc)
+    W0a, W1a = layer_closed(Yc - A2, model_id, acc)
+    return closed_finish(lam, A2, A3, rho, model_id, order, em, B1, Yc, W0c, W1c, W0a, W1a)
