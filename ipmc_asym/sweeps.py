@@ -38,7 +38,7 @@ from .units import parse_vary, parse_vary_spec, vary_values
 
 __all__ = ["VARIABLES", "DTYPE", "LABELS", "CHECK_COLS", "parse_vary", "parse_vary_spec", "vary_values", "sweep", "iter_sweep",
            "prefetched", "count_rows",
-           "withhold", "format_chunk", "csv_header", "write_csv", "write_json", "rows_as_dicts"]
+           "withhold", "format_chunk", "warm_writer", "csv_header", "write_csv", "write_json", "rows_as_dicts"]
 
 
 _FLOAT_COLS = ("length", "width", "thickness", "voltage", "modulus", "I", "M_A", "theta", "w", "w_small",
@@ -142,13 +142,16 @@ def iter_sweep(vary: dict, model="constant", fidelity="quadrature", base: Strip 
                 progress.update(k)
 
 
-def prefetched(chunks, depth: int = 1):
+def prefetched(chunks, depth: int = 1, threads: int | None = None):
     """``chunks`` computed one step ahead in a background thread.
 
     The consumer (formatting and writing a chunk, compiled and without the GIL) then runs on
     one core while the next chunk is computed on the other; memory grows by ``depth`` chunks.
     An exception in the producer is raised in the consumer, at the chunk where it happened.
-    Only the producer calls the parallel kernels (Numba's workqueue layer is not re-entrant).
+    The producer starts at once.  While it runs, the caller must not launch parallel kernels
+    itself (Numba's workqueue layer is not re-entrant): formatting and writing are serial.
+    ``threads``: Numba threads of the producer's kernels (e.g. 1: one core computes while the
+    consumer uses the other).
     """
     import contextvars
     import queue
@@ -160,6 +163,10 @@ def prefetched(chunks, depth: int = 1):
 
     def produce():
         try:
+            if threads is not None:  # Numba's thread count is per calling thread
+                import numba
+
+                numba.set_num_threads(max(1, min(int(threads), numba.config.NUMBA_NUM_THREADS)))
             for c in chunks:
                 while not stop.is_set():
                     try:
@@ -176,17 +183,21 @@ def prefetched(chunks, depth: int = 1):
     # the caller's context (NumPy's errstate lives in a context variable)
     ctx = contextvars.copy_context()
     t = threading.Thread(target=ctx.run, args=(produce,), name="ipmc-sweep-producer", daemon=True)
-    t.start()
-    try:
-        while True:
-            c, exc = q.get()
-            if c is done:
-                if exc is not None:
-                    raise exc
-                return
-            yield c
-    finally:
-        stop.set()
+    t.start()  # now, not at the first next(): the caller may prepare its writer meanwhile
+
+    def drain():
+        try:
+            while True:
+                c, exc = q.get()
+                if c is done:
+                    if exc is not None:
+                        raise exc
+                    return
+                yield c
+        finally:
+            stop.set()
+
+    return drain()
 
 
 def _pair_code(names, axes, idx, k):
@@ -424,6 +435,11 @@ def _format_chunk_python(arr: np.ndarray, kind: str = "csv") -> str:
     fmt = "{" + _row_format(names, ", ", json_keys=True) + "}"
     text = ",\n".join(map(fmt.__mod__, zip(*cols)))
     return text.replace("-inf", "null").replace("inf", "null").replace("nan", "null")
+
+
+def warm_writer(kind: str = "csv") -> None:
+    """Load the compiled formatter (from Numba's cache) now, e.g. while a producer computes."""
+    format_chunk(np.zeros(1, DTYPE), kind)
 
 
 def csv_header(names=DTYPE.names) -> str:

@@ -329,7 +329,8 @@ def _copy(src, start, m, out, pos):
 def _format_rows(F, C, U, kinds, idx, quote, P, text, pre_off, pre_len, vocab_off, vocab_len, voc_base,
                  nonfinite_off, nonfinite_len, row_start_off, row_start_len, row_end_off, row_end_len,
                  row_sep_off, row_sep_len, out):
-    """All rows into ``out``; returns the bytes written, or -1 (an ambiguous rounding).
+    """All rows into ``out``; returns the bytes written, -1 (an ambiguous rounding) or -2 (a
+    text column with a character that is not printable ASCII, or a quote or backslash).
 
     Every fixed piece of text (prefixes, vocabulary words, the non-finite field, row start,
     end and separator) is a slice ``text[off:off + len]``.  Column ``j`` of kind 0 is float
@@ -382,6 +383,8 @@ def _format_rows(F, C, U, kinds, idx, quote, P, text, pre_off, pre_len, vocab_of
                     c = U[k, i, q]
                     if c == 0:
                         break
+                    if c < 32 or c > 126 or c == 34 or c == 92:  # not printable ASCII, '"' or '\\'
+                        return -2
                     out[pos] = c
                     pos += 1
                 if quote[j]:
@@ -480,8 +483,6 @@ def format_table(columns, prefixes, precision: int, nonfinite: str = "", row_sta
         w = a.dtype.itemsize // 4
         if w:
             U[i, :, :w] = np.ascontiguousarray(a).view(np.uint32).reshape(n, w)
-    if U.size and (U.max() >= 127 or np.any((U < 32) & (U != 0)) or np.any((U == 34) | (U == 92))):
-        raise ValueError("text columns must be printable ASCII without '\"' or '\\'")
     tx = _Text()
     pre = [tx.add(p) for p in prefixes]
     voc = [tx.add(v) for v in vocab] or [(0, 0)]
@@ -494,6 +495,8 @@ def format_table(columns, prefixes, precision: int, nonfinite: str = "", row_sta
     m = _format_rows(F, C, U, i64(kinds), i64(idx), quote, int(precision), tx.array(),
                      i64([o for o, _ in pre]), i64([m for _, m in pre]), i64([o for o, _ in voc]),
                      i64([m for _, m in voc]), i64(offs), *nf, *rs, *re_, *sep, out)
+    if m == -2:
+        raise ValueError("text columns must be printable ASCII without '\"' or '\\'")
     if m < 0:
         return None
     return out[:m].tobytes().decode("ascii")

@@ -114,7 +114,7 @@ def run(args) -> int:
 
         check_scheduler(args.scheduler)
     # deferred: the compiled kernels load only once the sweep is known to be accepted
-    from ..sweeps import iter_sweep, prefetched, withhold, write_csv, write_json
+    from ..sweeps import iter_sweep, prefetched, warm_writer, withhold, write_csv, write_json
 
     base = strip_from_args(args)
     mat = material_from_args(args)
@@ -138,10 +138,12 @@ def run(args) -> int:
                 failures.append(f"{int(bad.sum())} row(s) with no valid rung of the fidelity ladder")
             chunks = [withhold(arr, copy=False)]
         else:
-            # computed one chunk ahead of the formatting and writing (two cores)
-            chunks = prefetched(withhold(c, copy=False) for c in iter_sweep(
+            # computed one chunk ahead of the formatting and writing: one core each
+            chunks = prefetched((withhold(c, copy=False) for c in iter_sweep(
                 vary, args.model, args.fidelity, base, mat, args.tol, escalate=not args.no_escalate,
-                progress=bar, failures=failures))
+                progress=bar, failures=failures)), threads=1)
+            # meanwhile, the formatter loads from the cache (serial code: no second parallel launch)
+            warm_writer("json" if args.json or (args.out or "").lower().endswith(".json") else "csv")
         try:
             # the fits after the rows: their (small) sweeps would otherwise run while the
             # producer thread is computing chunks, two parallel kernels at once
