@@ -285,6 +285,35 @@ def _sweep_fused(th, v, lamc, a2c, A3, rho, model_id, order, any_thickness, limi
                          I, err, B1, core, lam_o, A2_o, valid, nan_invalid)
 
 
+@jit(inline="always")  # seven output arrays: a real call costs more than the point
+def _put(i, t, vv, lam, A2, Ii, e_i, b1, c, limit, any_thickness, nan_invalid, full,
+         I, err, B1, core, lam_o, A2_o, valid):
+    """Write point ``i`` of a fused driver (``Ii`` for ``|phi0|``); returns 0 (written), 1 (invalid,
+    NaN in ``I``), 2 (thickness not finite or <= 0) or 3 (voltage not finite): NaN throughout."""
+    bad_t = not (math.isfinite(t) and t > 0.0)
+    if bad_t or not math.isfinite(vv):
+        I[i] = math.nan
+        valid[i] = False
+        if full:
+            err[i] = B1[i] = core[i] = lam_o[i] = A2_o[i] = math.nan
+        return 2 if bad_t else 3
+    ok = (e_i < limit) and (c > 0.0 or any_thickness)
+    valid[i] = ok
+    code = 0
+    if ok or not nan_invalid:
+        I[i] = Ii if vv >= 0.0 else -Ii
+    else:
+        I[i] = math.nan
+        code = 1
+    if full:
+        err[i] = e_i
+        B1[i] = b1
+        core[i] = c
+        lam_o[i] = lam
+        A2_o[i] = A2
+    return code
+
+
 @jit_parallel
 def _fused_blocks(th, v, lamc, a2c, A3, rho, model_id, order, any_thickness, limit,
                   I, err, B1, core, lam_o, A2_o, valid, nan_invalid):
@@ -321,36 +350,16 @@ def _fused_blocks(th, v, lamc, a2c, A3, rho, model_id, order, any_thickness, lim
             i = i0 + k
             t = th[i] if sth else th[0]
             vv = v[i] if sv else v[0]
-            bad_t = not (math.isfinite(t) and t > 0.0)
-            if bad_t or not math.isfinite(vv):
-                if bad_t:
-                    lb_th += 1
-                else:
-                    lb_v += 1
-                I[i] = math.nan
-                valid[i] = False
-                lb_inv += 1
-                if full:
-                    err[i] = B1[i] = core[i] = lam_o[i] = A2_o[i] = math.nan
-                continue
             lk, ak = _groups_point(t, vv, lamc, a2c)
             if ak == 0.0:  # zero volts: I = 0 exactly, as _point says
                 Ii, e_i, b1, c = 0.0, 0.0, 1.0, 2.0
             else:
                 Ii, e_i, b1, c = bI[k], be[k], bb[k], bc[k]
-            ok = (e_i < limit) and (c > 0.0 or any_thickness)
-            valid[i] = ok
-            if ok or not nan_invalid:
-                I[i] = Ii if vv >= 0.0 else -Ii
-            else:
-                I[i] = math.nan
-                lb_inv += 1
-            if full:
-                err[i] = e_i
-                B1[i] = b1
-                core[i] = c
-                lam_o[i] = lk
-                A2_o[i] = ak
+            code = _put(i, t, vv, lk, ak, Ii, e_i, b1, c, limit, any_thickness, nan_invalid, full,
+                        I, err, B1, core, lam_o, A2_o, valid)
+            lb_th += code == 2
+            lb_v += code == 3
+            lb_inv += code != 0
         counts[b, 0] = lb_th
         counts[b, 1] = lb_v
         counts[b, 2] = lb_inv
@@ -371,33 +380,15 @@ def _fused_points(th, v, lamc, a2c, A3, rho, model_id, order, any_thickness, lim
     for i in prange(n):
         t = th[i] if sth else th[0]
         vv = v[i] if sv else v[0]
-        bad_t = not (math.isfinite(t) and t > 0.0)
-        if bad_t or not math.isfinite(vv):
-            if bad_t:
-                bad_th += 1
-            else:
-                bad_v += 1
-            I[i] = math.nan
-            valid[i] = False
-            n_invalid += 1
-            if full:
-                err[i] = B1[i] = core[i] = lam_o[i] = A2_o[i] = math.nan
-            continue
-        lam, A2 = _groups_point(t, vv, lamc, a2c)
-        Ii, e_i, b1, c = _point(lam, A2, A3, rho, model_id, order)
-        ok = (e_i < limit) and (c > 0.0 or any_thickness)
-        valid[i] = ok
-        if ok or not nan_invalid:
-            I[i] = Ii if vv >= 0.0 else -Ii
-        else:
-            I[i] = math.nan
-            n_invalid += 1
-        if full:
-            err[i] = e_i
-            B1[i] = b1
-            core[i] = c
-            lam_o[i] = lam
-            A2_o[i] = A2
+        lam = A2 = Ii = e_i = b1 = c = math.nan
+        if math.isfinite(t) and t > 0.0 and math.isfinite(vv):  # else no kernel call at all
+            lam, A2 = _groups_point(t, vv, lamc, a2c)
+            Ii, e_i, b1, c = _point(lam, A2, A3, rho, model_id, order)
+        code = _put(i, t, vv, lam, A2, Ii, e_i, b1, c, limit, any_thickness, nan_invalid, full,
+                    I, err, B1, core, lam_o, A2_o, valid)
+        bad_th += code == 2
+        bad_v += code == 3
+        n_invalid += code != 0
     return bad_th, bad_v, n_invalid
 
 
