@@ -19,6 +19,7 @@ Layer rule: stdlib + numpy at import.
 
 from __future__ import annotations
 
+import io
 import sys
 
 import numpy as np
@@ -397,7 +398,13 @@ def format_chunk(arr: np.ndarray, kind: str = "csv") -> str:
     return _format_chunk_python(arr, kind) if text is None else text
 
 
-def _format_chunk_compiled(arr: np.ndarray, kind: str):
+def _format_chunk_bytes(arr: np.ndarray, kind: str) -> bytes:
+    """:func:`format_chunk` as ASCII bytes (what the writers write)."""
+    text = _format_chunk_compiled(arr, kind, as_bytes=True)
+    return _format_chunk_python(arr, kind).encode("ascii") if text is None else text
+
+
+def _format_chunk_compiled(arr: np.ndarray, kind: str, as_bytes: bool = False):
     names = arr.dtype.names
     csv = kind == "csv"
     cols = []
@@ -410,10 +417,11 @@ def _format_chunk_compiled(arr: np.ndarray, kind: str):
         else:
             cols.append(("u", a))
     if csv:
-        return format_table(cols, [""] + [","] * (len(names) - 1), 10, nonfinite="", row_sep="\n")
+        return format_table(cols, [""] + [","] * (len(names) - 1), 10, nonfinite="", row_sep="\n",
+                            as_bytes=as_bytes)
     keys = [f'"{LABELS.get(c, c)}": ' for c in names]
     return format_table(cols, keys[:1] + [", " + k for k in keys[1:]], 17, nonfinite="null", row_start="{",
-                        row_end="}", row_sep=",\n", quote_strings=True)
+                        row_end="}", row_sep=",\n", quote_strings=True, as_bytes=as_bytes)
 
 
 def _format_chunk_python(arr: np.ndarray, kind: str = "csv") -> str:
@@ -446,25 +454,63 @@ def csv_header(names=DTYPE.names) -> str:
     return ",".join(LABELS.get(c, c) for c in names)
 
 
-def write_csv(arr, path, progress=None):
+def _texts(chunks, kind: str, workers: int):
+    """``(ASCII bytes, rows)`` of each piece of each chunk, in order.  With ``workers`` > 1 the pieces
+    are formatted by that many threads at once (the compiled formatter releases the GIL; no
+    parallel kernel is launched), at most ``2 * workers`` pieces in flight (bounded memory)."""
+    if workers <= 1:
+        for c in chunks:
+            for piece in _pieces(c):
+                yield _format_chunk_bytes(piece, kind), piece.size
+        return
+    from collections import deque
+    from concurrent.futures import ThreadPoolExecutor
+
+    pending: deque = deque()
+    with ThreadPoolExecutor(max_workers=workers, thread_name_prefix="ipmc-format") as pool:
+        for c in chunks:
+            for piece in _pieces(c):
+                pending.append((pool.submit(_format_chunk_bytes, piece, kind), piece.size))
+                while len(pending) > 2 * workers:
+                    f, k = pending.popleft()
+                    yield f.result(), k
+        while pending:
+            f, k = pending.popleft()
+            yield f.result(), k
+
+
+def _byte_writer(fh):
+    """A function writing ASCII bytes to ``fh``: its binary buffer where it has one (after
+    flushing its text layer), else the decoded text (e.g. a ``StringIO``)."""
+    buf = getattr(fh, "buffer", None)
+    if buf is not None:
+        fh.flush()
+        return buf.write
+    if isinstance(fh, (io.RawIOBase, io.BufferedIOBase)):
+        return fh.write
+    return lambda b: fh.write(b.decode("utf-8"))
+
+
+def write_csv(arr, path, progress=None, workers: int = 1):
     """CSV with SI columns (header labels say units and TOTAL thickness/width).
 
     ``arr`` is a structured array or an iterable of chunks (streamed, memory independent of
     the number of rows); ``path`` ``None``/``"-"`` is stdout, otherwise written atomically.
-    Returns the number of rows written.
+    ``workers``: threads formatting pieces at once (the text is the same).  Returns the
+    number of rows written.
     """
     chunks = [arr] if isinstance(arr, np.ndarray) else arr
 
     def rows(fh):
-        fh.write(csv_header() + "\n")
+        put = _byte_writer(fh)
+        put((csv_header() + "\n").encode("ascii"))
         n = 0
-        for c in chunks:
-            for piece in _pieces(c):
-                fh.write(format_chunk(piece, "csv"))
-                fh.write("\n")
-            n += c.size
+        for text, k in _texts(chunks, "csv", int(workers)):
+            put(text)
+            put(b"\n")
+            n += k
             if progress is not None:
-                progress.update(c.size)
+                progress.update(k)
         return n
 
     if path in (None, "-"):
@@ -473,26 +519,31 @@ def write_csv(arr, path, progress=None):
         return rows(fh)
 
 
-def write_json(chunks, fh, extra_before: dict | None = None, extra_after=None):
+def write_json(chunks, fh, extra_before: dict | None = None, extra_after=None, workers: int = 1):
     """Stream ``{"rows": [...], ...}`` chunk by chunk; ``extra_after`` is a callable giving
-    the keys written after the rows (e.g. fits, timing).  Returns the number of rows."""
+    the keys written after the rows (e.g. fits, timing); ``workers`` as in :func:`write_csv`.
+    Returns the number of rows."""
     from .jsonio import dumps
 
-    fh.write("{\n")
+    put = _byte_writer(fh)
+
+    def say(text):  # keys and metadata: UTF-8 (the rows are ASCII)
+        put(text.encode("utf-8"))
+
+    say("{\n")
     for k, v in (extra_before or {}).items():
-        fh.write(f"{dumps(k)}: {dumps(v, indent=None)},\n")
-    fh.write('"rows": [\n')
+        say(f"{dumps(k)}: {dumps(v, indent=None)},\n")
+    say('"rows": [\n')
     n = 0
     first = True
-    for c in ([chunks] if isinstance(chunks, np.ndarray) else chunks):
-        for piece in _pieces(c):
-            if not first:
-                fh.write(",\n")
-            fh.write(format_chunk(piece, "json"))
-            first = False
-        n += c.size
-    fh.write("\n]")
+    for text, k in _texts([chunks] if isinstance(chunks, np.ndarray) else chunks, "json", int(workers)):
+        if not first:
+            put(b",\n")
+        put(text)
+        first = False
+        n += k
+    say("\n]")
     for k, v in (extra_after() if extra_after else {}).items():
-        fh.write(f",\n{dumps(k)}: {dumps(v, indent=1)}")
-    fh.write("\n}\n")
+        say(f",\n{dumps(k)}: {dumps(v, indent=1)}")
+    say("\n}\n")
     return n

@@ -413,7 +413,7 @@ class _Text:
 
 
 def format_table(columns, prefixes, precision: int, nonfinite: str = "", row_start: str = "",
-                 row_end: str = "", row_sep: str = "\n", quote_strings: bool = False):
+                 row_end: str = "", row_sep: str = "\n", quote_strings: bool = False, as_bytes: bool = False):
     """Rows of ``columns`` as text, or None if a float's rounding was too close to call.
 
     Parameters
@@ -430,10 +430,12 @@ def format_table(columns, prefixes, precision: int, nonfinite: str = "", row_sta
         Significant digits of the floats, 1-17.
     nonfinite, row_start, row_end, row_sep : str
         Field of a NaN/inf; text before and after each row; text between rows.
+    as_bytes : bool
+        Return ASCII bytes (for a binary file: no decoding and encoding again).
 
     Returns
     -------
-    str or None
+    str or bytes or None
     """
     if not 1 <= int(precision) <= 17:
         raise ValueError(f"precision must be an integer in 1..17; got {precision!r}")
@@ -499,7 +501,8 @@ def format_table(columns, prefixes, precision: int, nonfinite: str = "", row_sta
         raise ValueError("text columns must be printable ASCII without '\"' or '\\'")
     if m < 0:
         return None
-    return out[:m].tobytes().decode("ascii")
+    b = out[:m].tobytes()
+    return b if as_bytes else b.decode("ascii")
 
 
 def format_floats(x, precision: int) -> str | None:

@@ -51,6 +51,10 @@ def register(sub):
     p.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
 
 
+#: threads formatting the output text while the producer computes (the text is the same)
+FORMAT_WORKERS = 2
+
+
 def _fits(vary, args, base, mat):
     """Power-law fits along each swept axis (through the middle of the other axes)."""
     from ..fits import sweep_fits
@@ -166,9 +170,9 @@ def run(args) -> int:
                 rows = chunks[0].size
             elif args.out and to_json_file:
                 with atomic_write(args.out) as fh:
-                    rows = write_json(chunks, fh, {"n_rows": n}, tail)
+                    rows = write_json(chunks, fh, {"n_rows": n}, tail, workers=FORMAT_WORKERS)
             elif args.out:
-                rows = write_csv(chunks, args.out)
+                rows = write_csv(chunks, args.out, workers=FORMAT_WORKERS)
             elif args.json:
                 rows = write_json(chunks, sys.stdout, {"n_rows": n}, tail)
             else:
