@@ -216,7 +216,7 @@ def test_ctrl_c_leaves_no_partial_file(tmp_path, monkeypatch, capsys):
     from ipmc_asym import sweeps
 
     calls = {"n": 0}
-    real = sweeps.format_chunk
+    real = sweeps._format_chunk_bytes  # what the writers format with (in worker threads)
 
     def interrupted(arr, kind="csv"):
         calls["n"] += 1
@@ -224,7 +224,7 @@ def test_ctrl_c_leaves_no_partial_file(tmp_path, monkeypatch, capsys):
             raise KeyboardInterrupt
         return real(arr, kind)
 
-    monkeypatch.setattr(sweeps, "format_chunk", interrupted)
+    monkeypatch.setattr(sweeps, "_format_chunk_bytes", interrupted)
     monkeypatch.setattr(sweeps, "FORMAT_ROWS", 10)
     out = tmp_path / "s.csv"
     assert main(["sweep", "--vary", "length=1cm:2cm:100", "--fidelity", "leading", "--out", str(out)]) == 130
