@@ -46,8 +46,14 @@ from .progress import progress as _progress_bar
 from .registry import FIDELITIES as _FIDELITY_SPECS
 from .registry import MODELS as _MODEL_SPECS
 from .registry import check_choice, fidelity_names
-from .settings import (BVP_STATED_ERROR, EXACT_STATED_ERROR, INTERPRET_BUDGET_S, MIN_THICKNESS, ROUNDING_ERROR,
-                       VALIDITY_LIMIT)
+from .settings import (
+    BVP_STATED_ERROR,
+    EXACT_STATED_ERROR,
+    INTERPRET_BUDGET_S,
+    MIN_THICKNESS,
+    ROUNDING_ERROR,
+    VALIDITY_LIMIT,
+)
 
 __all__ = ["FIDELITIES", "MomentResult", "moment_integral", "moment", "groups_arrays", "check_fidelity",
            "check_min_thickness", "invalid_message", "validity_limit", "interpret_small"]

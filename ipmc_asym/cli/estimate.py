@@ -11,8 +11,8 @@ from . import SUMMARIES
 from .common import (
     add_strip_options,
     c_moy_label,
-    fmt_num,
     first_run_notice,
+    fmt_num,
     material_from_args,
     strip_from_args,
     tol_type,

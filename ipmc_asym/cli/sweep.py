@@ -16,7 +16,13 @@ from ..registry import fidelity_names, model_choices, model_names
 from ..settings import MAX_ROWS
 from ..units import parse_vary_spec, vary_values
 from . import SUMMARIES
-from .common import add_strip_options, count_type, material_from_args, strip_from_args, tol_type
+from .common import (
+    add_strip_options,
+    count_type,
+    material_from_args,
+    strip_from_args,
+    tol_type,
+)
 
 #: points per axis used for the fits (a subsample of a longer axis fits the same law)
 FIT_POINTS = 2000
@@ -118,7 +124,14 @@ def run(args) -> int:
 
         check_scheduler(args.scheduler)
     # deferred: the compiled kernels load only once the sweep is known to be accepted
-    from ..sweeps import iter_sweep, prefetched, warm_writer, withhold, write_csv, write_json
+    from ..sweeps import (
+        iter_sweep,
+        prefetched,
+        warm_writer,
+        withhold,
+        write_csv,
+        write_json,
+    )
 
     base = strip_from_args(args)
     mat = material_from_args(args)
