@@ -150,7 +150,8 @@ def prefetched(chunks, depth: int = 1, threads: int | None = None):
     one core while the next chunk is computed on the other; memory grows by ``depth`` chunks.
     An exception in the producer is raised in the consumer, at the chunk where it happened.
     The producer starts at once.  While it runs, the caller must not launch parallel kernels
-    itself (Numba's workqueue layer is not re-entrant): formatting and writing are serial.
+    itself (Numba's workqueue layer is not re-entrant): the consumer's kernels (the text
+    formatter, run by a few plain threads) are serial ones.
     ``threads``: Numba threads of the producer's kernels (e.g. 1: one core computes while the
     consumer uses the other).
     """
@@ -224,15 +225,12 @@ def _distinct(code):
     return first, np.asarray(inv).reshape(-1)
 
 
-def _chunk(cols, perm, fidelity, material, tol, escalate, failures, code=None):
+def _chunk(cols, perm, fidelity, material, tol, escalate, failures, code):
     k = cols["length"].size
     A5 = moment_scale(cols["width"], cols["thickness"], cols["voltage"], material.F, material.C_moy)
     EI = cols["modulus"] * second_moment(cols["width"], cols["thickness"])
-    # I depends on (thickness, voltage) only: evaluate each distinct pair once (by grid code:
-    # an integer sort at most, not a row-wise sort of float pairs)
-    if code is None:
-        code = np.unique(np.stack([cols["thickness"], cols["voltage"]], axis=1), axis=0, return_inverse=True)[1]
-        code = np.asarray(code).reshape(-1)
+    # I depends on (thickness, voltage) only: evaluate each distinct pair once (``code``: the
+    # pair's grid code, :func:`_pair_code`; an integer sort at most, not a sort of float pairs)
     first, inv = _distinct(code)
 
     def rows(a):  # per-distinct-pair values -> per-row values

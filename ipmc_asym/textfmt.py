@@ -5,14 +5,13 @@ One compiled call writes a whole block of rows into a byte buffer: floats exactl
 from small vocabularies, with per-column prefixes, so that CSV and JSON are the same kernel.
 
 Why: a 10^6-row sweep spent ~6 s formatting one Python ``%`` per row (25 columns), three
-times the computation.  Here a float costs ~50-100 ns.
+times the computation.  Here a float costs ~40 ns.
 
 Exactness: ``|x|`` is scaled by ``10^k`` held as a double-double (exact ``Fraction`` at
-import), so the scaled value carries ~1e-32 relative error; it is exact for
-``0 <= k <= 22``, where the ties of round-half-even are decided exactly.  Elsewhere a value
-whose discarded part lies within ``AMBIGUOUS`` of one half is not guessed: the kernel
-reports it and the caller formats that block in Python instead (never seen in practice: it
-takes a decimal tie through a power of ten that is not a double).
+import), so the scaled value carries ~1e-32 relative error.  A value whose discarded part
+lies within ``AMBIGUOUS`` of one half is either an exact decimal tie, decided in integer
+arithmetic (:func:`_is_tie`) and rounded half to even, or not guessed: the kernel reports
+it and the caller formats that block in Python instead (never seen in practice).
 
 Layer rule: ``_jit`` and numpy only.
 """
@@ -289,16 +288,6 @@ def _write_decomposed(n, e10, neg, P, out, pos):
     return pos + 2
 
 
-@jit
-def _write_g(x, P, out, pos):
-    """Write ``'%.{P}g' % x`` (finite ``x``) at ``out[pos:]``; return the new position, or -1
-    if the rounding is too close to call (the caller formats in Python)."""
-    n, e10, neg, ok = _decompose(x, P)
-    if not ok:
-        return -1
-    return _write_decomposed(n, e10, neg, P, out, pos)
-
-
 @jit(inline="always")  # numba-level: cached callers keep it inlined
 def _decompose_all(F, P, N, E, S):
     """:func:`_decompose` of every finite element of ``F`` (2-D) into ``N``, ``E``, ``S`` (sign);
@@ -326,7 +315,7 @@ def _copy(src, start, m, out, pos):
 
 
 @jit
-def _format_rows(F, C, U, kinds, idx, quote, P, text, pre_off, pre_len, vocab_off, vocab_len, voc_base,
+def _format_rows(F, C, U, kinds, idx, quote_strings, P, text, pre_off, pre_len, vocab_off, vocab_len, voc_base,
                  nonfinite_off, nonfinite_len, row_start_off, row_start_len, row_end_off, row_end_len,
                  row_sep_off, row_sep_len, out):
     """All rows into ``out``; returns the bytes written, -1 (an ambiguous rounding) or -2 (a
@@ -336,7 +325,7 @@ def _format_rows(F, C, U, kinds, idx, quote, P, text, pre_off, pre_len, vocab_of
     end and separator) is a slice ``text[off:off + len]``.  Column ``j`` of kind 0 is float
     row ``idx[j]`` of ``F``; kind 1 a code ``C[idx[j], i]`` into the words
     ``voc_base[j] + code``; kind 2 the ASCII text of ``U[idx[j], i]`` (code points,
-    NUL-padded), in double quotes where ``quote[j]``.
+    NUL-padded), in double quotes if ``quote_strings``.
     """
     n = F.shape[1] if F.shape[0] > 0 else (C.shape[1] if C.shape[0] > 0 else U.shape[1])
     N = np.empty(F.shape, np.int64)
@@ -376,7 +365,7 @@ def _format_rows(F, C, U, kinds, idx, quote, P, text, pre_off, pre_len, vocab_of
                 r = voc_base[j] + C[k, i]
                 pos = _copy(text, vocab_off[r], vocab_len[r], out, pos)
             else:
-                if quote[j]:
+                if quote_strings:
                     out[pos] = 34
                     pos += 1
                 for q in range(w):
@@ -387,7 +376,7 @@ def _format_rows(F, C, U, kinds, idx, quote, P, text, pre_off, pre_len, vocab_of
                         return -2
                     out[pos] = c
                     pos += 1
-                if quote[j]:
+                if quote_strings:
                     out[pos] = 34
                     pos += 1
         pos = _copy(text, row_end_off, row_end_len, out, pos)
@@ -492,9 +481,8 @@ def format_table(columns, prefixes, precision: int, nonfinite: str = "", row_sta
     width = (sum(m for _, m in pre) + len(floats) * max(MAX_FLOAT_WIDTH, nf[1]) + len(codes) * max(m for _, m in voc)
              + len(texts) * (wmax + 2) + rs[1] + re_[1] + sep[1])
     out = np.empty(max(n * width, 1), np.uint8)
-    quote = np.full(len(kinds), bool(quote_strings))
     i64 = (lambda v: np.array(v, np.int64))
-    m = _format_rows(F, C, U, i64(kinds), i64(idx), quote, int(precision), tx.array(),
+    m = _format_rows(F, C, U, i64(kinds), i64(idx), bool(quote_strings), int(precision), tx.array(),
                      i64([o for o, _ in pre]), i64([m for _, m in pre]), i64([o for o, _ in voc]),
                      i64([m for _, m in voc]), i64(offs), *nf, *rs, *re_, *sep, out)
     if m == -2:

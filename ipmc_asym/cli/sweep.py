@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import math
 import sys
 import time
@@ -159,17 +160,15 @@ def run(args) -> int:
             chunks = prefetched((withhold(c, copy=False) for c in iter_sweep(
                 vary, args.model, args.fidelity, base, mat, args.tol, escalate=not args.no_escalate,
                 progress=bar, failures=failures)), threads=1)
-            # meanwhile, the formatter loads from the cache (serial code: no second parallel launch)
-            warm_writer("json" if args.json or (args.out or "").lower().endswith(".json") else "csv")
+            # meanwhile, the formatter loads from the cache (serial code: no second parallel
+            # launch); CSV and JSON share the one compiled kernel
+            warm_writer()
         try:
             # the fits after the rows: their (small) sweeps would otherwise run while the
             # producer thread is computing chunks, two parallel kernels at once
-            fitted: list = []
-
+            @functools.cache
             def fits_and_notes():
-                if not fitted:
-                    fitted.append(_fits(vary, args, base, mat))
-                return fitted[0]
+                return _fits(vary, args, base, mat)
 
             def tail():
                 fits, notes = fits_and_notes()
