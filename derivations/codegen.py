@@ -114,8 +114,9 @@ def render_module(kernels, constants: dict, tables: dict | None = None) -> str:
     if constants:
         consts = "\n" + "\n".join(f"{k} = {float(v)!r}" for k, v in sorted(constants.items())) + "\n"
     if tables:
-        consts += "\n# Taylor patches about Y = 2k, k = K_MIN..K_MAX: rows = patches, columns = powers of (Y - 2k)\n"
-        consts += f"K_MIN = {tables['_kmin']}\nK_MAX = {tables['_kmax']}\n"
+        consts += ("\n# Taylor patches about Y = c = PATCH_STEP k, k = K_MIN..K_MAX, each used on |Y - c| <= "
+                   "PATCH_STEP/2:\n# rows = patches, columns = powers of (Y - c)\n")
+        consts += f"K_MIN = {tables['_kmin']}\nK_MAX = {tables['_kmax']}\nPATCH_STEP = {tables['_step']}\n"
         consts += "\n# Taylor coefficients of sqrt(Qhat(Y)) at Y = 0 (Dhat = |Y| sqrt(Qhat)), |Y| <= 1/2\n"
         for name in sorted(tables["_sqrtq"]):
             vals = ", ".join(repr(float(v)) for v in tables["_sqrtq"][name])

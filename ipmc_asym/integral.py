@@ -153,15 +153,24 @@ def check_min_thickness(thickness) -> None:
             "(settings.MIN_THICKNESS, docs/design.md)")
 
 
+#: where core/lam >= CORE_X_FLOOR the core interaction 4 exp(-core/lam) is bounded by its
+#: value there, ~1.7e-17 (below the 1e-11 floor of every stated error by 6 decades)
+CORE_X_FLOOR = 40.0
+CORE_ERROR_FLOOR = 4.0 * math.exp(-CORE_X_FLOOR)
+
+
 @jit
 def _core_error(core, lam):
-    """Relative error of the neutral-core assumption, ~4 exp(-core/lam).
+    """Relative error of the neutral-core assumption, ~4 exp(-core/lam) (a bound).
 
-    Skips exp() where it would underflow: glibc's underflow path is ~10x slower and this
-    sits on the hot path of every sweep.
+    Beyond ``core/lam = CORE_X_FLOOR`` it returns the bound ``CORE_ERROR_FLOOR`` without an
+    exp or a division (the test is a product): this sits on the hot path of every sweep,
+    and core/lam ranges over 1e2-1e7 at most points.
     """
-    x = max(core, 0.0) / lam
-    return 4.0 * math.exp(-x) if x < 700.0 else 0.0
+    c = max(core, 0.0)
+    if c < CORE_X_FLOOR * lam:
+        return 4.0 * math.exp(-(c / lam))
+    return CORE_ERROR_FLOOR
 
 
 @jit
@@ -181,11 +190,11 @@ def _point(lam, A2, A3, rho, model_id, order):
     if order == 0:
         Ii, J1, J2, b1, c = moment_quadrature(lam, A2, A3, rho)
         return Ii, ROUNDING_ERROR + _core_error(c, lam), b1, c
-    return _closed_post(lam, order, *moment_closed(lam, A2, A3, rho, model_id, order))
+    return _closed_post(lam, *moment_closed(lam, A2, A3, rho, model_id, order))
 
 
 @jit
-def _closed_post(lam, order, Ii, e_i, b1, c):
+def _closed_post(lam, Ii, e_i, b1, c):
     """The closed forms' ``(I, error, B1, core)`` as :func:`_point` returns them."""
     # The kernel keeps ~20 lam of exponential tails in its core; the layer width the
     # quadrature measures (to |y| = 1) is the depletion width +- 0.5 lam (measured on
@@ -193,10 +202,6 @@ def _closed_post(lam, order, Ii, e_i, b1, c):
     # core interaction 4 exp(-core/lam) below is no longer overstated by ~e^19
     # (``corrected`` was flagged invalid at 10 um while accurate to ~1e-9).
     c = c + 19.0 * lam
-    if order == 1:
-        # the kernel states t = |lam J2 / J1| (+ truncation), relative to the leading
-        # term; relative to I = lam J1 (1 + lam J2/J1) the error is at most t / (1 - t)
-        e_i = e_i / (1.0 - e_i) if e_i < 1.0 else math.inf
     e_i = max(e_i, ROUNDING_ERROR)
     # neglected core interaction: exponentially small in core/lambda
     return Ii, e_i + _core_error(c, lam), b1, c
@@ -208,31 +213,37 @@ BLOCK = 1024
 
 @jit
 def _closed_block(lam, A2, A3, rho, model_id, order, I, err, B1, core):
-    """:func:`_point` for the closed forms over a block of points (A2 > 0), stage by stage.
+    """:func:`_point` for the closed forms over a block of points, stage by stage.
 
     Why: one point is a chain of dependent calls (exp, log, a polynomial, square roots) whose
     latency, not the number of operations, sets its cost; run stage by stage over a block,
     consecutive points are independent and the processor overlaps them.  The operations are
     those of :func:`moment_closed`, in the same order: the results are bit for bit the same
     (tested).  ``I``, ``err``, ``B1``, ``core``: outputs of the block's length, also used as
-    the stage-1 and layer temporaries.
+    the stage-1 and layer temporaries.  ``A2 = 0`` gives :func:`_point`'s zero-volt values;
+    an ``A2`` that is not a number > 0 gives NaN (callers flag such inputs themselves); both
+    run the stages on a stand-in, so no table lookup ever sees a NaN.
     """
     m = lam.size
-    em = np.empty(m)
-    yc = np.empty(m)
-    w0a = np.empty(m)
-    w1a = np.empty(m)
+    tmp = np.empty((5, m))  # one allocation for the block's temporaries
+    em, yc, w0a, w1a, a2 = tmp[0], tmp[1], tmp[2], tmp[3], tmp[4]
     acc = 2 if order == 2 else 1
     for k in range(m):
-        em[k], B1[k], yc[k] = closed_b1(A2[k], model_id)
+        a2[k] = A2[k] if A2[k] > 0.0 else 1.0
+        em[k], B1[k], yc[k] = closed_b1(a2[k], model_id)
     for k in range(m):  # the cathode layer functions, held in I and err until stage 3
         I[k], err[k] = layer_closed(yc[k], model_id, acc)
     for k in range(m):
-        w0a[k], w1a[k] = layer_closed(yc[k] - A2[k], model_id, acc)
+        w0a[k], w1a[k] = layer_closed(yc[k] - a2[k], model_id, acc)
     for k in range(m):
-        Ii, e_i, b1, c = closed_finish(lam[k], A2[k], A3, rho, model_id, order, em[k], B1[k], yc[k], I[k], err[k],
-                                       w0a[k], w1a[k])
-        I[k], err[k], B1[k], core[k] = _closed_post(lam[k], order, Ii, e_i, b1, c)
+        if A2[k] > 0.0:
+            Ii, e_i, b1, c = closed_finish(lam[k], a2[k], A3, rho, model_id, order, em[k], B1[k], yc[k], I[k],
+                                           err[k], w0a[k], w1a[k])
+            I[k], err[k], B1[k], core[k] = _closed_post(lam[k], Ii, e_i, b1, c)
+        elif A2[k] == 0.0:  # zero volts: no field, I = 0 exactly (as _point)
+            I[k], err[k], B1[k], core[k] = 0.0, 0.0, 1.0, 2.0
+        else:
+            I[k] = err[k] = B1[k] = core[k] = math.nan
 
 
 @jit_parallel
@@ -244,16 +255,10 @@ def _sweep(lam, A2, A3, rho, model_id, order, sign, I, err, B1, core):
         for b in prange((n + BLOCK - 1) // BLOCK):
             i0 = b * BLOCK
             i1 = min(n, i0 + BLOCK)
-            ab = A2[i0:i1].copy()
-            for k in range(i1 - i0):
-                if not ab[k] > 0.0:  # zero volts: stand-in, overwritten below
-                    ab[k] = 1.0
-            _closed_block(lam[i0:i1], ab, A3, rho, model_id, order, I[i0:i1], err[i0:i1], B1[i0:i1], core[i0:i1])
+            _closed_block(lam[i0:i1], A2[i0:i1], A3, rho, model_id, order, I[i0:i1], err[i0:i1], B1[i0:i1],
+                          core[i0:i1])
             for i in range(i0, i1):
-                if A2[i] == 0.0:
-                    I[i], err[i], B1[i], core[i] = 0.0, 0.0, 1.0, 2.0
-                else:
-                    I[i] = sign[i] * I[i]
+                I[i] = sign[i] * I[i]
     else:
         for i in prange(n):
             Ii, e_i, b1, c = _point(lam[i], A2[i], A3, rho, model_id, order)
@@ -334,38 +339,41 @@ def _fused_blocks(th, v, lamc, a2c, A3, rho, model_id, order, any_thickness, lim
     for b in prange(nb):
         i0 = b * BLOCK
         m = min(n, i0 + BLOCK) - i0
-        lam = np.empty(m)
-        A2 = np.empty(m)
-        bI = np.empty(m)
-        be = np.empty(m)
-        bb = np.empty(m)
-        bc = np.empty(m)
+        tmp = np.empty((6, m))  # one allocation for the block's values
+        lam, A2, bI, be, bb, bc = tmp[0], tmp[1], tmp[2], tmp[3], tmp[4], tmp[5]
+        n_bad = 0
         for k in range(m):
             t = th[i0 + k] if sth else th[0]
             vv = v[i0 + k] if sv else v[0]
-            lam[k], A2[k] = 1e-3, 1.0  # stand-ins where a point is handled apart (below)
-            if math.isfinite(t) and t > 0.0 and math.isfinite(vv):
-                lk, ak = _groups_point(t, vv, lamc, a2c)
-                if ak > 0.0:
-                    lam[k], A2[k] = lk, ak
+            lam[k], A2[k] = _groups_point(t, vv, lamc, a2c)
+            if not (t > 0.0 and t < math.inf and abs(vv) < math.inf):
+                lam[k], A2[k] = math.nan, math.nan  # bad input: _closed_block gives NaN, _put flags it
+                n_bad += 1
         _closed_block(lam, A2, A3, rho, model_id, order, bI, be, bb, bc)
         lb_th = 0
         lb_v = 0
         lb_inv = 0
-        for k in range(m):
-            i = i0 + k
-            t = th[i] if sth else th[0]
-            vv = v[i] if sv else v[0]
-            lk, ak = _groups_point(t, vv, lamc, a2c)
-            if ak == 0.0:  # zero volts: I = 0 exactly, as _point says
-                Ii, e_i, b1, c = 0.0, 0.0, 1.0, 2.0
-            else:
-                Ii, e_i, b1, c = bI[k], be[k], bb[k], bc[k]
-            code = _put(i, t, vv, lk, ak, Ii, e_i, b1, c, limit, any_thickness, nan_invalid, full,
-                        I, err, B1, core, lam_o, A2_o, valid)
-            lb_th += code == 2
-            lb_v += code == 3
-            lb_inv += code != 0
+        if n_bad == 0 and nan_invalid and not full:
+            # the lean path of moment_integral (what _put does when every input is good; the
+            # general path costs ~8 ns a point more, measured)
+            for k in range(m):
+                i = i0 + k
+                vv = v[i] if sv else v[0]
+                ok = (be[k] < limit) and (bc[k] > 0.0 or any_thickness)
+                valid[i] = ok
+                Ii = bI[k] if vv >= 0.0 else -bI[k]
+                I[i] = Ii if ok else math.nan
+                lb_inv += not ok
+        else:
+            for k in range(m):
+                i = i0 + k
+                t = th[i] if sth else th[0]
+                vv = v[i] if sv else v[0]
+                code = _put(i, t, vv, lam[k], A2[k], bI[k], be[k], bb[k], bc[k], limit, any_thickness, nan_invalid,
+                            full, I, err, B1, core, lam_o, A2_o, valid)
+                lb_th += code == 2
+                lb_v += code == 3
+                lb_inv += code != 0
         counts[b, 0] = lb_th
         counts[b, 1] = lb_v
         counts[b, 2] = lb_inv
@@ -506,21 +514,14 @@ def moment(thickness, voltage, model="constant", fidelity="quadrature", *, mater
         e0 = max(float(perm.func(0.0)), 0.0)
         gperm = Permittivity("secant", eps0=e0, deps=max(float(perm.func(mat.C_moy)) - e0, 0.0))
     if fidelity != "bvp":
-        th = np.asarray(thickness, dtype=np.float64)
-        v = np.asarray(voltage, dtype=np.float64)
-        shape = np.broadcast_shapes(th.shape, v.shape)
-        I, err, B1, core, lam, A2 = (np.empty(shape) for _ in range(6))
-        valid = np.empty(shape, dtype=np.bool_)
-        check_min_thickness(th)
-        bad_th, bad_v, _ = _run_driver(_sweep_fused, I.size, fidelity, (
-            _flat_input(th, shape), _flat_input(v, shape), *_driver_constants(gperm, mat, fidelity),
-            *(a.reshape(-1) for a in (I, err, B1, core, lam, A2, valid))))
+        I, valid, (err, B1, core, lam, A2), (bad_th, bad_v, _) = _fused(thickness, voltage, gperm, mat, fidelity,
+                                                                       full=True)
         if bad_th:
             raise ValueError("thickness (total, 2e) must be finite and > 0 m")
         if bad_v:
             raise ValueError("voltage must be finite (volts)")
         return MomentResult(I=I, error=err, B1=B1, core=core, lam=lam, A2=A2, valid=valid,
-                            fidelity=fidelity, model=perm.name, success=np.ones(shape, bool))
+                            fidelity=fidelity, model=perm.name, success=np.ones(I.shape, bool))
     lam, A2, A3, rho, sign = groups_arrays(thickness, voltage, gperm, mat)
     shape = lam.shape
     I = np.empty(shape)
@@ -664,20 +665,32 @@ def _lean_integral(thickness, voltage, model, fidelity, material, material_kw):
     perm = get_model(model)
     if perm.is_custom:
         return None
-    mat = _material(material, material_kw)
+    I, valid, _, (bad_th, bad_v, n_invalid) = _fused(thickness, voltage, perm, _material(material, material_kw),
+                                                     fidelity, full=False)
+    if bad_th or bad_v:
+        return None
+    return I, valid, n_invalid
+
+
+def _fused(thickness, voltage, perm: Permittivity, mat: Material, fidelity: str, full: bool):
+    """Run the fused driver on broadcast inputs (TOTAL thickness in m, volts).
+
+    Returns ``(I, valid, bookkeeping, counts)``: ``bookkeeping`` is ``(error, B1, core, lam,
+    A2)`` if ``full``, else ``()`` and ``I`` is NaN where invalid (what :func:`moment_integral`
+    returns); ``counts`` are the driver's (bad thicknesses, bad voltages, invalid points).
+    """
     th = np.asarray(thickness, dtype=np.float64)
     v = np.asarray(voltage, dtype=np.float64)
     shape = np.broadcast_shapes(th.shape, v.shape)
     I = np.empty(shape)
     valid = np.empty(shape, dtype=np.bool_)
+    extra = tuple(np.empty(shape) for _ in range(5)) if full else ()
     check_min_thickness(th)
-    none = np.empty(0)
-    bad_th, bad_v, n_invalid = _run_driver(_sweep_fused, I.size, fidelity, (
+    outs = [a.reshape(-1) for a in extra] if full else [np.empty(0)] * 5
+    counts = _run_driver(_sweep_fused, I.size, fidelity, (
         _flat_input(th, shape), _flat_input(v, shape), *_driver_constants(perm, mat, fidelity),
-        I.reshape(-1), none, none, none, none, none, valid.reshape(-1), True))
-    if bad_th or bad_v:
-        return None
-    return I, valid, n_invalid
+        I.reshape(-1), *outs, valid.reshape(-1), not full))
+    return I, valid, extra, counts
 
 
 def invalid_message(r: MomentResult, total: int | None = None) -> str:

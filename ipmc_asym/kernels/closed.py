@@ -1,7 +1,7 @@
 """Closed-form fidelities ``leading`` and ``corrected``: evaluation of the derived forms.
 
 All formulas live in :mod:`._generated` (written by ``derivations/``); this module only
-picks the piece that applies to a given ``Y`` (Taylor patch about ``2k``, depletion or
+picks the piece that applies to a given ``Y`` (Taylor patch about an integer, depletion or
 accumulation asymptotics) and assembles ``I = lam J1 (+ lam^2 J2)``.
 """
 
@@ -15,12 +15,16 @@ from . import _generated as G
 __all__ = ["layer_closed", "moment_closed", "closed_b1", "closed_finish", "TRUNCATION"]
 
 
-#: truncation of the patches (18 terms at ratio <= 1/6 of the radius) and of the
-#: asymptotic pieces (O(T e^{-T}) at T = 31); checked against the quadrature in the tests.
+#: truncation of the patches (10 coefficients at ratio <= 1/24 of the radius: <= 2e-14) and of
+#: the asymptotic pieces (O(T e^{-T}) at T = 31.75); checked against the quadrature in the tests.
 TRUNCATION = 1e-11
 
 _KMIN = G.K_MIN
 _KMAX = G.K_MAX
+_STEP = float(G.PATCH_STEP)
+#: the patches cover [_Y_LO, _Y_HI]: depletion asymptotics below, accumulation above
+_Y_LO = _STEP * _KMIN - 0.5 * _STEP
+_Y_HI = _STEP * _KMAX + 0.5 * _STEP
 
 
 @jit
@@ -33,9 +37,10 @@ def _patch_tables(model_id):
 
 
 @jit
-def _poly(c, x):
-    acc = c[c.shape[0] - 1]
-    for k in range(c.shape[0] - 2, -1, -1):
+def _poly(c, x, n):
+    """Polynomial in ``x`` with the first ``n`` coefficients of ``c`` (Horner)."""
+    acc = c[n - 1]
+    for k in range(n - 2, -1, -1):
         acc = acc * x + c[k]
     return acc
 
@@ -50,12 +55,15 @@ def _horner_n(tab, row, h, n):
 
 
 #: terms of the patches used at order 1 (``leading``), whose own error lam J2/J1 is
-#: >~1e-5 anyway: W0 to ~(1/6)^9 ~ 1e-7 (the patches' ratio to the radius is <= 1/6), and
-#: W1, which only feeds the error estimate, to ~(1/6)^5 ~ 1e-4
-N_W0_LEADING = 9
-N_W1_ESTIMATE = 5
+#: >~1e-5 anyway: W0 to ~(1/24)^6 ~ 1e-8 (the patches' ratio to the radius is <= 1/24;
+#: measured <= 7e-9), and W1, which only feeds the error estimate, to ~(1/24)^4 ~ 1e-5
+#: (measured <= 3e-5)
+N_W0_LEADING = 6
+N_W1_ESTIMATE = 4
 #: truncation of W0 at order 1 (added to the error estimate)
 TRUNCATION_LEADING = 1e-6
+#: terms of the sqrt(Qhat) series (|Y| <= 1/2) at order 1: <= 1e-8 relative (measured)
+N_SQRTQ_LEADING = 8
 
 
 @jit
@@ -67,21 +75,21 @@ def layer_closed(Y, model_id, need_w1):
     """
     if not Y == Y:  # NaN: no table row to look up
         return math.nan, math.nan
-    if Y < 2.0 * _KMIN - 1.0:
+    if Y < _Y_LO:
         if model_id == 0:
             return G.depletion_constant(Y)
         if model_id == 1:
             return G.depletion_linear(Y)
         return G.depletion_affine(Y)
-    if Y > 2.0 * _KMAX + 1.0:
+    if Y > _Y_HI:
         if model_id == 0:
             return G.accumulation_constant(Y)
         # linear/affine cathodes never get there (Y = ln B1 < 2 up to kV); be explicit
         return math.nan, math.nan
-    k = int(math.floor(0.5 * (Y + 1.0)))
+    k = int(math.floor(Y / _STEP + 0.5))  # the nearest centre (Y / 0.5 and Y - 0.5 k: exact)
     if k > _KMAX:
         k = _KMAX
-    h = Y - 2.0 * k
+    h = Y - _STEP * k
     t0, t1 = _patch_tables(model_id)
     row = k - _KMIN
     if need_w1 == 2:
@@ -116,26 +124,35 @@ def closed_finish(lam, A2, A3, rho, model_id, order, em, B1, Yc, W0c, W1c, W0a, 
     # Dhat: straight from C = B1 when C - 1 is not small (no exp, no cancellation), else the
     # Taylor series of sqrt(Qhat) at 0 (no exp either)
     big = Yc > 0.5
+    nq = N_SQRTQ_LEADING if order == 1 else G.SQRTQ_CONSTANT.shape[0]
     if model_id == 0:
-        dh = G.dhat_from_c_constant(B1, Yc) if big else Yc * _poly(G.SQRTQ_CONSTANT, Yc)
+        dh = G.dhat_from_c_constant(B1, Yc) if big else Yc * _poly(G.SQRTQ_CONSTANT, Yc, nq)
         J1, J2 = G.assemble_j_constant(A2, A3, B1, cm, dh, W0c, W0a, W1c, W1a)
     elif model_id == 1:
-        dh = G.dhat_from_c_linear(B1, Yc) if big else Yc * _poly(G.SQRTQ_LINEAR, Yc)
+        dh = G.dhat_from_c_linear(B1, Yc) if big else Yc * _poly(G.SQRTQ_LINEAR, Yc, nq)
         J1, J2 = G.assemble_j_linear(A2, A3, B1, cm, dh, W0c, W0a, W1c, W1a)
     else:
-        dh = G.dhat_from_c_affine(B1, Yc) if big else Yc * _poly(G.SQRTQ_AFFINE, Yc)
+        dh = G.dhat_from_c_affine(B1, Yc) if big else Yc * _poly(G.SQRTQ_AFFINE, Yc, nq)
         J1, J2 = G.assemble_j_affine(A2, A3, B1, cm, dh, W0c, W0a, W1c, W1a)
     if order == 1:
         I = lam * J1
-        err = abs(lam * J2 / J1) + TRUNCATION_LEADING
+        # t = |lam J2 / J1| + truncation is the first neglected term relative to lam J1;
+        # relative to I = lam J1 (1 + lam J2/J1) the error is at most t / (1 - t), here
+        # a / d = t |J1| / ((1 - t) |J1|): one division instead of two
+        a = abs(lam * J2) + TRUNCATION_LEADING * abs(J1)
+        d = abs(J1) - a
+        err = a / d if d > 0.0 else math.inf
     else:
         I = lam * J1 + lam * lam * J2
         err = TRUNCATION * (1.0 + abs(lam * J2 / J1))
     # widths: depletion zone (eps ~ A1 there) ~ lam sqrt(2 rho (|Ya| - 1)), plus the
     # exponential tails (~10 Debye lengths each side)
-    if Yc > 2.0 * _KMAX + 1.0:  # leading accumulation asymptotics (constant model, > ~80 V)
+    if Yc > _Y_HI:  # leading accumulation asymptotics (constant model, > ~80 V)
         err += 0.1 * Yc * math.exp(-Yc)
-    dep = lam * math.sqrt(2.0 * rho * max(-Ya - 1.0, 0.0))
+    s = -Ya - 1.0
+    # no square root where there is no depletion zone (s <= 0, or the linear model's rho = 0):
+    # 0 * s is the 0 that sqrt(0) gave, and NaN for a NaN input
+    dep = lam * math.sqrt(2.0 * rho * s) if s > 0.0 and rho > 0.0 else 0.0 * s
     core = 2.0 - dep - 20.0 * lam
     return I, err, B1, core
 
@@ -153,9 +170,10 @@ def moment_closed(lam, A2, A3, rho, model_id, order):
     Returns
     -------
     I, error, B1, core : floats
-        ``error`` is a relative estimate: the first neglected term (``lam^2 |J2|``, only at
-        order 1, estimated from the closed form of ``J2``) plus the truncation of the layer
-        functions.  ``core`` (the neutral core length) is estimated from the depletion
+        ``error`` is a relative estimate: at order 1, ``t / (1 - t)`` (inf if ``t >= 1``)
+        with ``t`` the first neglected term ``|lam J2 / J1|`` (from the closed form of
+        ``J2``) plus the truncation of the layer functions, a bound relative to ``I`` itself;
+        at order 2, the truncation of the layer functions.  ``core`` (the neutral core length) is estimated from the depletion
         width ``lam * sqrt(2 (|Ya| - 1))`` and ``~ 10 lam`` per layer.
     """
     em, B1, Yc = closed_b1(A2, model_id)
