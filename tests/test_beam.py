@@ -281,3 +281,18 @@ def test_branch_integrals_quadrature_equals_fresnel_form():
     assert np.allclose(g1, g2, rtol=0, atol=1e-14)
     assert np.allclose(d1, d2, rtol=1e-12, atol=1e-14)
     assert np.max(np.abs(g2[: m.size // 2])) < 1e-13  # the table sits on G = 0
+
+
+def test_blocking_ratio_interpolation_is_at_rounding_level():
+    """Between the table's nodes psi comes from an 8-point interpolation, no Newton polish:
+    it must sit on the root of the Fresnel form of the blocking condition (Newton-converged
+    here, from the interpolated value) to <= 5e-15 relative, edges of the table included."""
+    rng = np.random.default_rng(7)
+    m = np.concatenate([rng.uniform(beam._SERIES_KL, beam.KL_BLOCK_MAX, 4000),
+                        [beam._SERIES_KL, beam._SERIES_KL + 1e-3, beam.KL_BLOCK_MAX - 1e-3, beam.KL_BLOCK_MAX]])
+    psi = beam.blocking_force_ratio(m)
+    root = psi.copy()
+    for _ in range(4):
+        g, dg = beam._G_and_dG_fresnel(root, m)
+        root = root - g / dg
+    assert np.max(np.abs(psi - root) / np.abs(root)) <= 5e-15

@@ -20,9 +20,8 @@ def client():
 
 
 def _same(a, b):
-    """Rows equal; floats to 1e-15 relative (the target).  Not bitwise: the beam's vectorised
-    Newton polish of the blocking force stops when every point of ITS array has converged,
-    so a point's last ulp depends on which points share its chunk (seen: 2.3e-16)."""
+    """Rows equal; floats to 1e-15 relative (the target; the outputs are pointwise, so they
+    are bitwise equal in practice, but another process may run another numpy build)."""
     for k in a.dtype.names:
         if a.dtype[k].kind == "f":
             np.testing.assert_allclose(a[k], b[k], rtol=1e-15, atol=0)  # NaN == NaN
