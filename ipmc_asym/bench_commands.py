@@ -58,7 +58,7 @@ def section(quick: bool = False) -> dict:
             return {"figures": [_fig("10^4-row `sweep --out F.csv` (leading), fresh process", t, "s", None,
                                      "quick mode: the 10^6-row target is measured by the full bench")]}
         ts = command_seconds([*SWEEP_1E6, "--out", os.path.join(d, "s.csv")])
-        tf = command_seconds(["figures", "--out", os.path.join(d, "figs")], repeats=1)
+        tf = command_seconds(["figures", "--out", os.path.join(d, "figs")], repeats=2)
     return {"figures": [
         _fig("10^6-row `sweep --out F.csv` (leading), fresh process", ts, "s", TARGETS["sweep_csv_1e6_s"],
              "start-up, compute, compiled CSV formatting (computed one chunk ahead) and atomic write"),
