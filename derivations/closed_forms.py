@@ -111,6 +111,14 @@ def sqrtq_series(rho, n):
 N_SQRTQ = 14
 
 
+#: coefficients evaluated at order 1 (``leading``): W0 to ~(1/24)^6 ~ 1e-8 (measured <= 7e-9;
+#: the ``leading`` error estimate adds 1e-6 for it), W1 -- which only feeds that estimate -- to
+#: ~(1/24)^4 (measured <= 3e-5), sqrt(Qhat) to <= 1e-8 (|Y| <= 1/2)
+N_W0_LEADING = 6
+N_W1_ESTIMATE = 4
+N_SQRTQ_LEADING = 8
+
+
 NCONT = 44  # terms used to continue W0, W1 from one centre to the next (ratio <= 1/3)
 
 
@@ -274,6 +282,9 @@ def _kernels():
             consts["W1INF_CONSTANT"] = W1inf
     tables["_kmin"], tables["_kmax"], tables["_step"] = K_MIN, K_MAX, PATCH_STEP
     tables["_sqrtq"] = {name: sqrtq_series(RHO[name], N_SQRTQ) for name in RHO}
+    # unrolled Horner evaluators (name, (coefficients of W0, of W1) or coefficients of sqrt(Qhat))
+    tables["_horner"] = {"patch_full": (NTERMS + 1, NTERMS + 1), "patch_leading": (N_W0_LEADING, N_W1_ESTIMATE),
+                         "sqrtq_full": N_SQRTQ, "sqrtq_leading": N_SQRTQ_LEADING}
     accY = sp.Symbol("Y")
     W0i, W1i = sp.Symbol("W0INF_CONSTANT"), sp.Symbol("W1INF_CONSTANT")
     ks.append(Kernel(

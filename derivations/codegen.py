@@ -109,6 +109,39 @@ def _table(name, rows) -> str:
     return "\n".join(out)
 
 
+def _horner_lines(var: str, coefs: str, n: int, x: str) -> list:
+    """Straight-line Horner of ``coefs[0..n-1]`` at ``x`` into ``var`` (the loop
+    ``acc = acc * x + c[k]`` unrolled: the same operations, so the same bits)."""
+    lines = [f"    {var} = {coefs}[{n - 1}]"]
+    lines += [f"    {var} = {var} * {x} + {coefs}[{k}]" for k in range(n - 2, -1, -1)]
+    return lines
+
+
+def render_horner(spec: dict) -> str:
+    """Unrolled evaluators of the patch tables and of the sqrt(Qhat) series.
+
+    Why: a Horner loop over a run-time count cost ~2x the straight-line code (loop control
+    on every step, no overlap across steps); the counts are known here, so the code is too.
+    """
+    out = []
+    for name in sorted(spec):
+        n = spec[name]
+        if name.startswith("patch_"):
+            n0, n1 = n
+            out += ["", "", "@jit", f"def {name}(t0, t1, row, h):",
+                    f'    """(W0, W1) from row ``row`` of the patch tables ``t0``, ``t1`` at ``h = Y - centre``:',
+                    f'    {n0} and {n1} coefficients, unrolled Horner."""',
+                    "    a = t0[row]", "    b = t1[row]"]
+            out += _horner_lines("w0", "a", n0, "h") + _horner_lines("w1", "b", n1, "h")
+            out.append("    return w0, w1")
+        else:
+            out += ["", "", "@jit", f"def {name}(c, x):",
+                    f'    """The sqrt(Qhat) series ``c`` at ``x``: {n} coefficients, unrolled Horner."""']
+            out += _horner_lines("s", "c", n, "x")
+            out.append("    return s")
+    return "\n".join(out) + "\n"
+
+
 def render_module(kernels, constants: dict, tables: dict | None = None) -> str:
     consts = ""
     if constants:
@@ -117,6 +150,11 @@ def render_module(kernels, constants: dict, tables: dict | None = None) -> str:
         consts += ("\n# Taylor patches about Y = c = PATCH_STEP k, k = K_MIN..K_MAX, each used on |Y - c| <= "
                    "PATCH_STEP/2:\n# rows = patches, columns = powers of (Y - c)\n")
         consts += f"K_MIN = {tables['_kmin']}\nK_MAX = {tables['_kmax']}\nPATCH_STEP = {tables['_step']}\n"
+        if "_horner" in tables:
+            hs = tables["_horner"]
+            consts += ("# coefficients evaluated at order 1 (leading): patch_leading, sqrtq_leading\n"
+                       f"N_W0_LEADING = {hs['patch_leading'][0]}\nN_W1_ESTIMATE = {hs['patch_leading'][1]}\n"
+                       f"N_SQRTQ_LEADING = {hs['sqrtq_leading']}\n")
         consts += "\n# Taylor coefficients of sqrt(Qhat(Y)) at Y = 0 (Dhat = |Y| sqrt(Qhat)), |Y| <= 1/2\n"
         for name in sorted(tables["_sqrtq"]):
             vals = ", ".join(repr(float(v)) for v in tables["_sqrtq"][name])
@@ -128,6 +166,8 @@ def render_module(kernels, constants: dict, tables: dict | None = None) -> str:
     body = HEADER.format(ver=sp.__version__, consts=consts)
     for k in sorted(kernels, key=lambda k: k.name):
         body += render_kernel(k) + "\n"
+    if tables and "_horner" in tables:
+        body += render_horner(tables["_horner"])
     return body
 
 

@@ -28,6 +28,10 @@ W1INF_CONSTANT = 2.982357607753037
 K_MIN = -63
 K_MAX = 19
 PATCH_STEP = 0.5
+# coefficients evaluated at order 1 (leading): patch_leading, sqrtq_leading
+N_W0_LEADING = 6
+N_W1_ESTIMATE = 4
+N_SQRTQ_LEADING = 8
 
 # Taylor coefficients of sqrt(Qhat(Y)) at Y = 0 (Dhat = |Y| sqrt(Qhat)), |Y| <= 1/2
 SQRTQ_AFFINE = np.array([1.0, 0.49834162520729686, 0.16625069786501434, 0.04156992585665537, 0.008312587025013049, 0.0013852607615384798, 0.00019791846254301626, 2.4744069588911045e-05, 2.748864627344517e-06, 2.7477855209856675e-07, 2.4989962828245583e-08, 2.085238063741697e-09, 1.6017936123086825e-10, 1.1371682641038402e-11])
@@ -766,3 +770,85 @@ def w_layer(y, rho):
     """
     t0 = rho - 1.0
     return (rho - t0*math.exp(y))/math.sqrt(rho*e2rel(y) - t0*exprel(y)*exprel(y))
+
+
+@jit
+def patch_full(t0, t1, row, h):
+    """(W0, W1) from row ``row`` of the patch tables ``t0``, ``t1`` at ``h = Y - centre``:
+    10 and 10 coefficients, unrolled Horner."""
+    a = t0[row]
+    b = t1[row]
+    w0 = a[9]
+    w0 = w0 * h + a[8]
+    w0 = w0 * h + a[7]
+    w0 = w0 * h + a[6]
+    w0 = w0 * h + a[5]
+    w0 = w0 * h + a[4]
+    w0 = w0 * h + a[3]
+    w0 = w0 * h + a[2]
+    w0 = w0 * h + a[1]
+    w0 = w0 * h + a[0]
+    w1 = b[9]
+    w1 = w1 * h + b[8]
+    w1 = w1 * h + b[7]
+    w1 = w1 * h + b[6]
+    w1 = w1 * h + b[5]
+    w1 = w1 * h + b[4]
+    w1 = w1 * h + b[3]
+    w1 = w1 * h + b[2]
+    w1 = w1 * h + b[1]
+    w1 = w1 * h + b[0]
+    return w0, w1
+
+
+@jit
+def patch_leading(t0, t1, row, h):
+    """(W0, W1) from row ``row`` of the patch tables ``t0``, ``t1`` at ``h = Y - centre``:
+    6 and 4 coefficients, unrolled Horner."""
+    a = t0[row]
+    b = t1[row]
+    w0 = a[5]
+    w0 = w0 * h + a[4]
+    w0 = w0 * h + a[3]
+    w0 = w0 * h + a[2]
+    w0 = w0 * h + a[1]
+    w0 = w0 * h + a[0]
+    w1 = b[3]
+    w1 = w1 * h + b[2]
+    w1 = w1 * h + b[1]
+    w1 = w1 * h + b[0]
+    return w0, w1
+
+
+@jit
+def sqrtq_full(c, x):
+    """The sqrt(Qhat) series ``c`` at ``x``: 14 coefficients, unrolled Horner."""
+    s = c[13]
+    s = s * x + c[12]
+    s = s * x + c[11]
+    s = s * x + c[10]
+    s = s * x + c[9]
+    s = s * x + c[8]
+    s = s * x + c[7]
+    s = s * x + c[6]
+    s = s * x + c[5]
+    s = s * x + c[4]
+    s = s * x + c[3]
+    s = s * x + c[2]
+    s = s * x + c[1]
+    s = s * x + c[0]
+    return s
+
+
+@jit
+def sqrtq_leading(c, x):
+    """The sqrt(Qhat) series ``c`` at ``x``: 8 coefficients, unrolled Horner."""
+    s = c[7]
+    s = s * x + c[6]
+    s = s * x + c[5]
+    s = s * x + c[4]
+    s = s * x + c[3]
+    s = s * x + c[2]
+    s = s * x + c[1]
+    s = s * x + c[0]
+    return s

@@ -36,34 +36,20 @@ def _patch_tables(model_id):
     return G.PATCH_W0_AFFINE, G.PATCH_W1_AFFINE
 
 
-@jit
-def _poly(c, x, n):
-    """Polynomial in ``x`` with the first ``n`` coefficients of ``c`` (Horner)."""
-    acc = c[n - 1]
-    for k in range(n - 2, -1, -1):
-        acc = acc * x + c[k]
-    return acc
-
-
-@jit
-def _horner_n(tab, row, h, n):
-    """Polynomial in ``h`` with the first ``n`` coefficients of ``tab[row]`` (Horner)."""
-    acc = tab[row, n - 1]
-    for k in range(n - 2, -1, -1):
-        acc = acc * h + tab[row, k]
-    return acc
-
-
-#: terms of the patches used at order 1 (``leading``), whose own error lam J2/J1 is
-#: >~1e-5 anyway: W0 to ~(1/24)^6 ~ 1e-8 (the patches' ratio to the radius is <= 1/24;
-#: measured <= 7e-9), and W1, which only feeds the error estimate, to ~(1/24)^4 ~ 1e-5
-#: (measured <= 3e-5)
-N_W0_LEADING = 6
-N_W1_ESTIMATE = 4
+#: coefficients used at order 1 (``leading``, whose own error lam J2/J1 is >~1e-5 anyway),
+#: set in ``derivations/closed_forms.py`` and unrolled in the generated ``patch_leading`` /
+#: ``sqrtq_leading``: W0 to ~1e-8, W1 (error estimate only) to ~3e-5, sqrt(Qhat) to ~1e-8
+N_W0_LEADING = G.N_W0_LEADING
+N_W1_ESTIMATE = G.N_W1_ESTIMATE
+N_SQRTQ_LEADING = G.N_SQRTQ_LEADING
 #: truncation of W0 at order 1 (added to the error estimate)
 TRUNCATION_LEADING = 1e-6
-#: terms of the sqrt(Qhat) series (|Y| <= 1/2) at order 1: <= 1e-8 relative (measured)
-N_SQRTQ_LEADING = 8
+
+
+@jit
+def _sqrtq(c, x, order):
+    """The sqrt(Qhat) series to the accuracy of ``order`` (1: ~1e-8; 2: ~1e-16)."""
+    return G.sqrtq_leading(c, x) if order == 1 else G.sqrtq_full(c, x)
 
 
 @jit
@@ -93,8 +79,8 @@ def layer_closed(Y, model_id, need_w1):
     t0, t1 = _patch_tables(model_id)
     row = k - _KMIN
     if need_w1 == 2:
-        return _horner_n(t0, row, h, t0.shape[1]), _horner_n(t1, row, h, t1.shape[1])
-    return _horner_n(t0, row, h, N_W0_LEADING), _horner_n(t1, row, h, N_W1_ESTIMATE)
+        return G.patch_full(t0, t1, row, h)
+    return G.patch_leading(t0, t1, row, h)
 
 
 @jit
@@ -124,15 +110,14 @@ def closed_finish(lam, A2, A3, rho, model_id, order, em, B1, Yc, W0c, W1c, W0a, 
     # Dhat: straight from C = B1 when C - 1 is not small (no exp, no cancellation), else the
     # Taylor series of sqrt(Qhat) at 0 (no exp either)
     big = Yc > 0.5
-    nq = N_SQRTQ_LEADING if order == 1 else G.SQRTQ_CONSTANT.shape[0]
     if model_id == 0:
-        dh = G.dhat_from_c_constant(B1, Yc) if big else Yc * _poly(G.SQRTQ_CONSTANT, Yc, nq)
+        dh = G.dhat_from_c_constant(B1, Yc) if big else Yc * _sqrtq(G.SQRTQ_CONSTANT, Yc, order)
         J1, J2 = G.assemble_j_constant(A2, A3, B1, cm, dh, W0c, W0a, W1c, W1a)
     elif model_id == 1:
-        dh = G.dhat_from_c_linear(B1, Yc) if big else Yc * _poly(G.SQRTQ_LINEAR, Yc, nq)
+        dh = G.dhat_from_c_linear(B1, Yc) if big else Yc * _sqrtq(G.SQRTQ_LINEAR, Yc, order)
         J1, J2 = G.assemble_j_linear(A2, A3, B1, cm, dh, W0c, W0a, W1c, W1a)
     else:
-        dh = G.dhat_from_c_affine(B1, Yc) if big else Yc * _poly(G.SQRTQ_AFFINE, Yc, nq)
+        dh = G.dhat_from_c_affine(B1, Yc) if big else Yc * _sqrtq(G.SQRTQ_AFFINE, Yc, order)
         J1, J2 = G.assemble_j_affine(A2, A3, B1, cm, dh, W0c, W0a, W1c, W1a)
     if order == 1:
         I = lam * J1
