@@ -184,14 +184,14 @@ def depletion_forms(rho_val):
     return Om, P1, t1
 
 
-def depletion_constants(rho_val, Om, P1, t1, patches=None):
+def depletion_constants(rho_val, Om, P1, t1):
     """K0, K1 with -W0(-T) = Omega(T) + K0, -W1(-T) = P1(T) + K1 up to O(T e^{-T}).
 
     W0(-60), W1(-60) come from the analytic continuation of the patches (``march``).
     """
     rho = mp.mpf(rho_val)
     kfar = -30  # centre 2 kfar = -60 (steps of 2)
-    pts = patches if patches is not None and kfar in patches else march(rho, kfar, 0, step=2)
+    pts = march(rho, kfar, 0, step=2)
     Tb = mp.mpf(60)
     W0T = -pts[kfar][0][0]
     W1T = -pts[kfar][1][0]

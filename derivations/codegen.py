@@ -150,11 +150,6 @@ def render_module(kernels, constants: dict, tables: dict | None = None) -> str:
         consts += ("\n# Taylor patches about Y = c = PATCH_STEP k, k = K_MIN..K_MAX, each used on |Y - c| <= "
                    "PATCH_STEP/2:\n# rows = patches, columns = powers of (Y - c)\n")
         consts += f"K_MIN = {tables['_kmin']}\nK_MAX = {tables['_kmax']}\nPATCH_STEP = {tables['_step']}\n"
-        if "_horner" in tables:
-            hs = tables["_horner"]
-            consts += ("# coefficients evaluated at order 1 (leading): patch_leading, sqrtq_leading\n"
-                       f"N_W0_LEADING = {hs['patch_leading'][0]}\nN_W1_ESTIMATE = {hs['patch_leading'][1]}\n"
-                       f"N_SQRTQ_LEADING = {hs['sqrtq_leading']}\n")
         consts += "\n# Taylor coefficients of sqrt(Qhat(Y)) at Y = 0 (Dhat = |Y| sqrt(Qhat)), |Y| <= 1/2\n"
         for name in sorted(tables["_sqrtq"]):
             vals = ", ".join(repr(float(v)) for v in tables["_sqrtq"][name])

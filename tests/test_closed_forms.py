@@ -38,7 +38,7 @@ def test_quadrature_against_mpmath(Y, mid):
 
 @pytest.mark.parametrize("mid", [0, 1, 2])
 def test_leading_truncation_of_the_patches(mid):
-    """At order 1 the patches are cut to ``N_W0_LEADING`` / ``N_W1_ESTIMATE`` terms: W0 within
+    """At order 1 the patches are cut to fewer coefficients (``patch_leading``): W0 within
     1e-7 (the ``leading`` error estimate adds ``TRUNCATION_LEADING`` = 1e-6 for it) and W1,
     which only feeds that estimate, within 1e-3, on the whole patched range (edges included)."""
     from ipmc_asym.kernels.closed import _Y_HI, _Y_LO, TRUNCATION_LEADING

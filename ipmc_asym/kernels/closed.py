@@ -1,7 +1,7 @@
 """Closed-form fidelities ``leading`` and ``corrected``: evaluation of the derived forms.
 
 All formulas live in :mod:`._generated` (written by ``derivations/``); this module only
-picks the piece that applies to a given ``Y`` (Taylor patch about an integer, depletion or
+picks the piece that applies to a given ``Y`` (Taylor patch about a multiple of 1/2, depletion or
 accumulation asymptotics) and assembles ``I = lam J1 (+ lam^2 J2)``.
 """
 
@@ -36,13 +36,10 @@ def _patch_tables(model_id):
     return G.PATCH_W0_AFFINE, G.PATCH_W1_AFFINE
 
 
-#: coefficients used at order 1 (``leading``, whose own error lam J2/J1 is >~1e-5 anyway),
-#: set in ``derivations/closed_forms.py`` and unrolled in the generated ``patch_leading`` /
-#: ``sqrtq_leading``: W0 to ~1e-8, W1 (error estimate only) to ~3e-5, sqrt(Qhat) to ~1e-8
-N_W0_LEADING = G.N_W0_LEADING
-N_W1_ESTIMATE = G.N_W1_ESTIMATE
-N_SQRTQ_LEADING = G.N_SQRTQ_LEADING
-#: truncation of W0 at order 1 (added to the error estimate)
+#: At order 1 (``leading``, whose own error lam J2/J1 is >~1e-5 anyway) the generated
+#: ``patch_leading`` / ``sqrtq_leading`` evaluate fewer coefficients (counts set in
+#: ``derivations/closed_forms.py``): W0 to ~1e-8, W1 (error estimate only) to ~3e-5,
+#: sqrt(Qhat) to ~1e-8.  Truncation of W0 at order 1 (added to the error estimate):
 TRUNCATION_LEADING = 1e-6
 
 
@@ -57,7 +54,7 @@ def layer_closed(Y, model_id, need_w1):
     """``(W0(Y), W1(Y))`` from the closed forms.
 
     ``need_w1``: 2 = full accuracy for both; 1 = the order-1 (``leading``) accuracy: W0 to
-    ~1e-7 and W1 to ~1e-4 (for the error estimate only).
+    ~1e-8 and W1 to ~3e-5 (for the error estimate only).
     """
     if not Y == Y:  # NaN: no table row to look up
         return math.nan, math.nan
@@ -158,8 +155,9 @@ def moment_closed(lam, A2, A3, rho, model_id, order):
         ``error`` is a relative estimate: at order 1, ``t / (1 - t)`` (inf if ``t >= 1``)
         with ``t`` the first neglected term ``|lam J2 / J1|`` (from the closed form of
         ``J2``) plus the truncation of the layer functions, a bound relative to ``I`` itself;
-        at order 2, the truncation of the layer functions.  ``core`` (the neutral core length) is estimated from the depletion
-        width ``lam * sqrt(2 (|Ya| - 1))`` and ``~ 10 lam`` per layer.
+        at order 2, the truncation of the layer functions.  ``core`` (the neutral core
+        length) is estimated from the depletion width ``lam * sqrt(2 (|Ya| - 1))`` and
+        ``~ 10 lam`` per layer.
     """
     em, B1, Yc = closed_b1(A2, model_id)
     # at order 1, J2 only feeds the error estimate: W1 to ~1e-6 is enough
