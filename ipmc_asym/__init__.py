@@ -3,17 +3,23 @@
 Matched-asymptotic closed forms (generated from SymPy derivations into Numba kernels), a
 layer quadrature, and a full-BVP cross-check of the Tixier & Pouget model.
 
-Layer rule (each layer imports only layers to its left; the core never imports matplotlib)::
+One subpackage per concern; each imports only the ones before it in this list (the layer
+rule, ``docs/design.md``, checked by ``tests/test_layers.py``)::
 
-    params -> permittivity -> kernels -> moment / bvp -> beam -> estimate, sweeps, scenes
-           -> plots, CLI
+    base -> model -> kernels -> bvp -> integral -> beam -> io -> forward -> dynamics
+         -> parallel -> studies -> validation -> plotting -> cli
 
-Public API (lazy: importing the package loads no Numba, SciPy or SymPy).
+Public API (lazy: importing the package loads no Numba, SciPy or SymPy).  The module paths
+of the flat layout (``ipmc_asym.params``, ``ipmc_asym.sweeps``, ...) still import: they are
+names of the modules in their subpackages (:data:`MOVED`).
 """
 
 from __future__ import annotations
 
 import importlib
+import importlib.abc
+import importlib.util
+import sys
 
 __version__ = "0.1.0"
 
@@ -38,24 +44,66 @@ __all__ = [
 ]
 
 _LAZY = {
-    "Strip": ("ipmc_asym.params", "Strip"),
-    "Material": ("ipmc_asym.params", "Material"),
-    "NAFION_LI": ("ipmc_asym.params", "NAFION_LI"),
-    "NOMINAL_STRIP": ("ipmc_asym.params", "NOMINAL_STRIP"),
-    "Permittivity": ("ipmc_asym.permittivity", "Permittivity"),
-    "MODELS": ("ipmc_asym.permittivity", "MODELS"),
-    "FIDELITIES": ("ipmc_asym.integral", "FIDELITIES"),
-    "moment_integral": ("ipmc_asym.integral", "moment_integral"),
-    "moment": ("ipmc_asym.integral", "moment"),
-    "evaluate": ("ipmc_asym.estimate", "evaluate"),
-    "solve_bvp_profile": ("ipmc_asym.bvp", "solve"),
-    "solve_beam": ("ipmc_asym.beam", "solve_beam"),
-    "run_scene": ("ipmc_asym.scenes", "run_scene"),
-    "sweep": ("ipmc_asym.sweeps", "sweep"),
-    "charge": ("ipmc_asym.electrode", "charge"),
-    "step_response": ("ipmc_asym.circuit", "step_response"),
-    "frequency_response": ("ipmc_asym.circuit", "frequency_response"),
+    "Strip": ("ipmc_asym.model.params", "Strip"),
+    "Material": ("ipmc_asym.model.params", "Material"),
+    "NAFION_LI": ("ipmc_asym.model.params", "NAFION_LI"),
+    "NOMINAL_STRIP": ("ipmc_asym.model.params", "NOMINAL_STRIP"),
+    "Permittivity": ("ipmc_asym.model.permittivity", "Permittivity"),
+    "MODELS": ("ipmc_asym.model.permittivity", "MODELS"),
+    "FIDELITIES": ("ipmc_asym.integral.api", "FIDELITIES"),
+    "moment_integral": ("ipmc_asym.integral.api", "moment_integral"),
+    "moment": ("ipmc_asym.integral.api", "moment"),
+    "evaluate": ("ipmc_asym.forward.estimate", "evaluate"),
+    "solve_bvp_profile": ("ipmc_asym.bvp.solver", "solve"),
+    "solve_beam": ("ipmc_asym.beam.statics", "solve_beam"),
+    "run_scene": ("ipmc_asym.studies.scenes", "run_scene"),
+    "sweep": ("ipmc_asym.studies.sweeps", "sweep"),
+    "charge": ("ipmc_asym.dynamics.electrode", "charge"),
+    "step_response": ("ipmc_asym.dynamics.circuit", "step_response"),
+    "frequency_response": ("ipmc_asym.dynamics.circuit", "frequency_response"),
 }
+
+
+#: module paths of the flat layout -> where the module lives now (same module object)
+MOVED = {
+    "registry": "base.registry", "settings": "base.settings", "units": "base.units",
+    "progress": "base.progress", "params": "model.params", "permittivity": "model.permittivity",
+    "_jit": "kernels.jit", "bvp_mesh": "bvp.mesh", "bvp_problems": "bvp.problems",
+    "integral_samples": "integral.samples", "fileio": "io.fileio", "jsonio": "io.jsonio",
+    "textfmt": "io.textfmt", "datasets": "io.datasets", "estimate": "forward.estimate",
+    "electrode": "dynamics.electrode", "transient": "dynamics.transient",
+    "circuit": "dynamics.circuit", "executors": "parallel.executors", "sweeps": "studies.sweeps",
+    "fits": "studies.fits", "profiles": "studies.profiles", "scene_schema": "studies.scene_schema",
+    "scenes": "studies.scenes", "laws": "studies.laws", "charge_studies": "studies.charge_studies",
+    "calibrate": "studies.calibrate", "uq": "studies.uq", "validate": "validation.validate",
+}
+
+
+class _MovedLoader(importlib.abc.Loader):
+    """Loads ``ipmc_asym.<old>`` as the module ``ipmc_asym.<new>`` (one module, two names)."""
+
+    def __init__(self, target):
+        self.target = target
+
+    def create_module(self, spec):
+        return importlib.import_module(self.target)
+
+    def exec_module(self, module):
+        pass
+
+
+class _MovedFinder(importlib.abc.MetaPathFinder):
+    """Answers only for the names in :data:`MOVED`; every other import is left to Python."""
+
+    def find_spec(self, fullname, path=None, target=None):
+        old = fullname[len(__name__) + 1:] if fullname.startswith(__name__ + ".") else None
+        if old not in MOVED:
+            return None
+        return importlib.util.spec_from_loader(fullname, _MovedLoader(f"{__name__}.{MOVED[old]}"))
+
+
+if not any(isinstance(f, _MovedFinder) for f in sys.meta_path):
+    sys.meta_path.append(_MovedFinder())
 
 
 def __getattr__(name):

@@ -1,5 +1,5 @@
 import sys
 
-from .cli import main
+from ipmc_asym.cli import main
 
 sys.exit(main())

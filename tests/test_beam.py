@@ -1,4 +1,4 @@
-"""Tests of ipmc_asym.beam against independent references.
+"""Tests of ipmc_asym.beam.statics against independent references.
 
 References: direct integration of the beam ODE (scipy solve_ivp), adaptive quadrature of the
 paper's blocking condition (scipy quad), an independent continuation of the blocking-force
@@ -16,7 +16,7 @@ import sympy as sp
 from scipy.integrate import IntegrationWarning, quad, solve_ivp
 from scipy.optimize import brentq
 
-from ipmc_asym import beam
+import ipmc_asym.beam.statics as beam
 
 L = 0.02
 EI = 1.3e8 * 4 * 2.5e-3 * (1e-4) ** 3 / 3  # E * 4 l e^3 / 3, ~4.33e-7 N m^2

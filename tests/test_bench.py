@@ -1,10 +1,10 @@
-"""ipmc_asym.bench on a small sweep: JSON structure and sane error ordering (no timing asserts)."""
+"""ipmc_asym.bench.suite on a small sweep: JSON structure and sane error ordering (no timing asserts)."""
 
 import json
 
 import pytest
 
-from ipmc_asym.bench import MODELS, format_table, run_bench
+from ipmc_asym.bench.suite import MODELS, format_table, run_bench
 from ipmc_asym.plotting.speed import plot_speed_accuracy
 
 

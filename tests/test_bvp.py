@@ -1,4 +1,4 @@
-"""Full BVP (ipmc_asym.bvp) against independent computations written here.
+"""Full BVP (ipmc_asym.bvp.solver) against independent computations written here.
 
 * linear model: exact solution ``C = 1 + (B1 - 1) sinh(z/z0)/sinh(1/z0)``;
 * constant / affine: first integral + layer quadratures (core neutral, exponentially
@@ -13,10 +13,10 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-from ipmc_asym import bvp
-from ipmc_asym.bvp import BVPResult, moment_integral_bvp, solve
-from ipmc_asym.params import NAFION_LI, Strip
-from ipmc_asym.permittivity import get_model
+import ipmc_asym.bvp.solver as bvp
+from ipmc_asym.bvp.solver import BVPResult, moment_integral_bvp, solve
+from ipmc_asym.model.params import NAFION_LI, Strip
+from ipmc_asym.model.permittivity import get_model
 
 NOMINAL = Strip(thickness=200e-6, voltage=1.0)
 QKW = dict(epsabs=1e-15, epsrel=1e-13, limit=400)
@@ -188,7 +188,7 @@ def test_corners_converge(model, thickness, voltage):
 def test_overlapping_layers_linear_exact(thickness, voltage):
     """Where the layers fill the strip (lambda ~ 1) the closed forms and the quadrature give up;
     the BVP must still converge to the exact solution of the linear model (any thickness)."""
-    from ipmc_asym.integral import moment
+    from ipmc_asym.integral.api import moment
 
     assert not bool(moment(thickness, voltage, "linear", "quadrature").valid)
     r = solve(Strip(thickness=thickness, voltage=voltage), "linear")

@@ -1,6 +1,6 @@
 """Calibration: synthetic round trip, identifiability, CSV errors.
 
-The synthetic data come from :func:`ipmc_asym.estimate.evaluate` (the scalar, per-strip path
+The synthetic data come from :func:`ipmc_asym.forward.estimate.evaluate` (the scalar, per-strip path
 at ``quadrature``), not from the vectorised predictor the fit uses.
 """
 
@@ -9,9 +9,9 @@ import math
 import numpy as np
 import pytest
 
-from ipmc_asym.calibrate import fit, read_data
-from ipmc_asym.estimate import evaluate
-from ipmc_asym.params import NAFION_LI, Strip
+from ipmc_asym.studies.calibrate import fit, read_data
+from ipmc_asym.forward.estimate import evaluate
+from ipmc_asym.model.params import NAFION_LI, Strip
 
 TRUE = {"modulus": 1.0e8, "c_moy": 2600.0}
 VOLTS = np.linspace(0.2, 1.2, 8)
@@ -129,7 +129,7 @@ def test_units_and_defaults(tmp_path):
 
 
 def test_unknown_free_parameter():
-    from ipmc_asym.calibrate import parse_free
+    from ipmc_asym.studies.calibrate import parse_free
 
     with pytest.raises(ValueError, match="unknown parameter 'young'"):
         parse_free("young")

@@ -9,10 +9,10 @@ import sympy as sp
 
 import ipmc_asym
 from derivations import charge as DC
-from ipmc_asym.electrode import charge, charge_scale
+from ipmc_asym.dynamics.electrode import charge, charge_scale
 from ipmc_asym.kernels import _generated_charge as GC
-from ipmc_asym.params import NAFION_LI, debye_length
-from ipmc_asym.permittivity import MODELS
+from ipmc_asym.model.params import NAFION_LI, debye_length
+from ipmc_asym.model.permittivity import MODELS
 
 M = NAFION_LI
 VT = M.R * M.T / M.F
@@ -27,7 +27,8 @@ def test_public_functions_are_not_shadowed_by_submodules():
     for mod in pkgutil.walk_packages(ipmc_asym.__path__, "ipmc_asym."):
         if not mod.name.endswith("__main__"):
             importlib.import_module(mod.name)
-    from ipmc_asym import circuit, electrode
+    import ipmc_asym.dynamics.circuit as circuit
+    import ipmc_asym.dynamics.electrode as electrode
 
     assert ipmc_asym.charge is electrode.charge
     assert ipmc_asym.step_response is circuit.step_response

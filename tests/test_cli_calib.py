@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from ipmc_asym.cli import main
-from ipmc_asym.estimate import evaluate
-from ipmc_asym.params import NAFION_LI, Strip
+from ipmc_asym.forward.estimate import evaluate
+from ipmc_asym.model.params import NAFION_LI, Strip
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
@@ -84,7 +84,7 @@ def test_uq_bad_scene_exit_2(tmp_path, capsys):
 
 def test_sweep_netcdf_out(tmp_path, capsys):
     xr = pytest.importorskip("xarray")
-    from ipmc_asym.sweeps import sweep
+    from ipmc_asym.studies.sweeps import sweep
 
     nc = tmp_path / "s.nc"
     assert main(["sweep", "--vary", "thickness=100um:300um:3", "--vary", "voltage=0.5V:2V:2", "--model", "all",

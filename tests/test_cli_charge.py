@@ -6,7 +6,7 @@ import json
 import pytest
 
 from ipmc_asym.cli import main
-from ipmc_asym.electrode import charge
+from ipmc_asym.dynamics.electrode import charge
 
 
 def test_charge_json_keys_and_values(capsys):

@@ -8,9 +8,9 @@ import pytest
 
 xr = pytest.importorskip("xarray")
 
-from ipmc_asym.datasets import available_engines, netcdf_engine, sweep_dataset, uq_dataset, write_netcdf  # noqa: E402
-from ipmc_asym.params import NAFION_LI, Strip  # noqa: E402
-from ipmc_asym.sweeps import sweep  # noqa: E402
+from ipmc_asym.io.datasets import available_engines, netcdf_engine, sweep_dataset, uq_dataset, write_netcdf  # noqa: E402
+from ipmc_asym.model.params import NAFION_LI, Strip  # noqa: E402
+from ipmc_asym.studies.sweeps import sweep  # noqa: E402
 
 
 @pytest.mark.parametrize("engine", available_engines())
@@ -41,7 +41,7 @@ def test_sweep_round_trip(tmp_path, engine):
 
 
 def test_uq_round_trip(tmp_path):
-    from ipmc_asym.uq import run_uq
+    from ipmc_asym.studies.uq import run_uq
 
     sc = {"name": "t", "voltage": "1V", "tolerance": 1e-2, "outputs": ["I", "rotation"],
           "uncertain": {"thickness": {"dist": "normal", "mean": "200um", "sd": "5um"},

@@ -6,8 +6,9 @@ import sys
 import numpy as np
 import pytest
 
-from ipmc_asym.executors import check_scheduler, chunk_slices, run_chunks, sweep_chunked
-from ipmc_asym.sweeps import sweep
+from ipmc_asym.parallel.executors import check_scheduler, chunk_slices, run_chunks
+from ipmc_asym.studies.sweep_chunks import sweep_chunked
+from ipmc_asym.studies.sweeps import sweep
 
 distributed = pytest.importorskip("distributed")
 
@@ -52,7 +53,7 @@ def _threads():
 
 
 def test_uq_identical_on_cluster(client):
-    from ipmc_asym.uq import run_uq
+    from ipmc_asym.studies.uq import run_uq
 
     sc = {"name": "t", "voltage": "1V", "tolerance": 1e-3, "outputs": ["I", "tip_deflection", "blocking_force"],
           "uncertain": {"thickness": {"dist": "normal", "mean": "200um", "sd": "10um"},
@@ -85,14 +86,14 @@ def test_bad_scheduler(bad):
 
 
 def test_import_does_not_load_dask():
-    code = ("import sys, ipmc_asym, ipmc_asym.executors, ipmc_asym.uq, ipmc_asym.calibrate, ipmc_asym.datasets;"
+    code = ("import sys, ipmc_asym, ipmc_asym.parallel.executors, ipmc_asym.studies.uq, ipmc_asym.studies.calibrate, ipmc_asym.io.datasets;"
             "print(any(m == 'dask' or m.startswith(('dask.', 'distributed')) for m in sys.modules))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "False"
 
 
 def test_fit_multistart_identical_on_cluster(client):
-    from ipmc_asym.calibrate import CalibrationData, fit, predict
+    from ipmc_asym.studies.calibrate import CalibrationData, fit, predict
 
     th = np.repeat([200e-6, 300e-6], 4)
     v = np.tile(np.linspace(0.3, 1.2, 4), 2)
@@ -118,7 +119,7 @@ def _env_of_worker(_):
 
 def test_process_pool_fallback_sets_threads():
     """Without dask, "local" is a spawn process pool; its workers get the same settings."""
-    from ipmc_asym.executors import _on_pool
+    from ipmc_asym.parallel.executors import _on_pool
 
     out = _on_pool(_env_of_worker, [0, 1, 2], 2, 1, ("leading",))
     assert out == [("1", "1", 1)] * 3

@@ -10,9 +10,9 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from ipmc_asym.bvp import solve
-from ipmc_asym.integral import moment
-from ipmc_asym.params import Strip
+from ipmc_asym.bvp.solver import solve
+from ipmc_asym.integral.api import moment
+from ipmc_asym.model.params import Strip
 
 MODELS = ("constant", "linear", "affine")
 FAST = ("leading", "corrected", "quadrature")

@@ -20,11 +20,11 @@ import numpy as np
 import pytest
 from test_bvp import I_layer_quadrature, I_linear_exact
 
-from ipmc_asym.integral import moment
-from ipmc_asym.params import NAFION_LI, Strip
-from ipmc_asym.permittivity import get_model
-from ipmc_asym.registry import FIDELITIES, fidelity_names, model_names
-from ipmc_asym.settings import BVP_STATED_ERROR
+from ipmc_asym.integral.api import moment
+from ipmc_asym.model.params import NAFION_LI, Strip
+from ipmc_asym.model.permittivity import get_model
+from ipmc_asym.base.registry import FIDELITIES, fidelity_names, model_names
+from ipmc_asym.base.settings import BVP_STATED_ERROR
 
 TH = np.array([20e-6, 200e-6, 1e-3])
 V = np.array([0.05, 1.0, 5.0])

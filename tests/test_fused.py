@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from ipmc_asym.integral import (
+from ipmc_asym.integral.api import (
     _ORDER,
     _sweep,
     closed_model_id,
@@ -14,8 +14,8 @@ from ipmc_asym.integral import (
     moment,
     moment_integral,
 )
-from ipmc_asym.params import NAFION_LI
-from ipmc_asym.permittivity import get_model
+from ipmc_asym.model.params import NAFION_LI
+from ipmc_asym.model.permittivity import get_model
 
 
 def _bare(th, v, model, fidelity):
@@ -87,9 +87,9 @@ def test_block_driver_is_the_point_driver_bit_for_bit(fidelity, model):
     """The closed forms run stage by stage over blocks of points (latency hidden); the results
     are those of the point-by-point driver, bit for bit, with every output, in both the full
     (moment) and the lean (moment_integral) modes -- zero volts and bad inputs included."""
-    from ipmc_asym import integral
-    from ipmc_asym.params import NAFION_LI
-    from ipmc_asym.permittivity import get_model
+    import ipmc_asym.integral.api as integral
+    from ipmc_asym.model.params import NAFION_LI
+    from ipmc_asym.model.permittivity import get_model
 
     rng = np.random.default_rng(5)
     n = 3 * integral.BLOCK + 17  # several blocks and a partial one

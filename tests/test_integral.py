@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from ipmc_asym import moment_integral
-from ipmc_asym.bvp import moment_integral_bvp
-from ipmc_asym.integral import moment
+from ipmc_asym.bvp.solver import moment_integral_bvp
+from ipmc_asym.integral.api import moment
 
 MODELS = ("constant", "linear", "affine")
 

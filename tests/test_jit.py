@@ -4,7 +4,7 @@ import re
 from pathlib import Path
 
 import ipmc_asym
-from ipmc_asym import _jit
+import ipmc_asym.kernels.jit as _jit
 
 
 def test_cache_key_covers_every_jitted_module():
@@ -31,9 +31,9 @@ import sys  # noqa: E402
 import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 
-from ipmc_asym import integral  # noqa: E402
-from ipmc_asym.params import NAFION_LI  # noqa: E402
-from ipmc_asym.permittivity import get_model  # noqa: E402
+import ipmc_asym.integral.api as integral  # noqa: E402
+from ipmc_asym.model.params import NAFION_LI  # noqa: E402
+from ipmc_asym.model.permittivity import get_model  # noqa: E402
 
 
 def _points(n, seed):

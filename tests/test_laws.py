@@ -5,7 +5,7 @@ import json
 import numpy as np
 import pytest
 
-from ipmc_asym.bvp import moment_integral_bvp
+from ipmc_asym.bvp.solver import moment_integral_bvp
 from ipmc_asym.cli import main
 
 

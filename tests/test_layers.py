@@ -140,6 +140,47 @@ def cycles(g) -> list[list[str]]:
 LAYERS = read_layers((ROOT / "docs" / "design.md").read_text(encoding="utf-8"))
 
 
+def read_studies_order(text: str) -> list[str]:
+    block = re.search(r"```studies\n(.*?)```", text, re.S)
+    assert block, "docs/design.md has no ```studies block"
+    return [f"ipmc_asym.studies.{m}" for m in block.group(1).split()]
+
+
+STUDIES = read_studies_order((ROOT / "docs" / "design.md").read_text(encoding="utf-8"))
+
+
+def studies_violations(mods):
+    """Imports inside ``studies/`` that go against its written order."""
+    g = graph(mods, LAYERS)
+    out = []
+    for m in g:
+        if not m.startswith("ipmc_asym.studies."):
+            continue
+        if m not in STUDIES:
+            out.append(f"{m}: not in the studies order of docs/design.md")
+            continue
+        for d in g[m]:
+            if d in STUDIES and STUDIES.index(d) > STUDIES.index(m):
+                out.append(f"{m} imports {d}: later in the studies order")
+    return out
+
+
+def test_the_tree_is_the_layer_rule():
+    """Every subpackage of ipmc_asym/ is a layer of the rule, and no module sits loose beside them."""
+    pkg = ROOT / "ipmc_asym"
+    loose = sorted(p.name for p in pkg.glob("*.py") if p.name not in ("__init__.py", "__main__.py"))
+    assert not loose, f"modules outside a subpackage: {loose}"
+    layer_names = [name for name, _ in LAYERS]
+    folders = sorted(p.name for p in pkg.iterdir() if (p / "__init__.py").exists())
+    missing = [f for f in folders if f not in layer_names]
+    assert not missing, f"subpackages without a layer in docs/design.md: {missing}"
+
+
+def test_studies_follow_their_order():
+    bad = studies_violations(project_modules())
+    assert not bad, "\n".join(bad)
+
+
 def test_every_import_follows_the_layer_rule():
     bad, _ = violations(project_modules(), LAYERS)
     assert not bad, "\n".join(bad)
@@ -175,9 +216,10 @@ def test_only_plotting_imports_matplotlib():
 
 
 @pytest.mark.parametrize("upward", [
-    ("ipmc_asym/params.py", "from .integral import moment\n"),
-    ("ipmc_asym/sweeps.py", "from .cli.common import UsageError\n"),
-    ("ipmc_asym/beam.py", "from .plotting import pyplot\n"),
+    ("ipmc_asym/model/params.py", "from ipmc_asym.integral.api import moment\n"),
+    ("ipmc_asym/studies/sweeps.py", "from ipmc_asym.cli.common import UsageError\n"),
+    ("ipmc_asym/beam/statics.py", "from ipmc_asym.plotting import pyplot\n"),
+    ("ipmc_asym/studies/fits.py", "from ipmc_asym.studies.uq import run_uq\n"),
 ])
 def test_the_rule_fails_on_an_upward_import(upward, tmp_path, monkeypatch):
     """The checker itself: an added upward import is reported (the test can fail)."""
@@ -196,6 +238,7 @@ def test_the_rule_fails_on_an_upward_import(upward, tmp_path, monkeypatch):
 
     monkeypatch.setattr(__import__(__name__), "module_name", shim)
     bad, _ = violations(mods, LAYERS)
+    bad += studies_violations(mods)
     assert any(b.startswith(name) for b in bad), bad
 
 

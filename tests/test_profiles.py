@@ -3,8 +3,8 @@ import math
 import numpy as np
 import pytest
 
-from ipmc_asym.params import Strip
-from ipmc_asym.profiles import _crossing, layer_widths, profile_summary
+from ipmc_asym.model.params import Strip
+from ipmc_asym.studies.profiles import _crossing, layer_widths, profile_summary
 
 
 def test_crossing_linear_interp():

@@ -1,4 +1,4 @@
-"""Scenes: planner escalation, reported fidelity/error, malformed input (ipmc_asym.scenes)."""
+"""Scenes: planner escalation, reported fidelity/error, malformed input (ipmc_asym.studies.scenes)."""
 
 import json
 import math
@@ -7,12 +7,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ipmc_asym.beam import blocking_force_large, tip_position
-from ipmc_asym.bvp import solve
-from ipmc_asym.integral import moment
-from ipmc_asym.params import NAFION_LI, Strip
-from ipmc_asym.profiles import layer_widths
-from ipmc_asym.scenes import LADDER, run_scene
+from ipmc_asym.beam.statics import blocking_force_large, tip_position
+from ipmc_asym.bvp.solver import solve
+from ipmc_asym.integral.api import moment
+from ipmc_asym.model.params import NAFION_LI, Strip
+from ipmc_asym.studies.profiles import layer_widths
+from ipmc_asym.studies.scenes import LADDER, run_scene
 
 EX = Path(__file__).resolve().parent.parent / "examples"
 
@@ -104,7 +104,7 @@ def test_layer_widths_mirror_with_the_voltage():
     neg, pos = r["outputs"]["profiles"]["values"]
     for side in ("anode_layer", "cathode_layer"):
         assert neg[side]["width_m"] == pytest.approx(pos[side]["width_m"], rel=1e-6)
-    # and they are the widths of ipmc_asym.profiles (one set of definitions)
+    # and they are the widths of ipmc_asym.studies.profiles (one set of definitions)
     w = layer_widths(solve(Strip(), "constant"), 100e-6)
     assert pos["anode_layer"]["width_m"] == pytest.approx(w["devoid_um"] * 1e-6, rel=1e-12)
     assert pos["cathode_layer"]["width_m"] == pytest.approx(w["accumulation_um"] * 1e-6, rel=1e-12)

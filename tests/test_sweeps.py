@@ -1,10 +1,10 @@
 import numpy as np
 import pytest
 
-from ipmc_asym.estimate import evaluate
-from ipmc_asym.fits import fit_power_law, sweep_fits
-from ipmc_asym.params import Strip
-from ipmc_asym.sweeps import iter_sweep, parse_vary, sweep
+from ipmc_asym.forward.estimate import evaluate
+from ipmc_asym.studies.fits import fit_power_law, sweep_fits
+from ipmc_asym.model.params import Strip
+from ipmc_asym.studies.sweeps import iter_sweep, parse_vary, sweep
 
 
 def test_parse_vary():
@@ -83,7 +83,7 @@ def test_prefetched_keeps_order_raises_and_stops():
     producer's exception surfaces in the consumer, and a consumer that stops early stops it."""
     import threading
 
-    from ipmc_asym.sweeps import prefetched
+    from ipmc_asym.studies.sweeps import prefetched
 
     assert list(prefetched(iter(range(50)))) == list(range(50))
 
@@ -117,7 +117,7 @@ def test_prefetched_keeps_order_raises_and_stops():
 
 
 def test_prefetched_sweep_identical_to_serial():
-    from ipmc_asym.sweeps import prefetched
+    from ipmc_asym.studies.sweeps import prefetched
 
     vary = {"thickness": np.linspace(50e-6, 500e-6, 7), "voltage": np.linspace(-2.0, 3.0, 9)}
     a = np.concatenate(list(iter_sweep(vary, "all", "leading", chunk_rows=10)))

@@ -5,8 +5,9 @@ from fractions import Fraction
 import numpy as np
 import pytest
 
-from ipmc_asym import sweeps, textfmt
-from ipmc_asym.textfmt import format_floats, format_table
+import ipmc_asym.studies.sweeps as sweeps
+import ipmc_asym.io.textfmt as textfmt
+from ipmc_asym.io.textfmt import format_floats, format_table
 
 
 def _doubles(n, seed=0):

@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from ipmc_asym.circuit import (
+from ipmc_asym.dynamics.circuit import (
     circuit_response,
     frequency_response,
     quasi_static_mechanics,
@@ -14,10 +14,10 @@ from ipmc_asym.circuit import (
     time_constant,
     waveform,
 )
-from ipmc_asym.electrode import charge
-from ipmc_asym.params import NAFION_LI, Strip
-from ipmc_asym.permittivity import MODELS
-from ipmc_asym.transient import solve_transient
+from ipmc_asym.dynamics.electrode import charge
+from ipmc_asym.model.params import NAFION_LI, Strip
+from ipmc_asym.model.permittivity import MODELS
+from ipmc_asym.dynamics.transient import solve_transient
 
 S0 = Strip()
 TAU = float(time_constant(S0.thickness))
@@ -95,7 +95,7 @@ def test_circuit_linear_limit_is_an_exponential():
 
 def test_time_constant_formula():
     """tau = R C_d(0) = e lambda_D / D."""
-    from ipmc_asym.params import debye_length
+    from ipmc_asym.model.params import debye_length
 
     for model in ("constant", "affine"):
         lamD = float(debye_length(S0.thickness, MODELS[model].eps_moy, NAFION_LI)) * S0.e
@@ -103,7 +103,7 @@ def test_time_constant_formula():
 
 
 def test_circuit_long_time_and_mechanics_match_the_static_strip():
-    from ipmc_asym.estimate import evaluate
+    from ipmc_asym.forward.estimate import evaluate
 
     for model in ("constant", "linear", "affine"):
         r = step_response(1.0, 40 * TAU * (15 if model != "constant" else 1), model=model, points=400)
@@ -115,7 +115,7 @@ def test_circuit_long_time_and_mechanics_match_the_static_strip():
 
 
 def test_small_signal_dc_limit_is_the_static_slope():
-    from ipmc_asym.estimate import evaluate
+    from ipmc_asym.forward.estimate import evaluate
 
     v = 1e-4
     for method in ("pnp-linear", "circuit"):
@@ -153,7 +153,7 @@ def test_linear_model_refused_by_the_pnp_solver():
 
 
 def test_charge_claims_rows_follow_their_criteria():
-    from ipmc_asym.charge_studies import charge_claims
+    from ipmc_asym.studies.charge_studies import charge_claims
 
     rows = {r["key"]: r for r in charge_claims()}
     cap, tim = rows["capacitance_permittivity"], rows["characteristic_time"]
@@ -161,7 +161,7 @@ def test_charge_claims_rows_follow_their_criteria():
         assert r["verdict"] in ("reproduced", "differs") and r["criterion"]
     e0 = cap["numbers"]["eps_app_0V"]
     # eps_app(0 V) = eps_core e / lambda_D, independently of the charge code
-    from ipmc_asym.params import debye_length
+    from ipmc_asym.model.params import debye_length
 
     for m in ("constant", "linear", "affine"):
         lam = float(debye_length(S0.thickness, MODELS[m].eps_moy, NAFION_LI))

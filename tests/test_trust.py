@@ -20,11 +20,11 @@ import pytest
 
 import ipmc_asym
 from ipmc_asym.cli import main
-from ipmc_asym.estimate import evaluate
-from ipmc_asym.integral import moment, moment_integral
-from ipmc_asym.params import Strip
-from ipmc_asym.registry import fidelity_names, model_names
-from ipmc_asym.settings import MIN_THICKNESS, STRAIN_LIMIT
+from ipmc_asym.forward.estimate import evaluate
+from ipmc_asym.integral.api import moment, moment_integral
+from ipmc_asym.model.params import Strip
+from ipmc_asym.base.registry import fidelity_names, model_names
+from ipmc_asym.base.settings import MIN_THICKNESS, STRAIN_LIMIT
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
@@ -78,7 +78,7 @@ def test_cli_bvp_at_minus_19_volts(capsys):
 @pytest.mark.parametrize("v", [20.0, -20.0])
 def test_bvp_converges_at_1um_20V_constant(v):
     """Independent solver (issue 9): I = 0.10324... at total thickness 1 um, 20 V."""
-    from ipmc_asym.bvp import solve
+    from ipmc_asym.bvp.solver import solve
 
     r = solve(Strip(thickness=1e-6, voltage=v), "constant")
     assert r.success, r.message
@@ -117,7 +117,7 @@ def test_valid_covers_strain_and_beam_regime():
     assert not row["valid"] and row["w"] is None and row["theta"] is None
     assert row["max_strain"] > STRAIN_LIMIT
     # the beam's own strain, independently: e |M| / EI
-    from ipmc_asym.params import NAFION_LI
+    from ipmc_asym.model.params import NAFION_LI
 
     EI = NAFION_LI.E * s.I_p
     assert row["max_strain"] == pytest.approx(s.e * abs(row["M_A"]) / EI, rel=1e-12)
@@ -140,9 +140,9 @@ def test_leading_error_bound_relative_to_I(model):
 
 @pytest.mark.parametrize("model", ["linear", "affine"])
 def test_corrected_valid_at_10um(model):
-    from ipmc_asym.bvp import moment_integral_bvp
+    from ipmc_asym.bvp.solver import moment_integral_bvp
 
-    from ipmc_asym.integral import validity_limit
+    from ipmc_asym.integral.api import validity_limit
 
     c = moment(10e-6, 1.0, model, "corrected")
     ref = moment_integral_bvp(10e-6, 1.0, model)
@@ -161,8 +161,8 @@ def test_evaluate_rejects_bad_tol():
 
 def test_escalation_is_generic_over_the_registry(monkeypatch):
     """A rung added to registry.FIDELITIES is climbed without code change (e.g. 'exact')."""
-    from ipmc_asym import registry
-    from ipmc_asym.estimate import moment_escalating
+    import ipmc_asym.base.registry as registry
+    from ipmc_asym.forward.estimate import moment_escalating
 
     r = moment_escalating([1e-7, 2e-4], 1.0, "constant", fidelity_names()[0])
     first_valid = next(f for f in fidelity_names() if bool(moment(1e-7, 1.0, "constant", f).valid))
@@ -174,7 +174,7 @@ def test_escalation_is_generic_over_the_registry(monkeypatch):
 # 9.7-9.9: sweeps in chunks, paths, atomic files, Ctrl-C
 # ---------------------------------------------------------------------------------------
 def test_iter_sweep_chunks_equal_the_in_memory_sweep(tmp_path):
-    from ipmc_asym.sweeps import iter_sweep, sweep, write_csv
+    from ipmc_asym.studies.sweeps import iter_sweep, sweep, write_csv
 
     vary = {"length": np.linspace(0.01, 0.04, 7), "voltage": [-1.0, 0.0, 2.0]}
     whole = sweep(vary, "all", "leading")
@@ -210,7 +210,7 @@ def test_output_paths_checked_first(argv, capsys):
 
 
 def test_ctrl_c_leaves_no_partial_file(tmp_path, monkeypatch, capsys):
-    from ipmc_asym import sweeps
+    import ipmc_asym.studies.sweeps as sweeps
 
     calls = {"n": 0}
     real = sweeps._format_chunk_bytes  # what the writers format with (in worker threads)
@@ -233,7 +233,7 @@ def test_ctrl_c_leaves_no_partial_file(tmp_path, monkeypatch, capsys):
 def _peak_rss_mb(rows: int) -> float:
     code = textwrap.dedent(f"""
         import resource, sys, numpy as np
-        from ipmc_asym.sweeps import iter_sweep, write_csv
+        from ipmc_asym.studies.sweeps import iter_sweep, write_csv
         write_csv(iter_sweep({{"length": np.linspace(0.01, 0.04, {rows})}}, "constant", "leading",
                              chunk_rows=5000), sys.argv[1])
         print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0)
@@ -324,8 +324,8 @@ def test_2d_sweep_fits_each_axis(capsys):
 
 
 def test_one_failed_point_keeps_the_other_rows(monkeypatch):
-    from ipmc_asym import integral
-    from ipmc_asym.sweeps import sweep
+    import ipmc_asym.integral.api as integral
+    from ipmc_asym.studies.sweeps import sweep
 
     real = integral._bvp_loop
 
@@ -353,7 +353,7 @@ def test_readme_python_blocks_run():
 
 def test_atomic_files_get_the_usual_permissions(tmp_path):
     """mkstemp makes 0600 files; a written result must be readable like any file (umask)."""
-    from ipmc_asym.fileio import atomic_path, atomic_write
+    from ipmc_asym.io.fileio import atomic_path, atomic_write
 
     mask = os.umask(0o022)
     try:
@@ -369,7 +369,7 @@ def test_atomic_files_get_the_usual_permissions(tmp_path):
 
 def test_voltage_beyond_the_validated_range_is_never_silent(capsys):
     """9.5: at 1000 V the linear model used to print a clean table."""
-    from ipmc_asym.settings import VALIDATED_VOLTAGE
+    from ipmc_asym.base.settings import VALIDATED_VOLTAGE
 
     assert main(["estimate", "--model", "linear", "--voltage", f"{50 * VALIDATED_VOLTAGE:g}V"]) in (0, 2)
     cap = capsys.readouterr()

@@ -5,9 +5,9 @@ import math
 import numpy as np
 import pytest
 
-from ipmc_asym.estimate import evaluate
-from ipmc_asym.params import NAFION_LI, Strip
-from ipmc_asym.uq import parse_uncertain, run_uq
+from ipmc_asym.forward.estimate import evaluate
+from ipmc_asym.model.params import NAFION_LI, Strip
+from ipmc_asym.studies.uq import parse_uncertain, run_uq
 
 
 def _scene(uncertain, outputs, **kw):
@@ -100,7 +100,7 @@ def test_estimators_equal_salib():
     """The written-out estimators are SALib's first_order/total_order (Saltelli 2010, Jansen)."""
     from SALib.analyze.sobol import first_order, separate_output_values, total_order
 
-    from ipmc_asym.uq import _saltelli, _sobol_indices
+    from ipmc_asym.studies.uq import _saltelli, _sobol_indices
 
     N, D = 2**10, 3
     U = _saltelli(D, N, 1)

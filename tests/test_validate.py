@@ -8,7 +8,7 @@ from dataclasses import replace
 
 import pytest
 
-from ipmc_asym.validate import (
+from ipmc_asym.validation.validate import (
     CLAIMS,
     VERDICTS,
     Claim,
@@ -75,7 +75,7 @@ def test_every_row_has_a_criterion_and_a_computed_verdict(rows):
 
 def test_slip2_prefactors_are_the_sympy_factor_three(rows):
     # independent: derivations/scaling.py (SymPy) gives the ratio section 3-4 / section 6.2
-    from ipmc_asym.laws import factor_three
+    from ipmc_asym.studies.laws import factor_three
 
     ratios = [float(eval(v)) for v in factor_three().values()]  # noqa: S307 - SymPy rationals as text
     claim = next(c for c in CLAIMS if c.key == "slip2_prefactor")
@@ -95,7 +95,7 @@ def test_slip3_interval_is_the_mechanics_ratio(rows):
 
 
 def test_no_sentence_contradicts_laws(rows):
-    from ipmc_asym.laws import law_ranges
+    from ipmc_asym.studies.laws import law_ranges
 
     ex = law_ranges("constant")["exponent_phi0"]
     m = re.search(r"([+-]\d\.\d+) at 1 V, ([+-]\d\.\d+) \.\. ([+-]\d\.\d+)", rows["I_phi_half"]["ours"])

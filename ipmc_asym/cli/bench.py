@@ -2,11 +2,11 @@
 
 from __future__ import annotations
 
-from ..bench import format_table, run_bench
-from ..fileio import check_output_path
-from ..jsonio import dumps
-from . import SUMMARIES
-from .common import count_type
+from ipmc_asym.bench.suite import format_table, run_bench
+from ipmc_asym.io.fileio import check_output_path
+from ipmc_asym.io.jsonio import dumps
+from ipmc_asym.cli import SUMMARIES
+from ipmc_asym.cli.common import count_type
 
 
 def register(sub):
@@ -31,7 +31,7 @@ def run(args) -> int:
     res = run_bench(args.points, args.bvp_points, compile_times=not args.no_compile, layout=args.layout,
                     sections=args.section, quick_sections=args.quick)
     if args.figure:
-        from ..plotting.speed import (
+        from ipmc_asym.plotting.speed import (
             plot_speed_accuracy,  # deferred: matplotlib (start-up)
         )
 

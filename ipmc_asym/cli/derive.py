@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from . import SUMMARIES
-from .common import UsageError
+from ipmc_asym.cli import SUMMARIES
+from ipmc_asym.cli.common import UsageError
 
 
 def register(sub):

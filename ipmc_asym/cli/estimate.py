@@ -2,13 +2,13 @@
 
 from __future__ import annotations
 
-from ..estimate import estimate_rows, model_list
-from ..integral import interpret_small
-from ..jsonio import dumps
-from ..registry import fidelity_names, model_choices
-from ..units import fmt_length
-from . import SUMMARIES
-from .common import (
+from ipmc_asym.forward.estimate import estimate_rows, model_list
+from ipmc_asym.integral.api import interpret_small
+from ipmc_asym.io.jsonio import dumps
+from ipmc_asym.base.registry import fidelity_names, model_choices
+from ipmc_asym.base.units import fmt_length
+from ipmc_asym.cli import SUMMARIES
+from ipmc_asym.cli.common import (
     add_strip_options,
     c_moy_label,
     first_run_notice,

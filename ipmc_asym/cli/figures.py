@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import sys
 
-from ..bench import load_bench
-from ..fileio import check_output_path
-from . import SUMMARIES
-from .common import count_type, new_dir_removed_on_failure
+from ipmc_asym.bench.suite import load_bench
+from ipmc_asym.io.fileio import check_output_path
+from ipmc_asym.cli import SUMMARIES
+from ipmc_asym.cli.common import count_type, new_dir_removed_on_failure
 
 
 def register(sub):
@@ -23,7 +23,7 @@ def register(sub):
 def run(args) -> int:
     check_output_path(args.out, "dir")
     bench = load_bench(args.bench) if args.bench else None
-    from ..plotting.figures import make_all  # deferred: matplotlib (start-up)
+    from ipmc_asym.plotting.figures import make_all  # deferred: matplotlib (start-up)
 
     with new_dir_removed_on_failure(args.out):
         out = make_all(args.out, args.dpi, quick=args.quick, bench=bench,

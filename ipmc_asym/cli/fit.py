@@ -4,12 +4,12 @@ from __future__ import annotations
 
 import sys
 
-from ..calibrate import FREE_PARAMETERS, fit, read_data
-from ..fileio import check_output_path
-from ..jsonio import dumps
-from ..registry import fidelity_names, model_names
-from . import SUMMARIES
-from .common import add_strip_options, count_type, material_from_args, strip_from_args
+from ipmc_asym.studies.calibrate import FREE_PARAMETERS, fit, read_data
+from ipmc_asym.io.fileio import check_output_path
+from ipmc_asym.io.jsonio import dumps
+from ipmc_asym.base.registry import fidelity_names, model_names
+from ipmc_asym.cli import SUMMARIES
+from ipmc_asym.cli.common import add_strip_options, count_type, material_from_args, strip_from_args
 
 
 def register(sub):
@@ -37,14 +37,14 @@ def run(args) -> int:
     if args.plot:
         check_output_path(args.plot, "file", "--plot")
     if args.scheduler is not None:
-        from ..executors import check_scheduler
+        from ipmc_asym.parallel.executors import check_scheduler
 
         check_scheduler(args.scheduler)
     data = read_data(args.data, strip_from_args(args))
     res = fit(data, args.free, model=args.model, material=material_from_args(args), fidelity=args.fidelity,
               multistart=args.multistart, seed=args.seed, scheduler=args.scheduler)
     if args.plot:
-        from ..plotting.calibrate import plot_fit  # deferred: matplotlib (start-up)
+        from ipmc_asym.plotting.calibrate import plot_fit  # deferred: matplotlib (start-up)
 
         plot_fit(res, args.plot)
     if args.json:

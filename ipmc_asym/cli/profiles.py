@@ -2,12 +2,12 @@
 
 from __future__ import annotations
 
-from ..fileio import check_output_path
-from ..jsonio import dumps
-from ..profiles import PAPER_LAYERS
-from ..registry import model_choices, model_names
-from . import SUMMARIES
-from .common import add_strip_options, material_from_args, new_dir_removed_on_failure, strip_from_args
+from ipmc_asym.io.fileio import check_output_path
+from ipmc_asym.io.jsonio import dumps
+from ipmc_asym.studies.profiles import PAPER_LAYERS
+from ipmc_asym.base.registry import model_choices, model_names
+from ipmc_asym.cli import SUMMARIES
+from ipmc_asym.cli.common import add_strip_options, material_from_args, new_dir_removed_on_failure, strip_from_args
 
 
 def register(sub):
@@ -24,7 +24,7 @@ def run(args) -> int:
         raise ValueError("profiles: voltage must be > 0 (a negative voltage is the mirror image)")
     mat = material_from_args(args)
     check_output_path(args.out, "dir")
-    from ..plotting.profiles import write_all  # deferred: matplotlib (start-up)
+    from ipmc_asym.plotting.profiles import write_all  # deferred: matplotlib (start-up)
 
     models = model_names() if args.model == "all" else (args.model,)
     with new_dir_removed_on_failure(args.out):

@@ -4,11 +4,11 @@ from __future__ import annotations
 
 import sys
 
-from ..fileio import check_output_path
-from ..jsonio import dumps
-from ..registry import FIDELITIES, fidelity_names
-from . import SUMMARIES
-from .common import count_type
+from ipmc_asym.io.fileio import check_output_path
+from ipmc_asym.io.jsonio import dumps
+from ipmc_asym.base.registry import FIDELITIES, fidelity_names
+from ipmc_asym.cli import SUMMARIES
+from ipmc_asym.cli.common import count_type
 
 
 def register(sub):
@@ -29,23 +29,23 @@ def register(sub):
 
 
 def run(args) -> int:
-    from ..uq import run_uq
+    from ipmc_asym.studies.uq import run_uq
 
     for opt in ("out", "plot"):
         if getattr(args, opt):
             check_output_path(getattr(args, opt), "file", f"--{opt}")
     if args.scheduler is not None:
-        from ..executors import check_scheduler
+        from ipmc_asym.parallel.executors import check_scheduler
 
         check_scheduler(args.scheduler)
     res = run_uq(args.scene, args.samples, seed=args.seed, fidelity=args.fidelity, scheduler=args.scheduler)
     if args.out:
-        from ..datasets import uq_dataset, write_netcdf
+        from ipmc_asym.io.datasets import uq_dataset, write_netcdf
 
         eng = write_netcdf(uq_dataset(res), args.out)
         sys.stderr.write(f"uq: {res.n_samples} samples -> {args.out} (NetCDF, engine {eng})\n")
     if args.plot:
-        from ..plotting.uq import plot_uq  # deferred: matplotlib (start-up)
+        from ipmc_asym.plotting.uq import plot_uq  # deferred: matplotlib (start-up)
 
         plot_uq(res, args.plot)
     if args.json:

@@ -11,8 +11,8 @@ import math
 
 import numpy as np
 
-from .._jit import jit
-from .special import e2rel, exprel, li2, li3  # noqa: F401
+from ipmc_asym.kernels.jit import jit
+from ipmc_asym.kernels.special import e2rel, exprel, li2, li3  # noqa: F401
 
 K0_AFFINE = 1.6383509345642195
 K0_CONSTANT = 0.3876521225943136

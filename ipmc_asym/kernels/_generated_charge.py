@@ -11,8 +11,8 @@ import math
 
 import numpy as np
 
-from .._jit import jit
-from .special import e2rel, exprel  # noqa: F401
+from ipmc_asym.kernels.jit import jit
+from ipmc_asym.kernels.special import e2rel, exprel  # noqa: F401
 
 
 @jit

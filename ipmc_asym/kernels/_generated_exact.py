@@ -10,8 +10,8 @@ fails on any difference.
 
 import math
 
-from .._jit import jit
-from .special import e2rel, exprel  # noqa: F401
+from ipmc_asym.kernels.jit import jit
+from ipmc_asym.kernels.special import e2rel, exprel  # noqa: F401
 
 
 @jit

@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import math
 
-from .._jit import jit
-from . import _generated as G
+from ipmc_asym.kernels.jit import jit
+from ipmc_asym.kernels import _generated as G
 
 __all__ = ["layer_closed", "moment_closed", "closed_b1", "closed_finish", "TRUNCATION"]
 
@@ -144,9 +144,9 @@ def moment_closed(lam, A2, A3, rho, model_id, order):
     """``I`` at order 1 (``leading``: lam J1) or 2 (``corrected``: lam J1 + lam^2 J2).
 
     ``rho`` must be the model's own (``A1/(A0+A1)``: 1, 0, 5/1005); the per-model kernels
-    have it built in and the caller (:func:`ipmc_asym.integral.moment`) guarantees it.
+    have it built in and the caller (:func:`ipmc_asym.integral.api.moment`) guarantees it.
     Three stages (:func:`closed_b1`, :func:`layer_closed` at both faces,
-    :func:`closed_finish`), which the block drivers of :mod:`ipmc_asym.integral` run stage by
+    :func:`closed_finish`), which the block drivers of :mod:`ipmc_asym.integral.api` run stage by
     stage over a block of points: the same operations, bit for bit.
 
     Returns

@@ -27,10 +27,10 @@ import math
 
 import numpy as np
 
-from .._jit import jit
-from ._generated import b1_exact, dhat
-from ._generated_exact import assemble_exact, exact_core, exact_outer, exact_outer_parts
-from .special import gauss_legendre
+from ipmc_asym.kernels.jit import jit
+from ipmc_asym.kernels._generated import b1_exact, dhat
+from ipmc_asym.kernels._generated_exact import assemble_exact, exact_core, exact_outer, exact_outer_parts
+from ipmc_asym.kernels.special import gauss_legendre
 
 __all__ = ["moment_exact", "moment_exact_nodes", "NODES"]
 

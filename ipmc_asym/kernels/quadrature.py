@@ -18,9 +18,9 @@ import math
 
 import numpy as np
 
-from .._jit import jit
-from ._generated import assemble_j, b1_exact, dhat, w_layer
-from .special import gauss_legendre
+from ipmc_asym.kernels.jit import jit
+from ipmc_asym.kernels._generated import assemble_j, b1_exact, dhat, w_layer
+from ipmc_asym.kernels.special import gauss_legendre
 
 __all__ = ["layer_functions", "moment_quadrature", "NODES"]
 

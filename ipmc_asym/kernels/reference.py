@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import math
 
-from .._jit import jit
+from ipmc_asym.kernels.jit import jit
 
 __all__ = ["seven_transcendentals"]
 

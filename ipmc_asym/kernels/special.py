@@ -16,7 +16,7 @@ import math
 
 import numpy as np
 
-from .._jit import jit
+from ipmc_asym.kernels.jit import jit
 
 __all__ = ["exprel", "e2rel", "li2", "li3", "gauss_legendre", "ZETA2", "ZETA3"]
 

@@ -1,13 +1,14 @@
 """All matplotlib code of the toolkit: one module per topic; nothing below imports matplotlib.
 
-:func:`pyplot` selects the Agg backend once and returns ``matplotlib.pyplot``;
-:func:`savefig` writes a figure atomically (temp file in the same directory, then rename)
-and closes it.
+:func:`pyplot` returns an object with ``subplots`` and ``close`` like ``matplotlib.pyplot``,
+making :class:`matplotlib.figure.Figure` objects without pyplot: no backend is selected or
+switched (a notebook user's backend stays as it is) and no figure enters pyplot's registry.
+:func:`savefig` writes a figure atomically (temp file in the same directory, then rename).
 """
 
 from __future__ import annotations
 
-from ..fileio import atomic_path
+from ipmc_asym.io.fileio import atomic_path
 
 __all__ = ["pyplot", "savefig", "MODEL_COLOURS"]
 
@@ -15,14 +16,24 @@ __all__ = ["pyplot", "savefig", "MODEL_COLOURS"]
 MODEL_COLOURS = {"constant": "C0", "linear": "C1", "affine": "C2"}
 
 
+class _Figures:
+    """The two pyplot functions the figures use, on bare :class:`matplotlib.figure.Figure`."""
+
+    @staticmethod
+    def subplots(nrows=1, ncols=1, *, figsize=None, dpi=None, **kw):
+        from matplotlib.figure import Figure  # deferred: matplotlib is heavy and only figures need it
+
+        fig = Figure(figsize=figsize, dpi=dpi)
+        return fig, fig.subplots(nrows, ncols, **kw)
+
+    @staticmethod
+    def close(fig):
+        """Nothing to release: the figure is not registered with pyplot."""
+
+
 def pyplot():
-    """``matplotlib.pyplot`` on the non-interactive Agg backend."""
-    import matplotlib  # deferred: matplotlib is heavy and only figures need it
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
+    """Figure factory with pyplot's ``subplots``/``close`` signatures (no backend switch)."""
+    return _Figures
 
 
 def savefig(fig, path, **kw) -> str:

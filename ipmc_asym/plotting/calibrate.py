@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import pyplot, savefig
+from ipmc_asym.plotting import pyplot, savefig
 
 __all__ = ["plot_fit"]
 
@@ -21,7 +21,7 @@ def plot_fit(result, path) -> str:
 
     Parameters
     ----------
-    result : ipmc_asym.calibrate.CalibrationResult
+    result : ipmc_asym.studies.calibrate.CalibrationResult
     path : str   PNG path (written atomically)
     """
     plt = pyplot()

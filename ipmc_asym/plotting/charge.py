@@ -6,11 +6,11 @@ import os
 
 import numpy as np
 
-from ..circuit import frequency_response, step_response, time_constant
-from ..electrode import charge
-from ..fileio import check_output_path
-from ..params import NAFION_LI, Strip
-from . import MODEL_COLOURS, pyplot, savefig
+from ipmc_asym.dynamics.circuit import frequency_response, step_response, time_constant
+from ipmc_asym.dynamics.electrode import charge
+from ipmc_asym.io.fileio import check_output_path
+from ipmc_asym.model.params import NAFION_LI, Strip
+from ipmc_asym.plotting import MODEL_COLOURS, pyplot, savefig
 
 __all__ = ["charge_figures", "plot_charge_capacitance", "plot_step", "plot_bode"]
 

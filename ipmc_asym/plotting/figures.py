@@ -1,11 +1,11 @@
 """The paper's figures (seed Figs 4-10) regenerated: ``ipmc-asym figures --out figures/``.
 
 * ``profile_{C,phi,D,p}.png`` (Figs 4-7) and ``profile_{E,rhoZ}.png``: full BVP at nominal,
-  full thickness + log zooms at each electrode (:mod:`ipmc_asym.profiles`);
+  full thickness + log zooms at each electrode (:mod:`ipmc_asym.studies.profiles`);
 * ``influence_length.png`` (Fig 8), ``influence_thickness.png`` (Fig 9),
   ``influence_voltage.png`` (Fig 10), ``influence_width.png``: deflection, blocking force and
   rotation, three models overlaid; points past a quarter turn drawn dotted (outside the model);
-* ``speed_accuracy.png`` if :func:`ipmc_asym.bench.speed_accuracy_figure` exists.
+* ``speed_accuracy.png`` if :func:`ipmc_asym.bench.suite.speed_accuracy_figure` exists.
 
 All matplotlib code lives in :mod:`ipmc_asym.plotting`.
 """
@@ -16,14 +16,14 @@ import os
 
 import numpy as np
 
-from ..params import NAFION_LI, Material, Strip
-from ..registry import model_names
-from ..settings import OUTSIDE_REGIMES
-from ..sweeps import sweep
-from . import MODEL_COLOURS, pyplot, savefig
-from ..profiles import compute_all
-from .profiles import write_all
-from .speed import speed_accuracy_figure
+from ipmc_asym.model.params import NAFION_LI, Material, Strip
+from ipmc_asym.base.registry import model_names
+from ipmc_asym.base.settings import OUTSIDE_REGIMES
+from ipmc_asym.studies.sweeps import sweep
+from ipmc_asym.plotting import MODEL_COLOURS, pyplot, savefig
+from ipmc_asym.studies.profiles import compute_all
+from ipmc_asym.plotting.profiles import write_all
+from ipmc_asym.plotting.speed import speed_accuracy_figure
 
 __all__ = ["influence_figure", "make_all", "INFLUENCE"]
 

@@ -1,9 +1,9 @@
-"""The speed/accuracy figure of the fidelity ladder (from :func:`ipmc_asym.bench.run_bench`)."""
+"""The speed/accuracy figure of the fidelity ladder (from :func:`ipmc_asym.bench.suite.run_bench`)."""
 
 from __future__ import annotations
 
-from ..bench import ERR_FLOOR, TARGETS, run_bench
-from . import pyplot, savefig
+from ipmc_asym.bench.suite import ERR_FLOOR, TARGETS, run_bench
+from ipmc_asym.plotting import pyplot, savefig
 
 __all__ = ["speed_accuracy_figure", "plot_speed_accuracy"]
 
@@ -19,7 +19,7 @@ def speed_accuracy_figure(path="figures/speed_accuracy.png", points: int = 10**5
         Size of the quick measurement (no compile subprocesses, no further sections) when
         ``bench`` is not given.
     bench : dict, optional
-        A saved ``ipmc-asym bench --json`` result (:func:`ipmc_asym.bench.load_bench`).
+        A saved ``ipmc-asym bench --json`` result (:func:`ipmc_asym.bench.suite.load_bench`).
     """
     res = bench if bench is not None else run_bench(points, bvp_points, repeats=1, compile_times=False,
                                                     sections=[])

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 
-from . import pyplot, savefig
+from ipmc_asym.plotting import pyplot, savefig
 
 __all__ = ["plot_uq"]
 
@@ -17,7 +17,7 @@ def plot_uq(result, path) -> str:
 
     Parameters
     ----------
-    result : ipmc_asym.uq.UQResult
+    result : ipmc_asym.studies.uq.UQResult
     path : str   PNG path (written atomically)
     """
     plt = pyplot()

@@ -1,0 +1,442 @@
+"""Reduced charging model and small-signal response (issue 11).
+
+Matched asymptotics of the transient Nernst-Planck/Gauss problem (``ipmc_asym.dynamics.transient``):
+the two electrode layers stay quasi-static (each in its static state for the charge it
+carries) while the neutral core carries an ohmic current.  Per unit electrode area::
+
+    R dsigma_L/dt = phi0(t) - V(sigma_L),     V = inverse of the static sigma(phi0) (electrode.py)
+
+plus the displacement charge of the bulk (a leaky dielectric, relaxation time ``lambda^2 e^2/D``,
+instantaneous on the scale ``tau``): ``sigma = sigma_L + C_g (phi0 - V(sigma_L))``,
+``C_g = eps_core/(2e)`` (``C_g/C_d(0) = lambda``; it is what a step charges at ``t = 0+``).
+
+``R = 2e/kappa`` with the core conductivity ``kappa = phi4 F^2 D C_moy/(R T)``: the paper's
+Nernst law (seed paper eq. "Nernst", solvent at rest, pressure term neglected as in §5) gives
+the molar cation flux per unit area of the MATERIAL ``phi4 C V1 = -phi4 D (grad C - F C E/(R T))``
+(``C`` is per unit volume of the liquid phase, a fraction ``phi4`` of the volume); in the
+neutral core ``C = C_moy``, so ``j = F phi4 C V1 = kappa E``.  The porosity factor is ``phi4``
+(no tortuosity factor: ``D`` is the diffusion coefficient in the liquid phase, as the paper
+defines it).  Linear time constant ``tau = R C_d(0) = e lambda_D/D``.
+
+The state is integrated as the layer voltage ``u = V(sigma)`` (``C_d(u) du/dt = (phi0 - u)/R``,
+``sigma = sigma(u)`` in closed form): no inversion of ``sigma(phi0)`` is needed.  The moment
+follows quasi-statically, ``M_A(t) = M_A^static(u(t))`` (the layers' state), then the beam:
+``theta``, ``w``, blocking force at each instant -- NO beam inertia or damping (the beam is in
+static equilibrium with the instantaneous moment).
+
+Outside this model (stated in every dynamic output): water transport (the paper's Darcy law)
+and the back-relaxation it causes; the solvent is at rest.
+
+Small signal about ``phi0 = 0``: the exact linearised PNP impedance and moment transfer
+(closed forms, ``derivations/charge.py``), and the circuit's ``R + 1/(i omega C_d(0))`` and
+``H(0)/(1 + i omega tau)``.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ipmc_asym.kernels.jit import jit
+from ipmc_asym.dynamics.electrode import (
+    _GL_W,
+    _GL_X,
+    _model_id,
+    capacitance_scale,
+    charge_hat_point,
+    charge_scale,
+    core_resistance,
+    time_constant,
+)
+from ipmc_asym.kernels import _generated_charge as GC
+from ipmc_asym.model.params import D_CATION_SOURCE, NAFION_LI, Material, Strip, check_finite, check_positive, debye_length
+from ipmc_asym.model.permittivity import Permittivity, get_model
+from ipmc_asym.base.registry import check_choice
+
+__all__ = ["DYNAMIC_NOTES", "StepResult", "FrequencyResult", "core_resistance", "time_constant",
+           "waveform", "step_response", "frequency_response", "circuit_response", "quasi_static_mechanics"]
+
+#: stated in every dynamic output
+DYNAMIC_NOTES = (
+    "water transport (the paper's Darcy law) and the back-relaxation it causes are outside this model: "
+    "the solvent is at rest",
+    "no beam inertia or damping: theta, w and the blocking force follow the moment quasi-statically",
+    "the cation diffusion coefficient D is not in the paper; " + D_CATION_SOURCE,
+)
+
+STEP_FIDELITIES = ("circuit", "pnp")
+WAVEFORMS = ("step", "ramp", "sine")
+FREQ_METHODS = ("pnp-linear", "circuit")
+
+
+def waveform(kind, voltage, *, ramp_time=None, frequency=None):
+    """``phi0(t)`` (V, vectorised) for ``step``, ``ramp``, ``sine`` or a user callable ``f(t)``.
+
+    ``step``: ``voltage`` for ``t >= 0``; ``ramp``: ``voltage * min(t/ramp_time, 1)``;
+    ``sine``: ``voltage * sin(2 pi frequency t)``; a callable is used as given (volts).
+    """
+    if callable(kind):
+        def user(t):
+            t = np.asarray(t, dtype=float)
+            try:
+                v = np.asarray(kind(t), dtype=float)
+                v = np.broadcast_to(v, t.shape).astype(float)
+            except Exception:  # not vectorised
+                v = np.array([float(kind(x)) for x in t.ravel()]).reshape(t.shape)
+            if not np.all(np.isfinite(v)):
+                raise ValueError("the voltage function phi0(t) must return finite volts")
+            return v
+        return user
+    check_choice("waveform", kind, WAVEFORMS)
+    V = check_finite("voltage", voltage, "a finite number of volts")
+    if kind == "step":
+        return lambda t: np.full(np.shape(t), V)
+    if kind == "ramp":
+        tr = check_positive("ramp_time", ramp_time, "s")
+        return lambda t: V * np.minimum(np.asarray(t, dtype=float) / tr, 1.0)
+    f = check_positive("frequency", frequency, "Hz")
+    return lambda t: V * np.sin(2.0 * math.pi * f * np.asarray(t, dtype=float))
+
+
+@dataclass
+class StepResult:
+    """Time series of a charging transient (SI, per unit electrode area unless stated).
+
+    Attributes
+    ----------
+    t : ndarray (n,)              time, s
+    phi0 : ndarray (n,)           applied voltage, V
+    sigma : ndarray (n,)          charge of the face z = -e, C/m^2
+    current_density : ndarray     dsigma/dt, A/m^2
+    layer_voltage : ndarray       voltage across the two electrode layers, V (circuit: V(sigma_L); pnp: phi0 - R J)
+    M_A, theta, w, F_block : ndarray   moment (N m), rotation (rad), tip deflection (m),
+                                  blocking force (N), quasi-static
+    tau : float                   linear time constant R C_d(0), s
+    R : float                     core resistance per area, Ohm m^2
+    C_d0 : float                  C_d(0), F/m^2
+    fidelity, model : str
+    notes : list of str           what the model leaves out (water transport, inertia, D source)
+    success : bool ; message : str
+    extra : dict                  solver details (pnp: mesh, energy balance, charge error)
+    seconds : float
+    """
+
+    t: np.ndarray
+    phi0: np.ndarray
+    sigma: np.ndarray
+    current_density: np.ndarray
+    layer_voltage: np.ndarray
+    M_A: np.ndarray
+    theta: np.ndarray
+    w: np.ndarray
+    F_block: np.ndarray
+    tau: float
+    R: float
+    C_d0: float
+    fidelity: str
+    model: str
+    notes: list
+    success: bool
+    message: str
+    extra: dict = field(default_factory=dict)
+    seconds: float = 0.0
+
+
+@jit
+def _shat(A, rho, mid, X, Wt):
+    """Signed sigma_hat(A) and Cd_hat(|A|) at the thermal voltage A = F u/(R T)."""
+    s, c, _ = charge_hat_point(abs(A), rho, mid, 0, X, Wt)
+    return (s if A >= 0.0 else -s), c
+
+
+@jit
+def _integrate(tt, ps, rho, mid, X, Wt, A_out, s_out):
+    """Variable-step BDF2 (first step backward Euler) for ds/dt = (psi0 - A)/2, s = s(A).
+
+    Time in units of tau, voltages in R T/F.  Each implicit step solves the monotone scalar
+    equation a0 s(A) + h A/2 = rhs by Newton with a bisection safeguard.
+    """
+    A = 0.0
+    A_prev = 0.0
+    s = 0.0
+    s_prev = 0.0
+    h_prev = 0.0
+    A_out[0] = 0.0
+    s_out[0] = 0.0
+    for n in range(1, tt.shape[0]):
+        h = tt[n] - tt[n - 1]
+        if h <= 0.0:
+            A_out[n] = A
+            s_out[n] = s
+            continue
+        if h_prev == 0.0:
+            a0 = 1.0
+            rhs = s + 0.5 * h * ps[n]
+        else:
+            w = h / h_prev
+            a0 = (1.0 + 2.0 * w) / (1.0 + w)
+            rhs = (1.0 + w) * s - w * w / (1.0 + w) * s_prev + 0.5 * h * ps[n]
+        # g(x) = a0 s(x) + h x / 2 - rhs is increasing: Newton from the linear predictor, with a
+        # bracket collected on the way (bisection once both ends are known)
+        lo = -math.inf
+        hi = math.inf
+        x = A + (A - A_prev) * (h / h_prev) if h_prev > 0.0 else A
+        for _ in range(200):
+            sx, cx = _shat(x, rho, mid, X, Wt)
+            g = a0 * sx + 0.5 * h * x - rhs
+            if g > 0.0:
+                hi = x
+            else:
+                lo = x
+            xn = x - g / (a0 * cx + 0.5 * h)
+            if not (lo < xn < hi):
+                if math.isinf(lo) or math.isinf(hi):
+                    xn = x - 2.0 * (1.0 + abs(g)) if math.isinf(lo) else x + 2.0 * (1.0 + abs(g))
+                else:
+                    xn = 0.5 * (lo + hi)
+            if abs(xn - x) <= 1e-13 * (1.0 + abs(x)):
+                x = xn
+                break
+            x = xn
+        s_prev = s
+        s, _ = _shat(x, rho, mid, X, Wt)
+        A_prev = A
+        A = x
+        h_prev = h
+        A_out[n] = A
+        s_out[n] = s
+
+
+def quasi_static_mechanics(u, strip: Strip, perm: Permittivity, material: Material):
+    """``(M_A, theta, w, F_block)`` of the static strip at the layer voltage(s) ``u`` (V).
+
+    The layers' state at a given charge is the static one at the voltage ``u = V(sigma)``
+    across them: moment at fidelity ``corrected`` (``quadrature`` for a non-paper affine
+    model), then the beam (no inertia).
+    """
+    from ipmc_asym.beam.statics import blocking_force_large, rotation, tip_deflection
+    from ipmc_asym.integral.api import moment
+    from ipmc_asym.model.params import moment_scale
+
+    fid = "corrected" if _model_id(perm, "corrected") >= 0 else "quadrature"
+    u = np.asarray(u, dtype=float)
+    r = moment(strip.thickness, u, perm, fid, material=material)
+    M = moment_scale(strip.width, strip.thickness, u, material.F, material.C_moy) * r.I
+    EI = material.E * strip.I_p
+    th = np.asarray(rotation(M, strip.length, EI), dtype=float)
+    w = np.asarray(tip_deflection(M, strip.length, EI), dtype=float)
+    Fb = np.asarray(blocking_force_large(M, strip.length, EI), dtype=float)
+    return M, th, w, Fb
+
+
+def _time_grid(duration, t, points):
+    if t is not None:
+        t = np.asarray(t, dtype=float).reshape(-1)
+        if t.size < 2 or not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0) or t[0] < 0:
+            raise ValueError("t must be a finite, strictly increasing array of >= 2 times >= 0 s")
+        return t
+    d = check_positive("duration", duration, "s")
+    n = int(points)
+    if n < 2:
+        raise ValueError(f"points must be an integer >= 2; got {points!r}")
+    return np.linspace(0.0, d, n)
+
+
+def circuit_response(t, phi0_fun, strip: Strip, perm: Permittivity, material: Material, substeps: int = 2):
+    """Integrate the reduced model on the time grid ``t`` (s); returns ``(sigma, u, J)``."""
+    m = material
+    VT = m.R * m.T / m.F
+    tau = float(time_constant(strip.thickness, perm, m))
+    # substeps between output times (BDF2 accuracy): at least `substeps`, and h <= tau/200;
+    # times in units of tau
+    dt = np.diff(t) / tau
+    k = np.maximum(int(substeps), np.ceil(dt / 5e-3)).astype(np.int64)
+    if k.sum() > 5_000_000:
+        raise ValueError("duration is too long for the reduced model's fixed substeps (> 1e6 tau); "
+                         "use fewer time constants")
+    idx = np.concatenate(([0], np.cumsum(k)))
+    frac = np.arange(idx[-1]) - np.repeat(idx[:-1], k)
+    tt = np.concatenate((np.repeat(t[:-1] / tau, k) + np.repeat(dt / k, k) * frac, [t[-1] / tau]))
+    ps = phi0_fun(tt * tau) / VT
+    A = np.empty(tt.size)
+    s = np.empty(tt.size)
+    rho = perm.eps0 / perm.eps_moy
+    _integrate(tt, ps, rho, _model_id(perm, "corrected"), _GL_X, _GL_W, A, s)
+    A, s = A[idx], s[idx]
+    u = VT * A
+    # the bulk is a leaky dielectric: besides the layers' charge the electrodes carry the
+    # displacement charge C_g (phi0 - u) of the core, C_g = eps_core/(2e) (its relaxation time
+    # R C_g = lambda^2 e^2/D is instantaneous on the scale tau); C_g/C_d(0) = lambda
+    Cg = perm.eps_moy / strip.thickness
+    ub = phi0_fun(t) - u
+    sigma = charge_scale(perm, m) * s + Cg * ub
+    J = ub / float(core_resistance(strip.thickness, m))
+    if t.size > 2:
+        J = J + Cg * np.gradient(ub, t)
+    return sigma, u, J
+
+
+def step_response(voltage=1.0, duration=None, *, strip: Strip | None = None, model="constant",
+                  fidelity="circuit", material: Material | None = None, t=None, points: int = 1000,
+                  waveform_kind="step", ramp_time=None, frequency=None, pnp_options=None) -> StepResult:
+    """Charging transient of the strip under an imposed ``phi0(t)`` (starting uncharged at t = 0).
+
+    Parameters
+    ----------
+    voltage : float
+        Amplitude (V) of the step / ramp plateau / sine (ignored for a callable waveform).
+    duration : float, optional
+        End time (s); default ``5 tau``.  Ignored when ``t`` is given.
+    strip : Strip, optional
+        Geometry (``thickness`` TOTAL 2e, ``width`` TOTAL 2l, ``length``); its voltage is unused.
+    model : {"constant", "linear", "affine"} or Permittivity
+    fidelity : {"circuit", "pnp"}
+        ``circuit``: the reduced nonlinear-capacitor model; ``pnp``: the transient
+        Nernst-Planck/Gauss solver (:mod:`ipmc_asym.dynamics.transient`).
+    material : Material, optional (``D`` = cation diffusion coefficient)
+    t : array_like, optional
+        Output times (s), increasing, from 0.
+    points : int
+        Number of output times when ``t`` is not given (default 1000).
+    waveform_kind : {"step", "ramp", "sine"} or callable ``phi0(t)`` (V)
+    ramp_time, frequency : float
+        For ``ramp`` (s) and ``sine`` (Hz).
+    pnp_options : dict, optional
+        Passed to :func:`ipmc_asym.dynamics.transient.solve_transient` (``cells_per_debye``, ``rtol``, ...).
+
+    Returns
+    -------
+    StepResult
+    """
+    t0 = time.perf_counter()
+    check_choice("fidelity", fidelity, STEP_FIDELITIES)
+    s = Strip() if strip is None else strip
+    m = NAFION_LI if material is None else material
+    perm = get_model(model)
+    if perm.is_custom:
+        raise ValueError("dynamic models need an affine permittivity (constant, linear, affine or a "
+                         "Permittivity); a custom eps(C) callable is not supported")
+    fun = waveform(waveform_kind, voltage, ramp_time=ramp_time, frequency=frequency)
+    tau = float(time_constant(s.thickness, perm, m))
+    tgrid = _time_grid(5.0 * tau if duration is None and t is None else duration, t, points)
+    R = float(core_resistance(s.thickness, m))
+    notes = list(DYNAMIC_NOTES)
+    extra = {}
+    if fidelity == "circuit":
+        sigma, u, J = circuit_response(tgrid, fun, s, perm, m)
+        success, message = True, "reduced model integrated (variable-step BDF2, 2 substeps per output interval)"
+    else:
+        from ipmc_asym.dynamics.transient import solve_transient
+
+        r = solve_transient(tgrid, fun, s, perm, m, **(pnp_options or {}))
+        if not r.success:
+            raise RuntimeError(f"transient PNP solver failed: {r.message}")
+        sigma, J = r.sigma, r.current_density
+        # the voltage left across the layers: phi0 minus the ohmic drop of the core (exact at
+        # t = 0+ and t -> infinity; the bulk's displacement current is O(lambda) of J)
+        u = fun(tgrid) - core_resistance(s.thickness, m) * J
+        success, message = r.success, r.message
+        extra = r.extra
+        notes.append("pnp: M_A(t) is the layers' quasi-static moment at the layer voltage phi0 - R J; the moment of the transient "
+                     "profiles (p' = (C + A3) E, which adds the pressure gradient of the ohmic core field) is in "
+                     "extra['M_A_profiles']")
+        extra = dict(extra, M_A_profiles=r.M_A_profiles)
+    M, th, w, Fb = quasi_static_mechanics(u, s, perm, m)
+    return StepResult(t=tgrid, phi0=fun(tgrid), sigma=sigma, current_density=J, layer_voltage=u, M_A=M,
+                      theta=th, w=w, F_block=Fb, tau=tau, R=R, C_d0=0.5 * capacitance_scale(perm, m),
+                      fidelity=fidelity, model=perm.name, notes=notes, success=success, message=message,
+                      extra=extra, seconds=time.perf_counter() - t0)
+
+
+@dataclass
+class FrequencyResult:
+    """Small-signal response about ``phi0 = 0`` (SI).
+
+    Attributes
+    ----------
+    f : ndarray (n,)          frequency, Hz
+    Z : ndarray complex (n,)  impedance of the strip (electrode area 2l L), Ohm
+    Z_area : ndarray complex  impedance per unit area, Ohm m^2
+    H_w : ndarray complex     tip deflection per volt (small displacements), m/V
+    w_amp, w_phase : ndarray  |H_w| (m/V), arg H_w (rad; w < 0 for phi0 > 0 gives phase pi at DC);
+                              H_w is the layers' (quasi-static) moment at the layer voltage V(sigma)
+    tau : float ; method : str ; model : str ; notes : list
+    H_w_profiles : ndarray complex or None   pnp-linear only: transfer of the full profile moment
+    """
+
+    f: np.ndarray
+    Z: np.ndarray
+    Z_area: np.ndarray
+    H_w: np.ndarray
+    w_amp: np.ndarray
+    w_phase: np.ndarray
+    tau: float
+    method: str
+    model: str
+    notes: list
+    H_w_profiles: object = None
+
+
+
+
+
+def frequency_response(f, *, strip: Strip | None = None, model="constant", material: Material | None = None,
+                       method="pnp-linear") -> FrequencyResult:
+    """Impedance and tip-deflection/voltage transfer function about zero volts.
+
+    Parameters
+    ----------
+    f : array_like
+        Frequencies (Hz), > 0.
+    strip : Strip, optional ; model : str or Permittivity ; material : Material, optional
+    method : {"pnp-linear", "circuit"}
+        ``pnp-linear``: exact closed form of the linearised Nernst-Planck/Gauss equations
+        (constant core permittivity: at 0 V every affine model linearises about ``eps_core``);
+        ``circuit``: ``R + 1/(i omega C_d(0))`` and ``H_w(0)/(1 + i omega tau)``.
+
+    Returns
+    -------
+    FrequencyResult
+    """
+    check_choice("method", method, FREQ_METHODS)
+    s = Strip() if strip is None else strip
+    m = NAFION_LI if material is None else material
+    perm = get_model(model)
+    if perm.is_custom:
+        raise ValueError("frequency_response needs an affine permittivity (constant, linear, affine)")
+    f = np.asarray(f, dtype=float)
+    if not np.all(np.isfinite(f)) or np.any(f <= 0):
+        raise ValueError("frequencies must be finite and > 0 Hz")
+    e = s.e
+    lam = float(debye_length(s.thickness, perm.eps_moy, m))
+    kappa = m.phi4 * m.F**2 * m.D * m.C_moy / (m.R * m.T)
+    A3 = -m.rho2 * m.Z3 / (m.C_moy * m.F)
+    omega = 2.0 * math.pi * f
+    tau = float(time_constant(s.thickness, perm, m))
+    # tip deflection per volt, small displacements: w = -M L^2/(2 E I_p),
+    # M per volt = 6 l e^2 C_moy F (1 + A3) * (moment transfer)
+    k_w = -s.length**2 / (2.0 * m.E * s.I_p) * 6.0 * s.l * e * e * m.C_moy * m.F * (1.0 + A3)
+    R = float(core_resistance(s.thickness, m))
+    # DC transfer: the static moment slope at 0 V, I(0+) = (1 + A3)(lam coth(1/lam) - lam^2)
+    h0 = k_w * float(GC.moment_transfer_hat(np.array([1e-12]), lam)[0].real)
+    if method == "pnp-linear":
+        W = omega * e * e / m.D
+        Za = (e / kappa) * GC.impedance_hat(W, lam)
+        Hprof = k_w * GC.moment_transfer_hat(W, lam)
+    else:
+        C0 = 0.5 * capacitance_scale(perm, m)
+        Za = R + 1.0 / (1j * omega * C0)
+        Hprof = None
+    # the layers' moment follows their charge: u = V(sigma) = sigma/C_d(0) = J/(i omega C_d(0))
+    Hw = h0 / (1j * omega * 0.5 * capacitance_scale(perm, m) * Za)
+    area = s.width * s.length
+    notes = list(DYNAMIC_NOTES)
+    if Hprof is not None:
+        notes.append("H_w_profiles: the moment of the linearised profiles, p' = (C + A3) E, which adds the pressure "
+                     "gradient of the ohmic core field (-> (1 + A3)/3 per unit psi0 at high frequency, ~1/(3 lambda) "
+                     "times the static slope); with the solvent at rest nothing relaxes it -- water flow would")
+    return FrequencyResult(f=f, Z=Za / area, Z_area=Za, H_w=Hw, w_amp=np.abs(Hw), w_phase=np.angle(Hw), tau=tau,
+                           method=method, model=perm.name, notes=notes, H_w_profiles=Hprof)

@@ -1,0 +1,330 @@
+"""Static electrode charge and differential capacitance at every fidelity (issue 11).
+
+Gauss's law with blocking electrodes (seed paper section 4): the face ``z = -e`` (where
+``phi0`` is applied) carries the surface charge ``sigma = D_z(-e)`` per unit area, the face
+``z = +e`` carries ``-sigma`` (``D_z(e) = D_z(-e)`` by electroneutrality).  Derived in
+``derivations/charge.py`` (generated into :mod:`ipmc_asym.kernels._generated_charge`):
+
+* ``sigma = S Dhat(ln B1)`` with ``S = sqrt(phi4 C_moy eps_core R T)`` (C/m^2), exactly up to the
+  exponentially small core interaction: the lambda-expansion of the face induction stops at
+  first order, so ``leading`` and ``corrected`` give the same closed form;
+* ``C_d = dsigma/dphi0 = (eps_core/lambda_D) chat_c chat_a/(chat_c + chat_a)``: the two layer
+  capacitances ``chat = exprel(Y) w(Y)`` in series (analytic derivative);
+  ``C_d(0) = eps_core/(2 lambda_D)`` (Debye-Hueckel);
+* ``Q = sigma 2l L`` and the apparent permittivity ``eps_app = C_d 2e`` that a capacitance
+  measurement on the strip (parallel-plate reading) would report.
+
+Fidelities: ``leading``/``corrected`` (closed form), ``quadrature`` (``sigma`` as the layer
+integral ``int_0^{Yc} chat dy`` by Gauss-Legendre panels, generic-rho kernels), ``bvp`` (face
+value of ``D`` from the full BVP; ``C_d`` by a central difference of two BVP solves with a
+Richardson error estimate).  Thickness is the TOTAL ``2e``; SI throughout.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ipmc_asym.kernels.jit import jit, jit_parallel, prange
+from ipmc_asym.kernels import _generated as G
+from ipmc_asym.kernels import _generated_charge as GC
+from ipmc_asym.kernels.special import gauss_legendre
+from ipmc_asym.model.params import NAFION_LI, Material, Strip, check_positive
+from ipmc_asym.model.permittivity import MODELS, Permittivity, get_model
+from ipmc_asym.base.registry import MODELS as _MODEL_SPECS
+from ipmc_asym.base.registry import check_choice, fidelity_names
+from ipmc_asym.base.settings import BVP_STATED_ERROR, VALIDITY_LIMIT
+
+__all__ = ["ChargeResult", "charge", "layer_voltage", "core_resistance", "time_constant", "charge_scale", "capacitance_scale", "charge_hat_point",
+           "CLOSED_TRUNCATION"]
+
+#: rounding of the closed forms (B1, Dhat, chat are cancellation-free): relative
+CLOSED_TRUNCATION = 1e-13
+_GL_X, _GL_W, _ = gauss_legendre(20)
+_GL_X = np.ascontiguousarray(_GL_X)
+_GL_W = np.ascontiguousarray(_GL_W)
+
+
+@dataclass
+class ChargeResult:
+    """Static electrode charge and capacitance; arrays broadcast from the inputs (SI).
+
+    Attributes
+    ----------
+    sigma : ndarray   surface charge of the face z = -e (where phi0 is applied), C/m^2; odd in phi0
+    Q : ndarray       total charge of that electrode ``sigma * width * length`` (C)
+    C_diff : ndarray  differential capacitance per area ``dsigma/dphi0``, F/m^2
+    eps_app : ndarray apparent permittivity ``C_diff * thickness`` (TOTAL 2e), F/m
+    error : ndarray   relative error estimate of ``sigma`` (and of ``Q``)
+    error_C_diff : ndarray  relative error estimate of ``C_diff`` (and of ``eps_app``)
+    core : ndarray    neutral core left between the layers (units of e)
+    valid : ndarray of bool  both error estimates below ``VALIDITY_LIMIT`` and a neutral core
+    fidelity, model : str
+    """
+
+    sigma: np.ndarray
+    Q: np.ndarray
+    C_diff: np.ndarray
+    eps_app: np.ndarray
+    error: np.ndarray
+    error_C_diff: np.ndarray
+    core: np.ndarray
+    valid: np.ndarray
+    fidelity: str
+    model: str
+
+
+def charge_scale(perm: Permittivity, material: Material) -> float:
+    """``S = sqrt(phi4 C_moy eps_core R T)`` (C/m^2): ``sigma = S Dhat`` (derivations/charge.py)."""
+    m = material
+    return math.sqrt(m.phi4 * m.C_moy * perm.eps_moy * m.R * m.T)
+
+
+def capacitance_scale(perm: Permittivity, material: Material) -> float:
+    """``S F/(R T) = eps_core/lambda_D`` (F/m^2): ``C_d = that * Cdhat``."""
+    return charge_scale(perm, material) * material.F / (material.R * material.T)
+
+
+@jit
+def _b1(A2, rho, model_id):
+    if model_id < 0:
+        return G.b1_exact(A2, rho)
+    em1 = math.expm1(-A2)
+    if model_id == 0:
+        return G.b1_constant(A2, em1)
+    if model_id == 1:
+        return G.b1_linear(A2, em1)
+    return G.b1_affine(A2, em1)
+
+
+@jit
+def _chat(y, rho, model_id):
+    if model_id == 0:
+        return GC.layer_capacitance_constant(y)
+    if model_id == 1:
+        return GC.layer_capacitance_linear(y)
+    if model_id == 2:
+        return GC.layer_capacitance_affine(y)
+    return GC.layer_capacitance(y, rho)
+
+
+@jit
+def _dhat(Y, rho, model_id):
+    if model_id == 0:
+        return G.dhat_constant(Y)
+    if model_id == 1:
+        return abs(math.expm1(Y))
+    if model_id == 2:
+        return G.dhat_affine(Y)
+    return G.dhat(Y, rho)
+
+
+@jit
+def _layer_integral(Yc, rho, X, Wt):
+    """``int_0^Yc chat(y) dy`` (generic rho) on panels with breakpoints 0, 1/2, 1, 2, 4, ..."""
+    if Yc == 0.0:
+        return 0.0
+    sgn = 1.0 if Yc > 0.0 else -1.0
+    T = abs(Yc)
+    total = 0.0
+    a = 0.0
+    b = min(0.5, T)
+    while True:
+        hm = 0.5 * (b - a)
+        xm = 0.5 * (a + b)
+        s = 0.0
+        for j in range(X.shape[0]):
+            s += Wt[j] * GC.layer_capacitance(sgn * (xm + hm * X[j]), rho)
+        total += hm * s
+        if b >= T:
+            break
+        a = b
+        b = min(2.0 * b, T)
+    return total
+
+
+@jit
+def charge_hat_point(A2, rho, model_id, quad, X, Wt):
+    """``(sigma_hat, Cd_hat, Ya)`` at ``A2 = F|phi0|/(R T) >= 0``.
+
+    ``sigma = S sigma_hat``, ``C_d = (S F/R T) Cd_hat``; ``model_id`` 0/1/2 the paper's
+    models (per-model kernels), -1 any ``rho`` (generic kernels).  ``quad`` = 1: ``sigma_hat``
+    by Gauss-Legendre of the layer capacitance instead of the closed form ``Dhat``.
+    """
+    if A2 == 0.0:  # no field: sigma = 0, two layers of chat(0) = 1 in series
+        return 0.0, 0.5, 0.0
+    if quad == 1:
+        B1 = G.b1_exact(A2, rho)
+    else:
+        B1 = _b1(A2, rho, model_id)
+    Yc = math.log(B1)
+    Ya = Yc - A2
+    mid = -1 if quad == 1 else model_id
+    if quad == 1:
+        sh = _layer_integral(Yc, rho, X, Wt)
+    else:
+        sh = _dhat(Yc, rho, mid)
+    cd = GC.series_capacitance(_chat(Yc, rho, mid), _chat(Ya, rho, mid))
+    return sh, cd, Ya
+
+
+@jit
+def _core_and_error(Ya, lam, rho):
+    """Neutral core (units of e) and the core-interaction error ~4 exp(-core/lam).
+
+    Same width estimate as the moment's closed forms (kernels/closed.py): depletion zone
+    ``lam sqrt(2 rho (|Ya| - 1))`` plus ~10 Debye lengths of exponential tail per layer.
+    """
+    dep = lam * math.sqrt(2.0 * rho * max(-Ya - 1.0, 0.0))
+    core = 2.0 - dep - 20.0 * lam
+    xx = max(core, 0.0) / lam
+    return core, (4.0 * math.exp(-xx) if xx < 700.0 else 0.0)
+
+
+@jit_parallel
+def _sweep(A2, lam, rho, model_id, quad, X, Wt, sh, cd, err, core):
+    for i in prange(A2.size):
+        s, c, Ya = charge_hat_point(A2[i], rho, model_id, quad, X, Wt)
+        co, ce = _core_and_error(Ya, lam[i], rho)
+        sh[i] = s
+        cd[i] = c
+        err[i] = CLOSED_TRUNCATION + ce
+        core[i] = co
+
+
+
+def _model_id(perm: Permittivity, fidelity: str) -> int:
+    if fidelity == "quadrature":
+        return -1
+    paper = MODELS.get(perm.name)
+    if paper is not None and (perm.eps0, perm.deps) == (paper.eps0, paper.deps):
+        return _MODEL_SPECS[perm.name].id
+    return -1  # the charge closed forms hold for any rho (generic kernels)
+
+
+def charge(thickness, voltage, model="constant", fidelity="corrected", *, width=5.0e-3, length=0.02,
+           material: Material | None = None) -> ChargeResult:
+    """Electrode charge ``sigma``, ``Q``, differential capacitance and apparent permittivity.
+
+    Parameters
+    ----------
+    thickness : float or array_like
+        TOTAL thickness ``2e`` (m), > 0.
+    voltage : float or array_like
+        ``phi0`` (V), any sign (``sigma`` is odd, ``C_diff`` even); broadcast with ``thickness``.
+    model : {"constant", "linear", "affine"}, Permittivity or callable
+        A callable ``eps(C)`` needs ``fidelity="bvp"``.
+    fidelity : {"leading", "corrected", "quadrature", "bvp"}
+    width, length : float
+        TOTAL width ``2l`` and length ``L`` (m), for ``Q = sigma 2l L``.
+    material : Material, optional (default ``nafion-li``)
+
+    Returns
+    -------
+    ChargeResult
+        Arrays of the broadcast shape (0-d for scalar inputs), SI.
+    """
+    check_choice("fidelity", fidelity, fidelity_names())
+    perm = get_model(model)
+    mat = NAFION_LI if material is None else material
+    w = check_positive("width (total, 2l)", width, "m")
+    L = check_positive("length", length, "m")
+    th = np.asarray(thickness, dtype=float)
+    v = np.asarray(voltage, dtype=float)
+    if not np.all(np.isfinite(th)) or np.any(th <= 0):
+        raise ValueError("thickness (total, 2e) must be finite and > 0 m")
+    if not np.all(np.isfinite(v)):
+        raise ValueError("voltage must be finite (volts)")
+    th, v = np.broadcast_arrays(th, v)
+    if perm.is_custom and fidelity != "bvp":
+        raise ValueError(f"a custom eps(C) needs fidelity 'bvp'; got fidelity {fidelity!r}")
+    if fidelity == "bvp":
+        sig, cdv, err, errc, core = _bvp(th, v, perm, mat)
+    else:
+        from ipmc_asym.model.params import debye_length
+
+        A2 = (mat.F * np.abs(v) / (mat.R * mat.T)).reshape(-1)
+        lam = np.asarray(debye_length(th, perm.eps_moy, mat), dtype=float).reshape(-1)
+        rho = perm.eps0 / perm.eps_moy
+        outs = [np.empty(A2.size) for _ in range(4)]
+        _sweep(np.ascontiguousarray(A2), np.ascontiguousarray(lam), rho, _model_id(perm, fidelity),
+               1 if fidelity == "quadrature" else 0, _GL_X, _GL_W, *outs)
+        sh, cdh, err, core = (o.reshape(th.shape) for o in outs)
+        sig = np.sign(v) * charge_scale(perm, mat) * sh
+        cdv = capacitance_scale(perm, mat) * cdh
+        errc = err.copy()
+    valid = (err < VALIDITY_LIMIT) & (errc < VALIDITY_LIMIT) & (core > 0)
+    return ChargeResult(sigma=sig, Q=sig * w * L, C_diff=cdv, eps_app=cdv * th, error=err,
+                        error_C_diff=errc, core=core, valid=valid, fidelity=fidelity, model=perm.name)
+
+
+def _bvp_sigma(thickness, voltage, perm, mat):
+    from ipmc_asym.bvp.solver import solve  # deferred: scipy.integrate is heavy (start-up of the closed forms)
+
+    r = solve(Strip(thickness=thickness, voltage=voltage), perm, mat)
+    if not r.success:
+        raise RuntimeError(f"BVP did not converge at thickness={thickness:g} m, voltage={voltage:g} V "
+                           f"({r.message}); try fidelity 'quadrature'")
+    # D_bar = D_z/(e phi4 F C_moy) at the face z = -1 (mirrored for a negative voltage)
+    return 0.5 * thickness * mat.phi4 * mat.F * mat.C_moy * float(r.D[0])
+
+
+def _bvp(th, v, perm, mat):
+    """Point by point: sigma from the BVP face value, C_d by central differences (Richardson)."""
+    sig = np.empty(th.shape)
+    cd = np.empty(th.shape)
+    err = np.full(th.shape, BVP_STATED_ERROR)
+    errc = np.empty(th.shape)
+    core = np.full(th.shape, 2.0)
+    VT = mat.R * mat.T / mat.F
+    for idx in np.ndindex(th.shape):
+        t, u = float(th[idx]), float(v[idx])
+        sig[idx] = _bvp_sigma(t, u, perm, mat)
+        h = 1e-3 * VT * max(1.0, abs(u) / VT) ** 0.5
+        f = {k: _bvp_sigma(t, u + k * h, perm, mat) if k else sig[idx] for k in (-2, -1, 1, 2)}
+        d1 = (f[1] - f[-1]) / (2 * h)
+        d2 = (f[2] - f[-2]) / (4 * h)
+        cd[idx] = (4 * d1 - d2) / 3  # Richardson: O(h^4)
+        if cd[idx] == 0.0:  # below the resolution of the difference quotient: no relative bound
+            errc[idx] = math.inf
+        else:
+            errc[idx] = (abs(d1 - d2) / 3 + 4 * BVP_STATED_ERROR * abs(sig[idx]) / h) / abs(cd[idx])
+    return sig, cd, err, errc, core
+
+
+def layer_voltage(sigma, model="constant", material: Material | None = None):
+    """``V(sigma)``: the static voltage at which the electrode charge is ``sigma`` (C/m^2), vectorised.
+
+    Newton on the closed form from ``V = 0`` (``sigma(V)`` is increasing and concave for
+    ``V > 0``, so the iterates increase monotonically onto the root); odd in ``sigma``.
+    Raises ``ValueError`` where ``|sigma|`` exceeds the saturation charge of the linear model.
+    """
+    perm = get_model(model)
+    mat = NAFION_LI if material is None else material
+    sg = np.asarray(sigma, dtype=float)
+    target = np.abs(sg)
+    if perm.eps0 == 0.0 and np.any(target >= charge_scale(perm, mat)):
+        raise ValueError("sigma must be below the saturation charge S of the linear model")
+    x = np.zeros_like(target)
+    for _ in range(100):
+        r = charge(1.0, x, perm, "corrected", material=mat)
+        dx = (target - r.sigma) / r.C_diff
+        x = x + dx
+        if np.all(np.abs(dx) <= 1e-14 * (1.0 + np.abs(x))):
+            break
+    return np.sign(sg) * x
+
+
+def core_resistance(thickness, material: Material = NAFION_LI):
+    """``R = 2e/kappa`` (Ohm m^2), ``kappa = phi4 F^2 D C_moy/(R T)`` (S/m); thickness TOTAL 2e."""
+    m = material
+    kappa = m.phi4 * m.F**2 * m.D * m.C_moy / (m.R * m.T)
+    return np.asarray(thickness, dtype=float) / kappa
+
+
+def time_constant(thickness, model="constant", material: Material = NAFION_LI):
+    """``tau = R C_d(0) = e lambda_D / D`` (s); thickness TOTAL 2e."""
+    perm = get_model(model)
+    return core_resistance(thickness, material) * 0.5 * capacitance_scale(perm, material)

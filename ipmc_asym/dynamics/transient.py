@@ -1,0 +1,339 @@
+"""Transient Nernst-Planck/Gauss solver across the thickness (the dynamic cross-check, issue 11).
+
+Seed paper eq. "Nernst" with the pressure term neglected (as in §5) and the solvent at rest
+(``V2 = 0``), Gauss's law with ``eps(C)`` (affine models), blocking electrodes, imposed
+``phi0(t)`` on the face ``z = -e`` (``z = +e`` grounded).  Thermal scaling ``psi = F phi/(R T)``,
+``x = z/e``, ``c = C/C_moy``, time ``t D/e^2``, induction ``d = D_z/(e phi4 F C_moy)``::
+
+    dc/dt = -dN/dx,   N = -(dc/dx + c dpsi/dx),   d = -lambda^2 epshat(c) dpsi/dx,   dd/dx = c - 1
+
+Method of lines, finite volumes on a mesh graded into both layers (:func:`make_fv_mesh`):
+cells ``i`` with averages ``c_i``; Scharfetter-Gummel fluxes between cell centres; Gauss's law
+on the dual (centre-to-centre) mesh.  The state is the cumulative charge at the interior
+faces ``S_f = int_{-1}^{X_f} (c - 1) dx`` (``S_0 = S_N = 0``), so ``c_i = 1 + (S_{i+1} - S_i)/h_i``
+and the total charge ``int (c - 1) dx = S_N - S_0`` is zero BY CONSTRUCTION (to rounding);
+``dS_f/dt = -N_f`` (the total current ``J = dd/dt + N`` is uniform and drops out).  The anode
+induction ``d_0`` (= ``sigma/(e phi4 F C_moy)``) follows from the voltage constraint
+``sum_f r_f (d_0 + S_f) = lambda^2 psi0(t)`` with the dual-cell resistances
+``r_f = sum of half cells h/(2 epshat)``.  With constant permittivity this discretisation
+satisfies the discrete energy identity EXACTLY (semi-discrete):
+``psi0 dd_0/dt = dF/dt + sum_f N_f (mu_{f-1} - mu_f)``,
+``F = sum_f r_f d_f^2/(2 lambda^2) + sum_i h_i (c_i ln c_i - c_i + 1)``, ``mu = ln c + psi``;
+the dissipation is integrated as an extra state, so the energy balance of a step closes to
+the integrator's tolerance.
+
+Integrator: SciPy ``solve_ivp`` (BDF by default, or Radau).  The Jacobian is NOT sparse:
+the voltage constraint couples every face through ``d_0`` (banded part plus one rank-one
+term); it is formed by finite differences by SciPy as a dense matrix (a banded sparsity
+pattern would drop the term that carries the current).  With ~500 cells this costs a few
+milliseconds per Jacobian.
+
+Not supported: the linear model (``eps -> 0`` at the anode: ``E ~ e^{A2}`` within ~1e-19 e of
+the face, which no mesh resolves; the static BVP integrates it in ``s = A0 C + A1 ln C``),
+custom ``eps(C)`` callables.  Water transport (Darcy) is outside the model.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ipmc_asym.model.params import NAFION_LI, Material, Strip, check_positive, debye_length
+from ipmc_asym.model.permittivity import Permittivity, get_model
+
+__all__ = ["TransientResult", "make_fv_mesh", "solve_transient", "bernoulli"]
+
+
+def bernoulli(x):
+    """``B(x) = x/(e^x - 1)`` (vectorised, no overflow, ``B(0) = 1``)."""
+    x = np.asarray(x, dtype=float)
+    out = np.empty_like(x)
+    small = np.abs(x) < 1e-4
+    xs = x[small]
+    out[small] = 1.0 - xs / 2.0 + xs * xs / 12.0
+    big = ~small
+    xb = x[big]
+    pos = xb > 0
+    r = np.empty_like(xb)
+    # x > 0: x e^{-x}/(1 - e^{-x}) ; x < 0: x/(e^x - 1) = -x/(-expm1(x))
+    ep = np.exp(-np.where(pos, xb, 0.0))
+    r[pos] = xb[pos] * ep[pos] / (-np.expm1(-xb[pos]))
+    r[~pos] = xb[~pos] / np.expm1(xb[~pos])
+    out[big] = r
+    return out
+
+
+def make_fv_mesh(lam: float, A2max: float, rho: float, *, cells_per_debye: float = 4.0, ratio: float = 1.08,
+                 h_core: float = 0.02) -> np.ndarray:
+    """Faces ``X`` (ascending, ``X[0] = -1``, ``X[-1] = 1``) graded into both electrode layers.
+
+    At each face the first cell is ``lambda/(cells_per_debye sqrt(B1))`` (the local Debye
+    length of the accumulation layer, ``B1 = C/C_moy`` at the cathode for ``A2max``) -- or, for
+    ``rho = eps0/eps_core < 1``, ``lambda sqrt(rho)/cells_per_debye`` over the depletion zone
+    (where ``eps -> eps0``) --, growing
+    by ``1 + (ratio - 1)/2`` to ``lambda/cells_per_debye``, uniform over the depletion zone
+    (``lambda sqrt(2 rho (A2 - 1))``) plus 12 Debye lengths, then growing by ``ratio`` up to
+    ``h_core`` in the neutral core.  Symmetric (either face may be the cathode).
+    """
+    from ipmc_asym.kernels._generated import b1_exact
+
+    b1 = float(b1_exact(A2max, rho)) if A2max > 0 else 1.0
+    h1 = lam / cells_per_debye
+    r_layer = 1.0 + 0.5 * (ratio - 1.0)
+    hs = []
+    if rho < 1.0:
+        # eps -> eps0 in the depletion zone: local Debye length lambda sqrt(rho) over its width
+        hd = lam * math.sqrt(rho) / cells_per_debye
+        wd = lam * (math.sqrt(2.0 * rho * max(A2max - 1.0, 0.0)) + 4.0 * math.sqrt(rho))
+        hs += [hd] * int(math.ceil(wd / hd))
+        h = hd
+    else:
+        h = h1 / math.sqrt(max(b1, 1.0))  # local Debye length of the accumulation layer
+    while h < h1:
+        hs.append(h)
+        h *= r_layer
+    width = lam * (2.0 * math.sqrt(2.0 * rho * max(A2max - 1.0, 0.0)) + 12.0)
+    width = min(width, 0.4)
+    n0 = int(math.ceil(max(width - sum(hs), 0.0) / h1))
+    hs += [h1] * n0
+    h = h1
+    while h < h_core:
+        h = min(h * ratio, h_core)
+        hs.append(h)
+    d = np.concatenate(([0.0], np.cumsum(hs)))
+    if d[-1] >= 1.0:
+        raise ValueError("the electrode layers fill the strip (thickness ~ a few Debye lengths): "
+                         "the transient solver needs a neutral core; use a thicker strip")
+    n_core = int(math.ceil((1.0 - d[-1]) / h_core))
+    d = np.concatenate((d, d[-1] + (1.0 - d[-1]) * np.arange(1, n_core + 1) / n_core))
+    left = -1.0 + d
+    right = 1.0 - d[::-1]
+    return np.concatenate((left[:-1], right))
+
+
+@dataclass
+class TransientResult:
+    """Output of :func:`solve_transient` on the requested times (SI unless stated).
+
+    Attributes
+    ----------
+    t : ndarray (n,) s
+    sigma : ndarray (n,)  charge of the face z = -e, C/m^2
+    current_density : ndarray (n,)  dsigma/dt, A/m^2
+    layer_voltage : ndarray (n,)  V(sigma) (V): the static voltage of the layers carrying sigma
+    M_A_profiles : ndarray (n,)  moment from the transient profiles, ``p' = (C + A3) E`` (N m),
+        which includes the pressure gradient of the ohmic core field (see notes)
+    total_charge : ndarray (n,)  ``int (c - 1) dx`` (dimensionless; 0 by construction)
+    c : ndarray (n, cells)  concentration profiles ``C/C_moy``; x : ndarray (cells,) centres ``z/e``;
+    faces : ndarray (cells + 1,)  cell faces ``z/e``
+    success : bool ; message : str ; extra : dict (mesh, energy balance, nfev, njev)
+    """
+
+    t: np.ndarray
+    sigma: np.ndarray
+    current_density: np.ndarray
+    layer_voltage: np.ndarray
+    M_A_profiles: np.ndarray
+    total_charge: np.ndarray
+    c: np.ndarray
+    x: np.ndarray
+    faces: np.ndarray
+    success: bool
+    message: str
+    extra: dict = field(default_factory=dict)
+
+
+class _Problem:
+    def __init__(self, X, lam, rho, psi0_fun, A3):
+        self.X = X
+        self.h = np.diff(X)
+        self.N = self.h.size
+        self.xc = 0.5 * (X[1:] + X[:-1])
+        self.delta = np.diff(self.xc)  # centre-to-centre, interior faces 1..N-1
+        self.lam2 = lam * lam
+        self.rho = rho
+        self.psi0 = psi0_fun
+        self.A3 = A3
+
+    def unpack(self, S):
+        Sf = np.zeros(self.N + 1)
+        Sf[1:-1] = S
+        c = 1.0 + np.diff(Sf) / self.h
+        return Sf, c
+
+    def fields(self, S, t):
+        """(c, d at faces, r_f, dpsi at faces, psi at centres)."""
+        Sf, c = self.unpack(S)
+        eh = self.rho + (1.0 - self.rho) * c
+        half = 0.5 * self.h / eh
+        r = np.empty(self.N + 1)
+        r[0] = half[0]
+        r[-1] = half[-1]
+        r[1:-1] = half[:-1] + half[1:]
+        d0 = (self.lam2 * self.psi0(t) - np.dot(r, Sf)) / np.sum(r)
+        d = d0 + Sf
+        dpsi = -r * d / self.lam2  # psi jump across each dual cell (f = 0: centre 0 - applied)
+        psi = self.psi0(t) + np.cumsum(dpsi[:-1])  # cell centres
+        return c, d, r, dpsi, psi
+
+    def flux(self, c, dpsi):
+        """SG flux at the interior faces 1..N-1."""
+        dp = dpsi[1:-1]
+        return (c[:-1] * bernoulli(dp) - c[1:] * bernoulli(-dp)) / self.delta
+
+    def rhs(self, t, y, with_diss):
+        S = y[: self.N - 1]
+        c, d, r, dpsi, psi = self.fields(S, t)
+        Nf = self.flux(c, dpsi)
+        if not with_diss:
+            return -Nf
+        mu = np.log(np.maximum(c, 1e-300)) + psi
+        diss = float(np.dot(Nf, mu[:-1] - mu[1:]))
+        return np.concatenate((-Nf, [diss]))
+
+
+def solve_transient(t, phi0_fun, strip: Strip, model="constant", material: Material = NAFION_LI, *,
+                    cells_per_debye: float = 4.0, ratio: float = 1.08, h_core: float = 0.02, refine: float = 1.0,
+                    rtol: float = 1e-8, atol: float = 1e-12, method: str = "BDF", energy: bool = False,
+                    profiles: bool = False, moment: bool = True) -> TransientResult:
+    """Integrate the transient Nernst-Planck/Gauss problem from the uncharged state at ``t = 0``.
+
+    Parameters
+    ----------
+    t : array_like (n,)
+        Output times (s), increasing, ``t[0] >= 0``.
+    phi0_fun : callable
+        ``phi0(t)`` in volts, vectorised (see :func:`ipmc_asym.dynamics.circuit.waveform`).
+    strip : Strip ; model : "constant" / "affine" or Permittivity ; material : Material
+    cells_per_debye, ratio, h_core : float
+        Mesh (:func:`make_fv_mesh`); the layer zone is sized for ``max |phi0|`` on ``t``.
+    refine : float
+        Refines the whole mesh: ``cells_per_debye * refine``, ``(ratio - 1)/refine``,
+        ``h_core/refine`` (self-convergence studies).
+    rtol, atol : float
+        solve_ivp tolerances (``atol`` on ``S``, in units of ``e``).
+    method : {"BDF", "Radau"}
+    energy : bool
+        Integrate the dissipation and return the energy balance in ``extra["energy"]``
+        (meaningful for constant permittivity: ``eps(C)`` adds an exchange term).
+    profiles : bool
+        Keep ``c`` at every output time.
+    moment : bool
+        Compute ``layer_voltage`` = V(sigma) (closed-form inversion); the profile moment is always computed.
+
+    Returns
+    -------
+    TransientResult
+    """
+    from scipy.integrate import solve_ivp  # deferred: heavy import (start-up)
+
+    perm: Permittivity = get_model(model)
+    m = material
+    if perm.is_custom:
+        raise ValueError("the transient solver needs an affine permittivity (constant or affine)")
+    if perm.eps0 == 0.0:
+        raise ValueError("model 'linear' (eps0 = 0) is not supported by the transient solver: E ~ e^{A2} "
+                         "at the anode face is not resolvable by finite volumes; use fidelity 'circuit'")
+    if method not in ("BDF", "Radau"):
+        raise ValueError(f"method must be BDF or Radau; got {method!r}")
+    check_positive("cells_per_debye", cells_per_debye)
+    tt = np.asarray(t, dtype=float).reshape(-1)
+    VT = m.R * m.T / m.F
+    e = strip.e
+    tscale = e * e / m.D
+    lam = float(debye_length(strip.thickness, perm.eps_moy, m))
+    rho = perm.eps0 / perm.eps_moy
+    A2max = float(np.max(np.abs(phi0_fun(np.linspace(tt[0], tt[-1], 2001))))) / VT
+    check_positive("refine", refine)
+    X = make_fv_mesh(lam, A2max, rho, cells_per_debye=cells_per_debye * refine, ratio=1.0 + (ratio - 1.0) / refine,
+                     h_core=h_core / refine)
+    A3 = -m.rho2 * m.Z3 / (m.C_moy * m.F)
+
+    def psi0(th):
+        return float(phi0_fun(np.array([th * tscale]))[0]) / VT
+
+    P = _Problem(X, lam, rho, psi0, A3)
+    n = P.N - 1 + (1 if energy else 0)
+    y0 = np.zeros(n)
+    t0 = time.perf_counter()
+    # one BLAS thread: the dense LU factorisations (~500^2) are 5-10x slower when OpenBLAS
+    # threads compete for the cores
+    from threadpoolctl import threadpool_limits  # deferred: only the transient solver needs it
+
+    with threadpool_limits(1):
+        sol = solve_ivp(lambda th, y: P.rhs(th, y, energy), (0.0, tt[-1] / tscale), y0, method=method,
+                        t_eval=tt / tscale, rtol=rtol, atol=atol, dense_output=False)
+    secs = time.perf_counter() - t0
+    if not sol.success or sol.y.shape[1] != tt.size:
+        return TransientResult(t=tt, sigma=np.full(tt.size, np.nan), current_density=np.full(tt.size, np.nan),
+                               layer_voltage=np.full(tt.size, np.nan),
+                               M_A_profiles=np.full(tt.size, np.nan), total_charge=np.full(tt.size, np.nan),
+                               c=np.empty((0, P.N)), x=P.xc, faces=P.X, success=False, message=str(sol.message),
+                               extra={"cells": P.N, "seconds": secs})
+    sig_scale = e * m.phi4 * m.F * m.C_moy
+    nt = tt.size
+    d0 = np.empty(nt)
+    J = np.empty(nt)
+    qtot = np.empty(nt)
+    Mprof = np.empty(nt)
+    Fe = np.empty(nt)
+    cs = np.empty((nt, P.N)) if profiles else np.empty((0, P.N))
+    for k in range(nt):
+        S = sol.y[: P.N - 1, k]
+        th = sol.t[k]
+        c, d, r, dpsi, psi = P.fields(S, th)
+        d0[k] = d[0]
+        qtot[k] = float(np.dot(c - 1.0, P.h))
+        Nf = P.flux(c, dpsi)
+        # dd0/dt from the constraint: sum r_f (d0 + S_f) = lam^2 psi0(t)
+        Sdot = np.zeros(P.N + 1)
+        Sdot[1:-1] = -Nf
+        Nfull = np.zeros(P.N + 1)
+        Nfull[1:-1] = Nf
+        cdot = -np.diff(Nfull) / P.h
+        eh = rho + (1.0 - rho) * c
+        hdot = -0.5 * P.h * (1.0 - rho) * cdot / (eh * eh)
+        rdot = np.empty(P.N + 1)
+        rdot[0], rdot[-1] = hdot[0], hdot[-1]
+        rdot[1:-1] = hdot[:-1] + hdot[1:]
+        dt = 1e-7 * max(th, 1e-3)
+        dpsi0 = (psi0(th + dt) - psi0(max(th - dt, 0.0))) / (th + dt - max(th - dt, 0.0)) if th > 0 else 0.0
+        J[k] = (P.lam2 * dpsi0 - np.dot(r, Sdot) - np.dot(rdot, d)) / np.sum(r)
+        # moment from the profiles: (c + A3) * (-dpsi) over the half cells, weight (1 - z^2)/2
+        zl = P.xc - 0.25 * P.h
+        zr = P.xc + 0.25 * P.h
+        drop = 0.5 * P.h / eh / P.lam2  # -dpsi per unit d over a half cell
+        Mprof[k] = float(np.sum((c + A3) * drop * (d[:-1] * 0.75 + d[1:] * 0.25) * (1 - zl * zl) / 2
+                                + (c + A3) * drop * (d[:-1] * 0.25 + d[1:] * 0.75) * (1 - zr * zr) / 2))
+        cpos = np.maximum(c, 1e-300)
+        Fe[k] = float(np.dot(r, d * d) / (2 * P.lam2) + np.dot(P.h, cpos * np.log(cpos) - cpos + 1.0))
+        if profiles:
+            cs[k] = c
+    sigma = sig_scale * d0
+    Jsi = sig_scale * J / tscale
+    from ipmc_asym.dynamics.electrode import layer_voltage
+
+    u = layer_voltage(sigma, perm, m) if moment else np.full(nt, np.nan)
+    Mscale = 6.0 * strip.l * e * e * m.C_moy * m.R * m.T
+    extra = {"cells": P.N, "h_min_over_debye": float(P.h.min() / lam), "nfev": int(sol.nfev),
+             "njev": int(sol.njev), "seconds": secs, "rtol": rtol, "method": method}
+    if energy:
+        diss = sol.y[-1]
+        # supplied after t = 0+ (the ideal step's instantaneous half-loss is not in the model)
+        c0, dd0, r0, _, _ = P.fields(np.zeros(P.N - 1), 0.0)
+        Fe0 = float(np.dot(r0, dd0 * dd0) / (2 * P.lam2))
+        psi_end = psi0(sol.t[-1])
+        supplied = psi_end * (d0[-1] - dd0[0])
+        stored = Fe[-1] - Fe0
+        dissipated = float(diss[-1])
+        extra["energy"] = {"supplied": supplied, "stored": stored, "dissipated": dissipated,
+                           "relative_residual": abs(supplied - stored - dissipated) / abs(supplied),
+                           "unit": "e phi4 C_moy R T per unit area (J/m^2)",
+                           "scale_J_per_m2": e * m.phi4 * m.C_moy * m.R * m.T}
+    res = TransientResult(t=tt, sigma=sigma, current_density=Jsi, layer_voltage=u,
+                          M_A_profiles=Mscale * Mprof, total_charge=qtot, c=cs, x=P.xc, faces=P.X, success=True,
+                          message=str(sol.message), extra=extra)
+    return res

@@ -1,0 +1,211 @@
+"""Labelled results: xarray Datasets of sweeps and UQ runs, written atomically to NetCDF.
+
+Coordinates are the varied parameters, data variables the outputs, each with ``units`` and
+``long_name`` (thickness: "total thickness 2e"); the strip, material, model, fidelity and
+package version are attributes (dicts as JSON strings: NetCDF attributes are flat).
+
+NetCDF engine: the first importable of ``netCDF4``, ``h5netcdf``, ``scipy`` (NetCDF-3,
+always present with SciPy, a core dependency); the ``netcdf`` extra installs ``netCDF4``
+for NetCDF-4 files.  :func:`write_netcdf` writes a temporary file beside the target and
+renames it on success (:func:`ipmc_asym.io.fileio.atomic_path`): Ctrl-C leaves no partial file.
+
+Layer rule: stdlib + numpy at import; xarray deferred (heavy import, start-up).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import importlib.util
+import json
+
+import numpy as np
+
+from ipmc_asym.io.fileio import atomic_path, check_output_path
+
+__all__ = ["VARIABLES", "sweep_dataset", "uq_dataset", "netcdf_engine", "available_engines", "write_netcdf"]
+
+#: name -> (units, long_name) of every coordinate and output the builders know
+VARIABLES = {
+    "length": ("m", "strip length L"),
+    "width": ("m", "total width 2l"),
+    "thickness": ("m", "total thickness 2e"),
+    "voltage": ("V", "voltage phi0 (sign = bending direction)"),
+    "modulus": ("Pa", "Young's modulus E"),
+    "c_moy": ("mol/m^3", "mean cation concentration C_moy"),
+    "I": ("1", "moment integral I (dimensionless)"),
+    "M_A": ("N m", "bending moment M_A"),
+    "moment": ("N m", "bending moment M_A"),
+    "theta": ("rad", "free-end rotation theta"),
+    "rotation": ("rad", "free-end rotation theta"),
+    "w": ("m", "tip deflection w (large displacement)"),
+    "tip_deflection": ("m", "tip deflection w (large displacement)"),
+    "w_small": ("m", "tip deflection w_p (small displacement)"),
+    "F_block": ("N", "blocking force (large displacement)"),
+    "blocking_force": ("N", "blocking force F"),
+    "F_block_small": ("N", "blocking force 3 M_A/(2 L) (small displacement)"),
+    "B1": ("1", "cathode concentration C(e)/C_moy"),
+    "error": ("1", "relative error estimate of I"),
+    "valid": ("1", "fidelity within its validity (1) or not (0)"),
+    "regime": ("", "beam regime (small, large, past-quarter-turn, multi-turn)"),
+    "max_strain": ("1", "largest bending strain e|kappa|"),
+    "fidelity_used": ("", "fidelity the point was computed at (after escalation)"),
+    "escalated": ("1", "escalated above the requested fidelity (1) or not (0)"),
+    "check_electrochemistry": ("1", "check: a valid rung of the fidelity ladder (1) or none (0)"),
+    "check_layer_separation": ("1", "check: electrode layers separated by a neutral core"),
+    "check_beam_regime": ("1", "check: free strip within a quarter turn"),
+    "check_strain": ("1", "check: bending strain within the small-strain limit"),
+}
+_SWEEP_OUT = ("I", "M_A", "theta", "w", "w_small", "F_block", "F_block_small", "B1", "error", "max_strain",
+              "fidelity_used", "escalated", "regime", "check_electrochemistry", "check_layer_separation",
+              "check_beam_regime", "check_strain", "valid")
+
+
+def _label(da, name):
+    u, ln = VARIABLES.get(name, ("", name))
+    da.attrs.update(units=u, long_name=ln)
+    return da
+
+
+def _common_attrs(model, fidelity, strip=None, material=None, extra=None) -> dict:
+    from ipmc_asym import __version__
+
+    def js(o):
+        if o is None:
+            return "null"
+        if dataclasses.is_dataclass(o):
+            d = dataclasses.asdict(o)
+            if hasattr(o, "C_moy"):
+                d["C_moy_value"] = o.C_moy
+            return json.dumps(d, default=str)
+        return json.dumps(o, default=str)
+
+    a = {"model": str(model), "fidelity": str(fidelity), "package": "ipmc_asym",
+         "package_version": __version__, "strip": js(strip), "material": js(material),
+         "thickness_convention": "thickness is the TOTAL thickness 2e; width the TOTAL width 2l"}
+    for k, v in (extra or {}).items():
+        a[k] = v if isinstance(v, (int, float, str)) else js(v)
+    return a
+
+
+def sweep_dataset(arr: np.ndarray, vary: dict, *, base=None, material=None):
+    """Dataset of a sweep (:func:`ipmc_asym.studies.sweeps.sweep` rows) on its grid.
+
+    Parameters
+    ----------
+    arr : structured ndarray
+        Rows model-major, then the grid of ``vary`` in C order (first key slowest).
+    vary : dict
+        name -> 1-D values (SI), the axes of the grid, in the order of the sweep.
+    base, material : Strip, Material (attributes)
+
+    Returns
+    -------
+    xarray.Dataset
+        Dims ``model`` and the varied names; coordinates labelled; outputs as data variables.
+    """
+    import xarray as xr  # deferred: heavy import (start-up)
+
+    names = list(vary)
+    axes = [np.atleast_1d(np.asarray(vary[k], float)) for k in names]
+    shape = tuple(a.size for a in axes)
+    models = list(dict.fromkeys(arr["model"].tolist()))
+    npts = int(np.prod(shape)) if shape else 1
+    if arr.size != npts * len(models):
+        raise ValueError(f"sweep_dataset: {arr.size} rows do not fill {len(models)} model(s) x grid {shape}")
+    fids = sorted(set(arr["fidelity"].tolist()))
+    coords = {"model": ("model", np.array(models))}
+    for k, a in zip(names, axes):
+        coords[k] = _label(xr.DataArray(a, dims=(k,)), k)
+    dv = {}
+    for k in _SWEEP_OUT:
+        if k not in arr.dtype.names:
+            continue
+        col = arr[k]
+        if col.dtype == bool:
+            col = col.astype(np.int8)
+        dv[k] = _label(xr.DataArray(col.reshape((len(models),) + shape), dims=("model",) + tuple(names)), k)
+    fixed = [k for k in ("length", "width", "thickness", "voltage", "modulus") if k not in names]
+    for k in fixed:  # constant inputs: scalar variables with units
+        dv[k] = _label(xr.DataArray(float(arr[k][0])), k)
+    ds = xr.Dataset(dv, coords=coords)
+    ds.attrs.update(_common_attrs(",".join(models), ",".join(fids), base, material,
+                                  {"kind": "sweep", "varied": ",".join(names)}))
+    return ds
+
+
+def uq_dataset(result):
+    """Dataset of a :class:`ipmc_asym.studies.uq.UQResult`.
+
+    Dim ``sample``: the uncertain inputs are coordinates along it, the outputs data
+    variables; ``S1``, ``S1_conf``, ``ST``, ``ST_conf`` on (``output``, ``parameter``);
+    ``quantile_value`` on (``output``, ``quantile``); ``mean``, ``sd`` on ``output``.
+    """
+    import xarray as xr  # deferred: heavy import (start-up)
+
+    outs = list(result.outputs)
+    pars = list(result.samples)
+    coords = {k: _label(xr.DataArray(v, dims=("sample",)), k) for k, v in result.samples.items()}
+    coords["output"] = ("output", np.array(outs))
+    coords["parameter"] = ("parameter", np.array(pars))
+    coords["quantile"] = _label(xr.DataArray(np.array([0.025, 0.5, 0.975]), dims=("quantile",)), "quantile")
+    coords["quantile"].attrs.update(units="1", long_name="probability level")
+    dv = {}
+    for o, y in result.outputs.items():
+        dv[o] = _label(xr.DataArray(y, dims=("sample",)), o)
+    for key in ("S1", "S1_conf", "ST", "ST_conf"):
+        a = np.full((len(outs), len(pars)), np.nan)
+        for i, o in enumerate(outs):
+            if result.sobol.get(o):
+                a[i] = [result.sobol[o][p][key] for p in pars]
+        what = "first-order" if key.startswith("S1") else "total"
+        ln = f"Sobol' {what} index" + (" (95 % interval half-width)" if key.endswith("conf") else "")
+        dv[key] = xr.DataArray(a, dims=("output", "parameter"), attrs={"units": "1", "long_name": ln})
+    q = np.array([[result.summary[o][k] for k in ("q2.5", "q50", "q97.5")] for o in outs])
+    dv["quantile_value"] = xr.DataArray(q, dims=("output", "quantile"),
+                                        attrs={"units": "see output_units", "long_name": "quantile of each output"})
+    for k in ("mean", "sd"):
+        dv[k] = xr.DataArray([result.summary[o][k] for o in outs], dims=("output",),
+                             attrs={"units": "see output_units", "long_name": f"{k} of each output"})
+    dv["output_units"] = xr.DataArray(np.array([VARIABLES.get(o, ("", ""))[0] or "1" for o in outs]),
+                                      dims=("output",), attrs={"long_name": "units of each output"})
+    ds = xr.Dataset(dv, coords=coords)
+    ds.attrs.update(_common_attrs(result.model, json.dumps(result.fidelity), None, result.material,
+                                  {"kind": "uq", "scene": result.scene, "tolerance": result.tolerance,
+                                   "n_samples": result.n_samples, "base_n": result.base_n,
+                                   "nominal": result.base,
+                                   "distributions": {k: [d, list(p)] for k, (d, p) in result.inputs.items()}}))
+    return ds
+
+
+#: engine -> modules it needs at write time (h5netcdf is useless without h5py)
+_ENGINES = {"netcdf4": ("netCDF4",), "h5netcdf": ("h5netcdf", "h5py"), "scipy": ("scipy.io",)}
+
+
+def available_engines() -> list:
+    """Engines whose modules all import, in order of preference."""
+    out = []
+    for eng, mods in _ENGINES.items():
+        try:
+            if all(importlib.util.find_spec(m.split(".")[0]) is not None for m in mods):
+                for m in mods:
+                    importlib.import_module(m)
+                out.append(eng)
+        except ImportError:
+            continue
+    return out
+
+
+def netcdf_engine() -> str:
+    """The first working of netCDF4, h5netcdf (+h5py), scipy (NetCDF-3)."""
+    for eng in available_engines():
+        return eng
+    raise ValueError("no NetCDF engine: install netCDF4 (pip install \".[netcdf]\") or h5netcdf")
+
+
+def write_netcdf(ds, path, engine: str | None = None) -> str:
+    """Write ``ds`` to ``path`` atomically (temp file + rename); returns the engine used."""
+    p = check_output_path(path, what="--out")
+    eng = engine or netcdf_engine()
+    with atomic_path(p) as tmp:
+        ds.to_netcdf(tmp, engine=eng)
+    return eng

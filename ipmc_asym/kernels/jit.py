@@ -1,0 +1,159 @@
+"""The one place where Numba compile flags are set (py-pde style).
+
+Kernels are plain module-level functions decorated with :func:`jit` (scalar kernels) or
+:func:`jit_parallel` (sweep drivers that use ``prange``).  Every such function caches its
+compiled code on disk in :data:`CACHE_DIR` (``NUMBA_CACHE_DIR`` if set), through a cache
+object set on the function itself, so that a fresh process loads it instead of compiling and
+no Numba setting of the user's process is changed.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import types
+from pathlib import Path
+
+import numba as nb
+from numba.core import caching
+
+__all__ = ["jit", "jit_parallel", "prange", "CACHE_DIR", "interpreted"]
+
+
+def hashed_sources() -> list:
+    """The modules that define jitted functions (and what they inline: ``settings`` values
+    such as ``EXACT_STATED_ERROR`` are frozen into the compiled sweep driver)."""
+    here = Path(__file__).resolve().parents[1]
+    return sorted([here / "base" / "settings.py", *(here / "kernels").glob("*.py"),
+                   *(here / "integral").glob("*.py"), here / "dynamics" / "electrode.py",
+                   here / "dynamics" / "circuit.py", here / "io" / "textfmt.py"])
+
+
+def _cache_dir() -> str:
+    """Numba's on-disk cache, keyed by a hash of this package's sources.
+
+    Numba invalidates a cached function when ITS file changes, not when a function it
+    calls from another module does (a sweep driver in integral.py inlines the kernels of
+    kernels/*.py).  Keying the whole cache on the sources of every module with jitted code
+    makes any edit or upgrade start from a clean cache.  ``NUMBA_CACHE_DIR``, if set, wins.
+    """
+    if os.environ.get("NUMBA_CACHE_DIR"):
+        return os.environ["NUMBA_CACHE_DIR"]
+    here = Path(__file__).resolve().parents[1]
+    h = hashlib.sha256()
+    for p in hashed_sources():
+        h.update(p.relative_to(here).as_posix().encode())
+        h.update(p.read_bytes())
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return os.path.join(base, "ipmc_asym", f"numba-{nb.__version__}-{h.hexdigest()[:16]}")
+
+
+CACHE_DIR = _cache_dir()
+
+
+class _PackageCacheLocator(caching.UserProvidedCacheLocator):
+    """Numba's user-directory locator, pointed at :data:`CACHE_DIR` for this package's
+    functions only: ``numba.config.CACHE_DIR`` (every other library's cache in the user's
+    process) is left as it is."""
+
+    def __init__(self, py_func, py_file):
+        super().__init__(py_func, py_file)
+        self._cache_path = os.path.join(CACHE_DIR, self.get_suitable_cache_subpath(py_file))
+
+    @classmethod
+    def from_function(cls, py_func, py_file):
+        # skip UserProvidedCacheLocator's test of numba.config.CACHE_DIR: ours is always set
+        return super(caching.UserProvidedCacheLocator, cls).from_function(py_func, py_file)
+
+
+class _PackageCacheImpl(caching.CompileResultCacheImpl):
+    _locator_classes = [_PackageCacheLocator]
+
+
+class _PackageFunctionCache(caching.FunctionCache):
+    _impl_class = _PackageCacheImpl
+
+
+def _cached(dispatcher):
+    """``dispatcher`` with its on-disk cache in :data:`CACHE_DIR` (set per function)."""
+    dispatcher._cache = _PackageFunctionCache(dispatcher.py_func)
+    return dispatcher
+
+prange = nb.prange
+
+_FLAGS = dict(nopython=True, fastmath=False, nogil=True, error_model="numpy")
+
+
+def jit(func=None, **kw):
+    """``numba.njit`` with the project's flags (serial kernels)."""
+    opts = {**_FLAGS, **kw}
+    if func is None:
+        return lambda f: _cached(nb.jit(f, **opts))
+    return _cached(nb.jit(func, **opts))
+
+
+def jit_parallel(func=None, **kw):
+    """``numba.njit(parallel=True)`` with the project's flags: only for ``prange`` drivers."""
+    opts = {**_FLAGS, "parallel": True, **kw}
+    if func is None:
+        return lambda f: _cached(nb.jit(f, **opts))
+    return _cached(nb.jit(func, **opts))
+
+
+# --------------------------------------------------------------------------------------
+# Interpreted twins: the same source run by the Python interpreter
+# --------------------------------------------------------------------------------------
+#: twin of each jitted function (by id of its Python function) and twin globals of each module
+_TWINS: dict = {}
+_TWIN_GLOBALS: dict = {}
+_PACKAGE = __name__.rsplit(".", 1)[0] + "."
+
+
+def _is_jitted(obj) -> bool:
+    return isinstance(obj, nb.core.dispatcher.Dispatcher)
+
+
+class _TwinModule:
+    """A module of this package seen from a twin: its jitted attributes are twins too."""
+
+    def __init__(self, module):
+        self._module = module
+
+    def __getattr__(self, name):
+        value = getattr(self._module, name)
+        return interpreted(value) if _is_jitted(value) else value
+
+
+def _fill_twin_globals(g: dict) -> None:
+    """Replace, in a module's twin globals ``g``, jitted functions and package modules by twins."""
+    for k, v in list(g.items()):
+        if _is_jitted(v):
+            g[k] = interpreted(v)
+        elif isinstance(v, types.ModuleType) and v.__name__.startswith(_PACKAGE):
+            g[k] = _TwinModule(v)
+
+
+def interpreted(func):
+    """The jitted ``func`` as plain Python: its own source, run by the interpreter, calling
+    the twins of the jitted functions it calls (nothing is compiled or loaded from the cache).
+
+    Why: loading one compiled driver from the cache costs a fresh process ~0.5 s (Numba's
+    typing and target registries, and SciPy's BLAS that Numba's array library imports),
+    ~1000x the interpreted cost of a few closed-form points.  Semantics differ from the
+    compiled code only where that returns inf/NaN without complaint: the interpreter raises
+    (``ZeroDivisionError``, ``OverflowError``, ``ValueError`` from ``math``, or
+    ``FloatingPointError`` under ``np.errstate(all="raise")``), and the caller then uses the
+    compiled function.  Not jitted: ``func`` itself.
+    """
+    if not _is_jitted(func):
+        return func
+    py = func.py_func
+    twin = _TWINS.get(id(py))
+    if twin is None:
+        fresh = id(py.__globals__) not in _TWIN_GLOBALS
+        g = _TWIN_GLOBALS.setdefault(id(py.__globals__), dict(py.__globals__))
+        twin = _TWINS[id(py)] = types.FunctionType(py.__code__, g, py.__name__, py.__defaults__, py.__closure__)
+        twin.__doc__ = py.__doc__
+        if fresh:  # after registering the twin: the module's other functions may call it
+            _fill_twin_globals(g)
+    return twin

@@ -1,0 +1,378 @@
+"""Strip geometry, material data and the dimensionless groups of the model.
+
+Layer rule: this module is the bottom of the stack (parameters -> permittivity ->
+kernels -> layers/BVP -> beam -> sweeps/scenes -> plots/CLI).  It imports numpy only.
+
+Conventions
+-----------
+* SI units everywhere inside the library.
+* ``thickness`` and ``width`` are the TOTAL thickness ``2e`` and TOTAL width ``2l``; the
+  paper's ``e`` and ``l`` are halves and appear here as ``Strip.e`` and ``Strip.l``.
+* The voltage ``phi0`` is the potential of the face ``z = -e`` (anode) relative to the face
+  ``z = +e`` (cathode).  A negative voltage is the mirror image ``z -> -z`` of ``|phi0|``.
+  The dimensionless groups are built on ``|phi0|`` (the scale), so ``A2 >= 0`` and the
+  moment integral ``I`` is odd in ``phi0`` (``M_A = A5 * I`` with ``A5 >= 0``).
+
+Sources of the ``nafion-li`` preset (seed paper section 4): ``Z3 = -9e4 C/kg`` (Collette),
+``rho3 = 2078 kg/m^3`` and ``phi4 = 0.38`` (Nemat-Nasser & Li 2000), ``E = 1.3e8 Pa``
+(Satterfield & Benziger 2009), ``rho2 = 1000 kg/m^3``, ``T = 300 K``, ``F = 96487 C/mol``,
+``R = 8.31 J/(mol K)``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+
+from ipmc_asym.base.units import parse_pressure
+
+__all__ = [
+    "C_MOY_PAPER",
+    "D_CATION_DEFAULT",
+    "D_CATION_SOURCE",
+    "Material",
+    "Strip",
+    "Groups",
+    "NOMINAL_STRIP",
+    "NAFION_LI",
+    "MATERIALS",
+    "check_positive",
+    "check_finite",
+    "make_groups",
+    "moment_scale",
+    "debye_length",
+    "second_moment",
+    "MATERIAL_KEYS",
+    "material_from_spec",
+]
+
+#: Default cation diffusion coefficient (m^2/s) of the ``nafion-li`` preset and its source.
+D_CATION_DEFAULT = 1.0e-10
+D_CATION_SOURCE = (
+    "D = 1e-10 m^2/s: order of the measured self-diffusion coefficients of alkali cations in "
+    "fully hydrated Nafion 117 (radiotracer: A. Goswami et al., J. Phys. Chem. B 105 (2001) "
+    "9196; Li+ taken equal to Na+ within that order) and of the values used in PNP models of "
+    "Nafion IPMCs (S. Nemat-Nasser, J. Y. Li, J. Appl. Phys. 87 (2000) 3321); uncertain by a "
+    "factor ~3 either way: every dynamic time scales as 1/D"
+)
+
+#: The value the paper states (section 4) and uses; the formula with the quoted data gives
+#: about 3162 mol/m^3 (docs/design.md, slip 1).
+C_MOY_PAPER = 3082.0
+
+
+def check_finite(name: str, value, allowed: str = "a finite number") -> float:
+    """Return ``value`` as float or raise a one-line ``ValueError`` naming ``name``."""
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be {allowed}; got {value!r}") from None
+    if not math.isfinite(v):
+        raise ValueError(f"{name} must be {allowed}; got {value!r}")
+    return v
+
+
+def check_positive(name: str, value, unit: str = "") -> float:
+    """Finite and strictly positive, else ``ValueError`` naming the parameter and range."""
+    u = f" {unit}" if unit else ""
+    v = check_finite(name, value, f"a finite number > 0{u}")
+    if v <= 0.0:
+        raise ValueError(f"{name} must be a finite number > 0{u}; got {value!r}")
+    return v
+
+
+@dataclass(frozen=True)
+class Material:
+    """Ionic polymer data (SI).  ``c_moy`` is ``"paper"``, ``"formula"`` or a number (mol/m^3).
+
+    Attributes
+    ----------
+    Z3 : float   mass charge of the polymer backbone, C/kg (negative)
+    rho3 : float density of the solid phase, kg/m^3
+    phi4 : float volume fraction of the solution, in (0, 1)
+    rho2 : float density of the solvent (water), kg/m^3
+    E : float    Young's modulus, Pa
+    T : float    absolute temperature, K
+    F : float    Faraday constant, C/mol
+    R : float    gas constant, J/(mol K)
+    D : float    diffusion coefficient of the cations in the liquid phase, m^2/s (not in the
+                 paper, which names it in its Nernst law but gives no value; used only by the
+                 dynamic models).  Default :data:`D_CATION_DEFAULT`, source
+                 :data:`D_CATION_SOURCE`.
+    """
+
+    Z3: float = -9.0e4
+    rho3: float = 2078.0
+    phi4: float = 0.38
+    rho2: float = 1000.0
+    E: float = 1.3e8
+    T: float = 300.0
+    F: float = 96487.0
+    R: float = 8.31
+    D: float = D_CATION_DEFAULT
+    c_moy: object = "paper"
+    name: str = "nafion-li"
+
+    def __post_init__(self):
+        z3 = check_finite("Z3", self.Z3, "a finite number < 0 C/kg")
+        if z3 >= 0.0:
+            raise ValueError(f"Z3 must be a finite number < 0 C/kg (fixed anions); got {self.Z3!r}")
+        check_positive("rho3", self.rho3, "kg/m^3")
+        phi4 = check_finite("phi4", self.phi4, "in the open interval (0, 1)")
+        if not 0.0 < phi4 < 1.0:
+            raise ValueError(f"phi4 must be in the open interval (0, 1); got {self.phi4!r}")
+        check_positive("rho2", self.rho2, "kg/m^3")
+        check_positive("modulus E", self.E, "Pa")
+        check_positive("temperature T", self.T, "K")
+        check_positive("Faraday constant F", self.F, "C/mol")
+        check_positive("gas constant R", self.R, "J/(mol K)")
+        check_positive("cation diffusion coefficient D", self.D, "m^2/s")
+        if isinstance(self.c_moy, str):
+            if self.c_moy not in ("paper", "formula"):
+                raise ValueError(
+                    f"c_moy must be 'paper', 'formula' or a number > 0 mol/m^3; got {self.c_moy!r}"
+                )
+        else:
+            check_positive("c_moy", self.c_moy, "mol/m^3")
+
+    @property
+    def C_moy_formula(self) -> float:
+        """``-(1 - phi4) rho3 Z3 / (phi4 F)`` (paper section 4), mol/m^3."""
+        return -(1.0 - self.phi4) * self.rho3 * self.Z3 / (self.phi4 * self.F)
+
+    @property
+    def C_moy(self) -> float:
+        """Mean cation concentration used by the model, mol/m^3."""
+        if self.c_moy == "paper":
+            return C_MOY_PAPER
+        if self.c_moy == "formula":
+            return self.C_moy_formula
+        return float(self.c_moy)
+
+    def with_(self, **kw) -> "Material":
+        return replace(self, **kw)
+
+
+NAFION_LI = Material()
+MATERIALS = {"nafion-li": NAFION_LI}
+
+#: keys of a material specification (scene ``[material]`` table, CLI options)
+MATERIAL_KEYS = ("preset", "E", "modulus", "c_moy", "phi4", "Z3", "rho3", "rho2", "T")
+
+
+def material_from_spec(spec=None, labels=None) -> Material:
+    """The one material parser (scene ``[material]`` tables and the command line).
+
+    Parameters
+    ----------
+    spec : dict or None
+        Any of :data:`MATERIAL_KEYS`: ``preset`` (a key of :data:`MATERIALS`, default
+        ``nafion-li``); ``E`` or ``modulus`` (Pa, number or string with units such as
+        ``"130MPa"``); ``c_moy`` (``"paper"``, ``"formula"``, or a number > 0 in mol/m^3,
+        also as a string); ``phi4``, ``Z3``, ``rho3``, ``rho2``, ``T`` (numbers, SI).
+    labels : dict, optional
+        How to name each key in error messages (e.g. ``{"c_moy": "--c-moy"}``); default
+        ``material.<key>``.
+
+    Returns
+    -------
+    Material
+
+    Raises
+    ------
+    ValueError
+        One line naming the key: unknown key, wrong type, value out of range.
+    """
+    spec = {} if spec is None else spec
+    labels = labels or {}
+
+    def name(k):
+        return labels.get(k, f"material.{k}")
+
+    if not isinstance(spec, dict):
+        raise ValueError(f"material must be a table (section); got {type(spec).__name__}")
+    for k in spec:
+        if k not in MATERIAL_KEYS:
+            raise ValueError(f"unknown key {k!r} in [material]; allowed: {', '.join(sorted(MATERIAL_KEYS))}")
+    preset = spec.get("preset", "nafion-li")
+    if preset not in MATERIALS:
+        raise ValueError(f"{name('preset')} must be one of {', '.join(MATERIALS)}; got {preset!r}")
+    if "E" in spec and "modulus" in spec:
+        raise ValueError(f"{name('E')}: give E or modulus, not both")
+    kw = {}
+    for k in ("E", "modulus"):
+        if k in spec:
+            v = spec[k]
+            if isinstance(v, bool) or not isinstance(v, (int, float, str)):
+                raise ValueError(f"{name(k)} must be a number or a string with units; got {v!r}")
+            E = parse_pressure(name(k), v)
+            if E <= 0:
+                raise ValueError(f"{name(k)} must be > 0 Pa (e.g. 130MPa); got {v!r}")
+            kw["E"] = E
+    for k in ("phi4", "Z3", "rho3", "rho2", "T"):
+        if k in spec:
+            v = spec[k]
+            if isinstance(v, bool) or not isinstance(v, (int, float)):
+                raise ValueError(f"{name(k)} must be a number; got {v!r}")
+            kw[k] = float(v)
+    if "c_moy" in spec:
+        v = spec["c_moy"]
+        bad = f"{name('c_moy')} must be paper, formula or a number > 0 mol/m^3; got {v!r}"
+        if isinstance(v, bool) or not isinstance(v, (int, float, str)):
+            raise ValueError(bad)
+        if isinstance(v, str) and v not in ("paper", "formula"):
+            try:
+                v = float(v)
+            except ValueError:
+                raise ValueError(bad) from None
+        if not isinstance(v, str) and not (math.isfinite(v) and v > 0):
+            raise ValueError(bad)
+        kw["c_moy"] = v
+    try:
+        return MATERIALS[preset].with_(**kw)
+    except ValueError as exc:
+        raise ValueError(f"material: {exc}") from None
+
+
+@dataclass(frozen=True)
+class Strip:
+    """Cantilever strip.  ``width`` and ``thickness`` are TOTAL (2l, 2e); SI units.
+
+    ``voltage`` may be negative (mirror image) or zero (no bending).
+    """
+
+    length: float = 0.02
+    width: float = 5.0e-3
+    thickness: float = 200.0e-6
+    voltage: float = 1.0
+
+    def __post_init__(self):
+        check_positive("length", self.length, "m")
+        check_positive("width (total, 2l)", self.width, "m")
+        check_positive("thickness (total, 2e)", self.thickness, "m")
+        check_finite("voltage", self.voltage, "a finite number of volts")
+
+    @property
+    def e(self) -> float:
+        """Half thickness (the paper's ``e``), m."""
+        return 0.5 * self.thickness
+
+    @property
+    def l(self) -> float:  # noqa: E743 - the paper's name
+        """Half width (the paper's ``l``), m."""
+        return 0.5 * self.width
+
+    @property
+    def I_p(self) -> float:
+        """Second moment of area ``4 l e^3 / 3`` (paper section 3), m^4."""
+        return float(second_moment(self.width, self.thickness))
+
+    def with_(self, **kw) -> "Strip":
+        return replace(self, **kw)
+
+
+NOMINAL_STRIP = Strip()
+
+
+def moment_scale(width, thickness, voltage, F, C_moy):
+    """``A5 = 6 l e^2 F |phi0| C_moy`` (N m): ``M_A = A5 I`` (paper sections 3-4).
+
+    Vectorised; ``width``, ``thickness`` are TOTAL (2l, 2e).
+    """
+    import numpy as np
+
+    l = 0.5 * np.asarray(width, dtype=float)  # noqa: E741
+    e = 0.5 * np.asarray(thickness, dtype=float)
+    return 6.0 * l * e * e * F * np.abs(np.asarray(voltage, dtype=float)) * C_moy
+
+
+def debye_length(thickness, eps_core, material: "Material"):
+    """Core Debye length over ``e``: ``lambda = sqrt(eps_core R T / (e^2 phi4 F^2 C_moy))``.
+
+    Equal to ``sqrt((A0 + A1)/A2)`` but defined at zero volts too (all three groups scale
+    with ``|phi0|``).  Vectorised; ``thickness`` is TOTAL (2e).
+    """
+    import numpy as np
+
+    m = material
+    e = 0.5 * np.asarray(thickness, dtype=float)
+    return np.sqrt(eps_core * m.R * m.T / (e * e * m.phi4 * m.F * m.F * m.C_moy))
+
+
+def second_moment(width, thickness):
+    """``I_p = 4 l e^3 / 3`` (m^4) from TOTAL width and thickness (vectorised)."""
+    import numpy as np
+
+    l = 0.5 * np.asarray(width, dtype=float)  # noqa: E741
+    e = 0.5 * np.asarray(thickness, dtype=float)
+    return 4.0 * l * e**3 / 3.0
+
+
+@dataclass(frozen=True)
+class Groups:
+    """Dimensionless groups of the system (paper eq. for ``A0..A5``), built on ``|phi0|``.
+
+    ``sign`` is the sign of the voltage (+1, -1, or 0): the solution for a negative voltage
+    is the mirror image of the one for ``|phi0|``, so ``I`` carries ``sign``.
+    """
+
+    C_moy: float
+    A0: float
+    A1: float
+    A2: float
+    A3: float
+    A5: float
+    sign: float
+    e: float
+    l: float  # noqa: E741
+    phi0: float
+    extra: dict = field(default_factory=dict, compare=False, repr=False)
+
+    @property
+    def debye(self) -> float:
+        """Core Debye length relative to ``e``: ``lambda = sqrt((A0 + A1) / A2)``.
+
+        Independent of the voltage (all three groups scale with ``|phi0|``); stored from the
+        dimensional data so that it is defined at zero volts too.
+        """
+        return self.extra["debye"]
+
+
+def make_groups(strip: Strip, material: Material, eps0: float, deps: float) -> Groups:
+    """Dimensionless groups for a strip, a material and ``eps = eps0 + deps * C / C_moy``.
+
+    Parameters
+    ----------
+    strip : Strip
+    material : Material
+    eps0 : float
+        Permittivity at zero concentration, F/m (``>= 0``).
+    deps : float
+        ``eps_moy - eps0``, F/m (``>= 0``; not both zero).
+
+    Returns
+    -------
+    Groups
+        ``A0 = |phi0| deps / (e^2 phi4 F C_moy)``, ``A1 = |phi0| eps0 / (e^2 phi4 F C_moy)``,
+        ``A2 = F |phi0| / (R T)``, ``A3 = -rho2 Z3 / (C_moy F)``,
+        ``A5 = 6 l e^2 F |phi0| C_moy`` (N m).
+    """
+    m = material
+    cm = m.C_moy
+    e, l = strip.e, strip.l
+    phi = abs(float(strip.voltage))
+    sign = math.copysign(1.0, strip.voltage) if strip.voltage != 0.0 else 0.0
+    den = e * e * m.phi4 * m.F * cm
+    return Groups(
+        C_moy=cm,
+        A0=phi * deps / den,
+        A1=phi * eps0 / den,
+        A2=m.F * phi / (m.R * m.T),
+        A3=-m.rho2 * m.Z3 / (cm * m.F),
+        A5=float(moment_scale(strip.width, strip.thickness, phi, m.F, cm)),
+        sign=sign,
+        e=e,
+        l=l,
+        phi0=float(strip.voltage),
+        extra={"debye": float(debye_length(strip.thickness, eps0 + deps, m))},
+    )

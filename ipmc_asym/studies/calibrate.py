@@ -1,0 +1,658 @@
+"""Calibration: weighted least squares of a user's measurements, with honest error bars.
+
+``fit(read_data("DATA.csv"), ["modulus", "c_moy"])`` returns a :class:`CalibrationResult`
+whose :meth:`~CalibrationResult.as_dict` has exactly the keys ``parameters`` (name ->
+``{value, stderr, ci95, identifiable}``), ``correlation``, ``chi2_red``, ``n_points``,
+``fidelity``, ``model``.
+
+Library choice: SciPy ``least_squares`` (``trf``, bounds) with a hand-rolled profile
+likelihood, not lmfit.  Reasons: SciPy is already a core dependency (lmfit would add one,
+plus asteval/uncertainties, to every install); the fit runs in log parameters with bounds
+and a vectorised residual, which ``least_squares`` takes directly; and the part that matters
+here -- deciding that a parameter is NOT identifiable (flat or one-sided profile, or a
+profile that walks out of the model's domain) instead of printing a fake interval -- needs
+control over the profile walk that lmfit's ``conf_interval`` (which raises or warns at a
+bound) does not give.  The profile is the textbook one: fix the parameter, re-minimise over
+the others, and find where ``Delta chi^2`` reaches the 95 % threshold.
+
+Model (paper sections 3-4): ``M_A = A5 I`` with ``A5 = 6 l e^2 F |phi0| C_moy``; free-end
+tip deflection ``|w| = 2 sin^2(kappa L/2)/|kappa|``, ``kappa = M_A/(E I_p)`` (large
+displacement); blocking force ``|F| = psi(kappa L) |M_A|/L`` (large displacement).  Hence at
+fixed geometry the deflection sees ``M_A/E`` only and the force ``M_A`` only (``psi``
+depends on ``E`` through ``kappa L`` by a relative ``(kappa L)^2/3360``): ``modulus`` needs
+deflection data AND something that fixes ``M_A`` (force data, or a known ``c_moy``), and
+force-only data leave ``modulus`` not identifiable.  The profile finds this; nothing here
+assumes it.
+
+Weights: a ``sigma_<measured>`` column is one standard deviation (absolute, chi^2 with
+known scale, threshold ``chi2.ppf(0.95, 1) = 3.84``).  Without it the weights are equal and
+relative (residual / |measured|) and the scale is estimated from the residuals
+(``s^2 = chi^2/(n - p)``; covariance scaled by ``s^2``; profile threshold ``t_{0.975,n-p}^2``).
+
+Fidelity: the cheapest rung of ``leading -> corrected -> quadrature -> bvp`` whose error
+estimate at every data point (from :func:`ipmc_asym.integral.api.moment`, propagated to each
+output, at the fitted parameters) is below a tenth of the data's relative error (the
+smallest ``sigma/|measured|``, or the fitted relative scale ``s`` without sigma columns),
+and -- because the estimates average over the points while a model error does not -- whose
+worst-case linearised shift of every estimate is below a tenth of its standard error
+(:func:`_bias_check`).  The closed
+forms exist for the paper's permittivity pairs only, so a free ``eps0``/``deps`` starts at
+``quadrature``.
+
+Layer rule: stdlib + numpy at import; SciPy's optimiser and statistics deferred.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import os
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ipmc_asym.base.registry import closed_form_fidelities, fidelity_names
+from ipmc_asym.model.params import NAFION_LI, Material, Strip, moment_scale, second_moment
+from ipmc_asym.base.units import parse_length, parse_pressure, parse_quantity, parse_voltage
+
+__all__ = [
+    "FREE_PARAMETERS",
+    "MEASURED",
+    "CalibrationData",
+    "CalibrationResult",
+    "read_data",
+    "parse_free",
+    "predict",
+    "fit",
+]
+
+#: free parameters: name -> (unit, default bounds, what it sets).  Names as the CLI/sweeps use.
+FREE_PARAMETERS = {
+    "modulus": ("Pa", (1e6, 1e11), "Young's modulus E"),
+    "c_moy": ("mol/m^3", (10.0, 1e5), "mean cation concentration C_moy"),
+    "eps0": ("F/m", (1e-10, 1.0), "permittivity at C = 0, eps0"),
+    "deps": ("F/m", (1e-10, 1.0), "eps_moy - eps0"),
+}
+#: measured columns -> unit (magnitudes)
+MEASURED = {"deflection": "m", "blocking_force": "N"}
+GEOMETRY = ("length", "width", "thickness", "voltage")
+_FORCE = {"N": 1.0, "mN": 1e-3, "uN": 1e-6, "µN": 1e-6, "μN": 1e-6, "kN": 1e3}
+#: the fidelity ladder, cheapest first (the registry is the one list)
+LADDER = fidelity_names()
+#: starting value of a permittivity parameter whose nominal value is 0 (log parameters)
+_EPS_START = {"eps0": 5e-6, "deps": 1e-3}
+
+
+# ---- data ------------------------------------------------------------------------------------
+@dataclass
+class CalibrationData:
+    """Measurements, one entry per CSV row (SI).
+
+    Attributes
+    ----------
+    geometry : dict
+        ``length``, ``width`` (TOTAL 2l), ``thickness`` (TOTAL 2e), ``voltage``: arrays (n_rows,).
+    measured : dict
+        name -> array (n_rows,) of magnitudes, NaN where the row does not measure it.
+    sigma : dict
+        name -> array (n_rows,) of one standard deviation, or None (relative weights).
+    source : str
+    """
+
+    geometry: dict
+    measured: dict
+    sigma: dict
+    source: str = "data"
+
+    @property
+    def n_rows(self) -> int:
+        return int(next(iter(self.geometry.values())).size)
+
+    @property
+    def n_points(self) -> int:
+        """Number of measured values (all columns)."""
+        return int(sum(np.count_nonzero(np.isfinite(v)) for v in self.measured.values()))
+
+    @property
+    def has_sigma(self) -> bool:
+        return all(s is not None for s in self.sigma.values())
+
+
+def _parse_cell(col, text):
+    if col in ("length", "width", "thickness", "deflection") or col == "sigma_deflection":
+        return parse_length(col, text)
+    if col == "voltage":
+        return parse_voltage(col, text)
+    if col in ("blocking_force", "sigma_blocking_force"):
+        return parse_quantity(col, text, _FORCE, "force")
+    raise ValueError(f"column {col!r} not readable")  # pragma: no cover - filtered earlier
+
+
+def read_data(path, base: Strip | None = None) -> CalibrationData:
+    """Read a calibration CSV (header row; SI numbers or values with units).
+
+    Columns: any of ``length, width, thickness, voltage`` (width/thickness TOTAL; a missing
+    column takes ``base``), measured ``deflection`` (|w|, m) and/or ``blocking_force``
+    (|F|, N), optional ``sigma_deflection``, ``sigma_blocking_force``.  An empty measured
+    cell means "not measured in this row".  Every error is one line naming the row/column.
+    """
+    base = Strip() if base is None else base
+    p = os.fspath(path)
+    name = os.path.basename(p)
+    try:
+        with open(p, newline="", encoding="utf-8") as fh:
+            rows = list(csv.reader(fh))
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ValueError(f"data file {p!r}: cannot read ({exc.__class__.__name__})") from None
+    rows = [r for r in rows if any(c.strip() for c in r) and not r[0].lstrip().startswith("#")]
+    if not rows:
+        raise ValueError(f"{name}: empty file (need a header row and data rows)")
+    header = [h.strip() for h in rows[0]]
+    allowed = list(GEOMETRY) + list(MEASURED) + [f"sigma_{m}" for m in MEASURED]
+    for j, h in enumerate(header, 1):
+        if h == "charge_density" or h == "sigma_charge_density":
+            raise ValueError(f"{name}: column {j} {h!r} is not supported yet (charge output not in this "
+                             f"version); allowed: {', '.join(allowed)}")
+        if h not in allowed:
+            raise ValueError(f"{name}: unknown column {j} {h!r} in the header; allowed: {', '.join(allowed)}")
+        if header.count(h) > 1:
+            raise ValueError(f"{name}: column {h!r} appears twice in the header")
+    meas = [m for m in MEASURED if m in header]
+    if not meas:
+        raise ValueError(f"{name}: no measured column; need deflection and/or blocking_force")
+    for m in MEASURED:
+        if f"sigma_{m}" in header and m not in header:
+            raise ValueError(f"{name}: column sigma_{m} without a {m} column")
+    data = rows[1:]
+    if not data:
+        raise ValueError(f"{name}: no data rows after the header")
+    n = len(data)
+    cols = {h: np.full(n, np.nan) for h in header}
+    for i, r in enumerate(data):
+        rowno = i + 2  # 1-based, header is row 1
+        if len(r) != len(header):
+            raise ValueError(f"{name} row {rowno}: {len(r)} fields, header has {len(header)}")
+        for h, cell in zip(header, r):
+            cell = cell.strip()
+            if cell == "":
+                if h in GEOMETRY:
+                    raise ValueError(f"{name} row {rowno}, column {h!r}: empty (geometry/drive needs a value)")
+                continue
+            try:
+                v = _parse_cell(h, cell)
+            except ValueError as exc:
+                raise ValueError(f"{name} row {rowno}, column {h!r}: {exc}") from None
+            if h != "voltage" and not v > 0:
+                what = "a magnitude > 0" if h in MEASURED else "> 0"
+                raise ValueError(f"{name} row {rowno}, column {h!r}: must be {what}; got {cell!r}")
+            cols[h][i] = v
+    for m in meas:
+        s = f"sigma_{m}"
+        if s in cols:
+            miss = np.isfinite(cols[m]) & ~np.isfinite(cols[s])
+            if np.any(miss):
+                raise ValueError(f"{name} row {int(np.argmax(miss)) + 2}, column {s!r}: empty where {m} is given")
+    geometry = {g: (cols[g] if g in cols else np.full(n, float(getattr(base, g)))) for g in GEOMETRY}
+    for m in meas:
+        zero_v = np.isfinite(cols[m]) & (geometry["voltage"] == 0.0)
+        if np.any(zero_v):
+            raise ValueError(f"{name} row {int(np.argmax(zero_v)) + 2}, column 'voltage': 0 V gives no bending; "
+                             f"a measured {m} needs a non-zero voltage")
+    measured = {m: cols[m] for m in meas}
+    sigma = {m: cols.get(f"sigma_{m}") for m in meas}
+    if any(s is None for s in sigma.values()) and any(s is not None for s in sigma.values()):
+        raise ValueError(f"{name}: give sigma_ columns for every measured column or for none")
+    return CalibrationData(geometry, measured, sigma, source=name)
+
+
+def parse_free(spec) -> dict:
+    """``"modulus=50MPa:500MPa,c_moy"`` or a list/dict -> ``{name: (lo, hi)}`` (SI)."""
+    if isinstance(spec, dict):
+        items = list(spec.items())
+    else:
+        if isinstance(spec, str):
+            spec = [s for s in spec.split(",") if s.strip()]
+        items = []
+        for s in spec:
+            s = s.strip()
+            if "=" in s:
+                k, rng = s.split("=", 1)
+                parts = rng.split(":")
+                if len(parts) != 2:
+                    raise ValueError(f"--free {k.strip()}: bounds must be LO:HI; got {rng!r}")
+                items.append((k.strip(), tuple(parts)))
+            else:
+                items.append((s, None))
+    out = {}
+    for k, b in items:
+        if k not in FREE_PARAMETERS:
+            raise ValueError(f"--free: unknown parameter {k!r}; allowed: {', '.join(FREE_PARAMETERS)}")
+        if k in out:
+            raise ValueError(f"--free: {k!r} given twice")
+        unit, dflt, _ = FREE_PARAMETERS[k]
+        if b is None:
+            out[k] = dflt
+            continue
+        lo, hi = (_bound(k, x) for x in b)
+        if not 0 < lo < hi:
+            raise ValueError(f"--free {k}: bounds must satisfy 0 < LO < HI ({unit}); got {lo:g}:{hi:g}")
+        out[k] = (lo, hi)
+    if not out:
+        raise ValueError("--free needs at least one of " + ", ".join(FREE_PARAMETERS))
+    return out
+
+
+def _bound(k, x):
+    if k == "modulus":
+        return parse_pressure(k, x)
+    try:
+        return float(x)
+    except (TypeError, ValueError):
+        raise ValueError(f"--free {k}: bound {x!r} is not a number ({FREE_PARAMETERS[k][0]})") from None
+
+
+# ---- forward model ---------------------------------------------------------------------------
+def _perm(model, values):
+    from ipmc_asym.model.permittivity import Permittivity, get_model
+
+    p = get_model(model)
+    if "eps0" in values or "deps" in values:
+        p = Permittivity(p.name, eps0=values.get("eps0", p.eps0), deps=values.get("deps", p.deps))
+    return p
+
+
+def _material(material: Material, values) -> Material:
+    kw = {}
+    if "modulus" in values:
+        kw["E"] = float(values["modulus"])
+    if "c_moy" in values:
+        kw["c_moy"] = float(values["c_moy"])
+    return material.with_(**kw) if kw else material
+
+
+def predict(values: dict, geometry: dict, model="constant", fidelity="leading",
+            material: Material = NAFION_LI):
+    """Model predictions at the data's geometry for parameter ``values`` (SI).
+
+    Returns
+    -------
+    outputs : dict
+        ``deflection`` (|w|, large displacement, m) and ``blocking_force`` (|F|, large
+        displacement, N): arrays (n_rows,), NaN where the beam has no answer.
+    errors : dict
+        Relative error estimate of each output, arrays (n_rows,): the error estimate of ``I``
+        (hence of ``M_A``) times ``|d ln y / d ln M_A|`` -- for the arc deflection
+        ``2u cot(u) - 1`` with ``u = kappa L/2`` (1 for small bending, unbounded where the
+        strip curls back and ``w`` stops growing with ``M``); for the force
+        ``1 + d ln psi / d ln(kappa L)`` (by a central difference).
+    valid : ndarray of bool (n_rows,)
+    """
+    from ipmc_asym.beam.statics import blocking_force_large, blocking_force_ratio, tip_deflection
+    from ipmc_asym.integral.api import moment
+
+    mat = _material(material, values)
+    perm = _perm(model, values)
+    g = geometry
+    r = moment(g["thickness"], g["voltage"], perm, fidelity, material=mat, progress=False)
+    M = moment_scale(g["width"], g["thickness"], g["voltage"], mat.F, mat.C_moy) * np.asarray(r.I)
+    EI = mat.E * second_moment(g["width"], g["thickness"])
+    err = np.asarray(r.error, float)
+    with np.errstate(all="ignore"):
+        w = np.abs(np.asarray(tip_deflection(M, g["length"], EI), dtype=float))
+        F = np.abs(np.asarray(blocking_force_large(M, g["length"], EI), dtype=float))
+        u = 0.5 * np.abs(M) * g["length"] / EI
+        sw = np.where(u < 1e-4, 1.0, 2.0 * u / np.tan(np.where(u < 1e-4, 1.0, u)) - 1.0)
+        m = 2.0 * u
+        h = 1e-4
+        dpsi = (np.asarray(blocking_force_ratio(m * (1 + h)), float)
+                - np.asarray(blocking_force_ratio(m * (1 - h)), float)) / (2 * h)
+        sF = 1.0 + dpsi / np.asarray(blocking_force_ratio(m), float)
+        errors = {"deflection": np.abs(sw) * err, "blocking_force": np.abs(sF) * err}
+    errors = {k: np.where(np.isfinite(v), v, np.inf) for k, v in errors.items()}
+    return {"deflection": w, "blocking_force": F}, errors, np.asarray(r.valid, bool)
+
+
+# ---- the fit ---------------------------------------------------------------------------------
+@dataclass
+class CalibrationResult:
+    """Outcome of :func:`fit`.
+
+    Attributes
+    ----------
+    parameters : dict
+        name -> ``{"value", "stderr", "ci95", "identifiable"}`` (SI); ``stderr`` None and
+        ``ci95`` with None on the open side(s) where the parameter is not identifiable.
+    correlation : list of list
+        Correlation matrix of the free parameters (order of ``names``); None entries for
+        non-identifiable parameters.
+    chi2_red : float
+        ``chi^2/(n - p)`` (relative residuals without sigma columns).
+    n_points, fidelity, model
+    success : bool
+    message : str
+        What was decided (fidelity, identifiability) in one or a few sentences.
+    names : list of str
+    predictions : dict   model at the optimum (for plots)
+    data : CalibrationData
+    """
+
+    parameters: dict
+    correlation: list
+    chi2_red: float
+    n_points: int
+    fidelity: str
+    model: str
+    success: bool = True
+    message: str = ""
+    names: list = field(default_factory=list)
+    predictions: dict = field(default_factory=dict, repr=False)
+    data: CalibrationData | None = field(default=None, repr=False)
+
+    def as_dict(self) -> dict:
+        """Exactly the keys of ``--json``."""
+        return {"parameters": self.parameters, "correlation": self.correlation, "chi2_red": self.chi2_red,
+                "n_points": self.n_points, "fidelity": self.fidelity, "model": self.model}
+
+
+class _Problem:
+    """Weighted residuals in log parameters (picklable: workers of a multistart get one)."""
+
+    def __init__(self, data, names, model, material, fidelity, fixed=None):
+        self.data, self.names, self.model, self.material, self.fidelity = data, names, model, material, fidelity
+        self.fixed = dict(fixed or {})
+        self.keys = list(data.measured)
+        self.masks = {k: np.isfinite(data.measured[k]) for k in self.keys}
+        if data.has_sigma:
+            self.scale = {k: data.sigma[k][self.masks[k]] for k in self.keys}
+        else:
+            self.scale = {k: data.measured[k][self.masks[k]] for k in self.keys}
+
+    def values(self, x):
+        v = dict(self.fixed)
+        v.update({n: math.exp(float(xi)) for n, xi in zip(self.names, x)})
+        return v
+
+    def residuals(self, x):
+        out, _, _ = predict(self.values(x), self.data.geometry, self.model, self.fidelity, self.material)
+        parts = []
+        for k in self.keys:
+            m = self.masks[k]
+            parts.append((out[k][m] - self.data.measured[k][m]) / self.scale[k])
+        r = np.concatenate(parts)
+        # outside the model's domain (beam branch not tracked): a large finite residual so the
+        # trust region backs off instead of the optimiser seeing NaN
+        return np.where(np.isfinite(r), r, 1e3)
+
+
+def _solve(problem, x0, lo, hi):
+    from scipy.optimize import least_squares  # deferred: heavy import (start-up)
+
+    x0 = np.clip(np.asarray(x0, float), lo + 1e-12, hi - 1e-12)
+    with np.errstate(all="ignore"):
+        return least_squares(problem.residuals, x0, bounds=(lo, hi), method="trf", x_scale=1.0,
+                             xtol=1e-12, ftol=1e-12, gtol=1e-12, max_nfev=400)
+
+
+def _multistart_task(args):
+    """One start of a multistart (module level: runs on workers)."""
+    problem, x0, lo, hi = args
+    r = _solve(problem, x0, lo, hi)
+    return float(r.cost), np.asarray(r.x, float)
+
+
+def _start_values(names, model, material):
+    from ipmc_asym.model.permittivity import get_model
+
+    p = get_model(model)
+    out = []
+    for n in names:
+        if n == "modulus":
+            v = material.E
+        elif n == "c_moy":
+            v = material.C_moy
+        else:
+            v = getattr(p, n)
+            if v <= 0:
+                v = _EPS_START[n]
+        out.append(v)
+    return out
+
+
+def fit(data: CalibrationData, free, model="constant", material: Material = NAFION_LI,
+        fidelity: str | None = None, multistart: int = 0, seed: int = 0, scheduler=None) -> CalibrationResult:
+    """Weighted least squares of ``data`` over the ``free`` parameters, with profile intervals.
+
+    Parameters
+    ----------
+    data : CalibrationData
+    free : str, list or dict
+        Names from :data:`FREE_PARAMETERS` (``modulus``, ``c_moy``, ``eps0``, ``deps``), or
+        ``{name: (lo, hi)}`` bounds in SI (default bounds otherwise).
+    model : {"constant", "linear", "affine"}
+        Permittivity model (its eps0/deps are the start/fixed values).
+    material : Material
+        Fixed material data and start values of ``modulus``/``c_moy``.
+    fidelity : str, optional
+        Force a fidelity; default: the cheapest whose error estimate is < 1/10 of the data's
+        relative error at the fitted parameters.
+    multistart : int
+        Extra starts, log-uniform inside the bounds (seeded by ``seed``), run through
+        :func:`ipmc_asym.parallel.executors.run_chunks` on ``scheduler``; the best one is kept.
+    scheduler : None, "local" or "tcp://HOST:PORT"
+
+    Returns
+    -------
+    CalibrationResult
+
+    Raises
+    ------
+    ValueError
+        One line: unknown parameter, too many free parameters for the data (the request is
+        refused before any work), a fidelity outside its validity at every rung.
+    """
+    from scipy import stats  # deferred: heavy import (start-up)
+
+    bounds = parse_free(free)
+    names = list(bounds)
+    p = len(names)
+    n = data.n_points
+    need = p + (0 if data.has_sigma else 1)
+    if n < need:
+        extra = "" if data.has_sigma else " (without sigma_ columns one more, to estimate the noise scale)"
+        raise ValueError(f"too many free parameters: {p} ({', '.join(names)}) for {n} measured value(s); "
+                         f"need at least {need}{extra}")
+    lo = np.log([bounds[k][0] for k in names])
+    hi = np.log([bounds[k][1] for k in names])
+    x0 = np.clip(np.log(_start_values(names, model, material)), lo, hi)
+    perm_free = any(k in ("eps0", "deps") for k in names)
+    if fidelity is not None:
+        if fidelity not in LADDER:
+            raise ValueError(f"fidelity must be one of {', '.join(LADDER)}; got {fidelity!r}")
+        ladder = [fidelity]
+    else:
+        ladder = [f for f in LADDER if not (perm_free and f in closed_form_fidelities())]
+
+    # multistart (fidelity of the first rung; the ladder then refines the best start)
+    starts = [x0]
+    if multistart and multistart > 0:
+        rng = np.random.default_rng(seed)
+        starts += [rng.uniform(lo, hi) for _ in range(int(multistart))]
+    notes = []
+    res = None
+    chosen = None
+    x = x0
+    for k, fid in enumerate(ladder):
+        prob = _Problem(data, names, model, material, fid)
+        if k == 0 and len(starts) > 1:
+            from ipmc_asym.parallel.executors import run_chunks
+
+            outs = run_chunks(_multistart_task, [(prob, s, lo, hi) for s in starts], scheduler=scheduler)
+            best = min(range(len(outs)), key=lambda i: outs[i][0])
+            x = outs[best][1]
+            notes.append(f"multistart: best of {len(starts)} starts is #{best}")
+        res = _solve(prob, x, lo, hi)
+        x = res.x
+        out, errs, valid = predict(prob.values(x), data.geometry, model, fid, material)
+        rows = np.zeros(data.n_rows, bool)
+        for m in prob.masks.values():
+            rows |= m
+        worst = max(float(np.max(errs[k][prob.masks[k]])) for k in prob.keys)
+        chi2 = 2.0 * float(res.cost)
+        if data.has_sigma:
+            rel = min(float(np.min(data.sigma[m][prob.masks[m]] / data.measured[m][prob.masks[m]]))
+                      for m in prob.keys)
+        else:
+            rel = math.sqrt(chi2 / max(n - p, 1))
+        bias_ok, bias_note = _bias_check(prob, res, out, errs, chi2, n, p, data.has_sigma)
+        if bool(np.all(valid[rows])) and worst < 0.1 * rel and bias_ok:
+            chosen = fid
+            break
+        if bool(np.all(valid[rows])) and worst < 0.1 * rel:
+            notes.append(f"{fid}: {bias_note}")
+            continue
+        notes.append(f"{fid}: error estimate {worst:.2g} not below a tenth of the data's relative error "
+                     f"{rel:.2g}" + ("" if np.all(valid[rows]) else " (outside validity)"))
+    if chosen is None:
+        if fidelity is not None:
+            raise ValueError(f"fidelity {fidelity!r}: error estimate {worst:.2g} is not below a tenth of the data's "
+                             f"relative error {rel:.2g}; leave --fidelity unset to escalate")
+        raise ValueError(f"no fidelity is accurate enough for data this precise ({'; '.join(notes)})")
+    prob = _Problem(data, names, model, material, chosen)
+    chi2 = 2.0 * float(res.cost)
+    dof = n - p
+    chi2_red = chi2 / dof if dof > 0 else float("nan")
+    s2 = 1.0 if data.has_sigma else chi2_red
+    thr = float(stats.chi2.ppf(0.95, 1)) if data.has_sigma else float(stats.t.ppf(0.975, dof) ** 2)
+
+    J = np.asarray(res.jac, float)
+    cov = s2 * np.linalg.pinv(J.T @ J)
+    sd_log = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+
+    params, ident = {}, []
+    for j, nm in enumerate(names):
+        lo_ci, hi_ci, why = _profile(prob, res.x, j, lo, hi, chi2, s2, thr, sd_log[j])
+        ok = lo_ci is not None and hi_ci is not None
+        ident.append(ok)
+        val = math.exp(float(res.x[j]))
+        params[nm] = {
+            "value": val,
+            "stderr": val * float(sd_log[j]) if ok else None,
+            "ci95": [None if lo_ci is None else math.exp(lo_ci), None if hi_ci is None else math.exp(hi_ci)],
+            "identifiable": ok,
+        }
+        if not ok:
+            notes.append(f"{nm} not identifiable from these data: {why}")
+    corr = []
+    for a in range(p):
+        row = []
+        for b in range(p):
+            if ident[a] and ident[b] and sd_log[a] > 0 and sd_log[b] > 0:
+                row.append(float(cov[a, b] / (sd_log[a] * sd_log[b])))
+            else:
+                row.append(None)
+        corr.append(row)
+    out, _, _ = predict(prob.values(res.x), data.geometry, model, chosen, material)
+    msg = (f"fidelity {chosen} (cheapest with error estimate < 1/10 of the data's relative error and a model-error "
+           f"shift < 0.1 standard error on every estimate)")
+    if notes:
+        msg += "; " + "; ".join(notes)
+    from ipmc_asym.model.permittivity import get_model
+
+    return CalibrationResult(parameters=params, correlation=corr, chi2_red=chi2_red, n_points=n,
+                             fidelity=chosen, model=get_model(model).name, success=bool(res.success),
+                             message=msg, names=names, predictions=out, data=data)
+
+
+def _bias_check(prob, res, out, errs, chi2, n, p, has_sigma):
+    """Does the model error move the estimates by less than a tenth of their standard error?
+
+    The per-point rule (error < 1/10 of the data's relative error) does not see that the
+    estimates average over ``n`` points while a systematic model error does not average out.
+    Linearised: the shift of the log parameters is ``G r_model`` with ``G = (J^T J)^+ J^T``
+    and ``r_model`` the worst-case weighted model error (error estimate x |prediction| /
+    weight scale, every sign the worst one: ``|G| |r_model|``).
+    """
+    J = np.asarray(res.jac, float)
+    rm = np.concatenate([errs[k][prob.masks[k]] * np.abs(out[k][prob.masks[k]]) / prob.scale[k] for k in prob.keys])
+    if not np.all(np.isfinite(rm)):
+        return False, "model error estimate not finite at some point"
+    JtJ = np.linalg.pinv(J.T @ J)
+    G = JtJ @ J.T
+    s2 = 1.0 if has_sigma else chi2 / max(n - p, 1)
+    sd = np.sqrt(np.clip(np.diag(s2 * JtJ), 0.0, None))
+    bias = np.abs(G) @ np.abs(rm)
+    ok = (sd <= 0) | (bias < 0.1 * sd)
+    if np.all(ok):
+        return True, ""
+    j = int(np.argmax(np.where(sd > 0, bias / np.where(sd > 0, sd, 1.0), 0.0)))
+    return False, (f"model error could shift {prob.names[j]} by {bias[j] / sd[j]:.2g} standard errors "
+                   f"(> 0.1)")
+
+
+def _profile(prob, xhat, j, lo, hi, chi2min, s2, thr, sd):
+    """95 % profile-likelihood interval of parameter ``j`` in log space.
+
+    Walks away from the optimum on each side (steps growing x1.6 from ~2 standard errors)
+    until ``Delta chi^2 / s^2`` crosses ``thr`` (then brentq), the bound is reached, or the
+    model has no answer (beam branch not tracked).  Returns ``(lo, hi, why)`` with None on a
+    side that never crossed.
+    """
+    from scipy.optimize import brentq  # deferred: heavy import (start-up)
+
+    others = [i for i in range(len(xhat)) if i != j]
+    sub_lo, sub_hi = lo[others], hi[others]
+    warm = {+1: xhat[others].copy(), -1: xhat[others].copy()}
+
+    def delta(xj, side):
+        if others:
+            fixed = dict(prob.fixed)
+            fixed[prob.names[j]] = math.exp(xj)
+            sub = _Problem(prob.data, [prob.names[i] for i in others], prob.model, prob.material, prob.fidelity,
+                           fixed)
+            r = _solve(sub, warm[side], sub_lo, sub_hi)
+            warm[side] = r.x
+            c = 2.0 * float(r.cost)
+        else:
+            x = xhat.copy()
+            x[j] = xj
+            r = prob.residuals(x)
+            c = float(r @ r)
+        return (c - chi2min) / s2
+
+    ends, why = {}, []
+    for side in (-1, +1):
+        bound = lo[j] if side < 0 else hi[j]
+        step = min(max(2.0 * sd if np.isfinite(sd) and sd > 0 else 0.05, 1e-3), 0.5)
+        x_prev, d_prev = float(xhat[j]), 0.0
+        ends[side] = None
+        for _ in range(60):
+            x_new = x_prev + side * step
+            at_bound = (x_new - bound) * side >= 0
+            if at_bound:
+                x_new = float(bound)
+            d = delta(x_new, side)
+            if not np.isfinite(d):
+                why.append(f"the model has no answer {'below' if side < 0 else 'above'} "
+                           f"{math.exp(x_prev):.3g}")
+                break
+            if d >= thr:
+                if d > thr:
+                    a, b = sorted((x_prev, x_new))
+                    ends[side] = brentq(lambda t: delta(t, side) - thr, a, b, xtol=1e-6)
+                else:
+                    ends[side] = x_new
+                break
+            if at_bound:
+                why.append(f"profile stays within the 95 % threshold down to the bound "
+                           f"{math.exp(bound):.3g}" if side < 0 else
+                           f"profile stays within the 95 % threshold up to the bound {math.exp(bound):.3g}")
+                break
+            x_prev, d_prev = x_new, d
+            step *= 1.6
+    if ends[-1] is None and ends[+1] is None:
+        kind = "flat profile"
+    elif ends[-1] is None or ends[+1] is None:
+        kind = "one-sided profile"
+    else:
+        kind = ""
+    return ends[-1], ends[+1], (kind + (": " + "; ".join(why) if why else "")) if kind else ""

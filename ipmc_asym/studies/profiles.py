@@ -1,0 +1,186 @@
+"""Profiles through the thickness (seed paper section 6.1, Figs 4-7): ``ipmc-asym profiles``.
+
+The profiles come from the full BVP (:func:`ipmc_asym.bvp.solver.solve`) on its graded mesh, so the
+electrode layers (~1e-3 of the thickness) are resolved.  Distances are measured from the
+face, in micrometres, with ``e`` the HALF thickness (``z = z_bar e``, ``z_bar in [-1, 1]``;
+anode ``z_bar = -1``, cathode ``z_bar = +1``).
+
+Layer widths (the toolkit's one set of definitions: :data:`LAYER_WIDTHS`, used by
+``profiles``, ``validate`` and ``scenes``; thresholds in :mod:`ipmc_asym.base.settings`)
+-----------------------------------------------------------------------------------
+``depletion`` (anode)
+    distance from the anode face to the first point where ``C_bar`` rises through
+    ``settings.DEPLETION_LEVEL`` (1/2: half the mean concentration).
+``devoid`` (anode)
+    distance from the anode face to where ``C_bar`` rises through ``settings.DEVOID_LEVEL``
+    (0.01): the paper's "zone presque totalement depourvue de cations" (section 6.1).  This
+    is the width compared with the paper's anode-layer widths.
+``accumulation`` (cathode)
+    distance from the cathode face to the point where the excess ``C_bar - 1`` has fallen to
+    ``settings.ACCUMULATION_FRACTION`` (1/e) of its face value ``B1 - 1``: the 1/e decay
+    length of the accumulated charge.
+``accumulation_half`` (cathode)
+    same, with ``settings.ACCUMULATION_HALF_FRACTION`` (1/2; less sensitive to the tail).
+
+The anode is the face at the higher potential: ``z_bar = -1`` for a positive voltage,
+``z_bar = +1`` for a negative one (the mirror image).
+
+Layer rule: stdlib + numpy at import; SciPy (via bvp) is imported lazily; figures are drawn by
+:mod:`ipmc_asym.plotting.profiles`.
+"""
+
+from __future__ import annotations
+
+import csv
+
+import numpy as np
+
+from ipmc_asym.io.fileio import atomic_write
+from ipmc_asym.model.params import NAFION_LI, Material, Strip
+from ipmc_asym.base.registry import model_names
+from ipmc_asym.base.settings import (
+    ACCUMULATION_FRACTION,
+    ACCUMULATION_HALF_FRACTION,
+    DEPLETION_LEVEL,
+    DEVOID_LEVEL,
+)
+
+__all__ = ["QUANTITIES", "profile", "layer_widths", "profile_summary", "write_csv",
+           "compute_all", "PAPER_LAYERS", "LAYER_WIDTHS"]
+
+#: quantity key -> (BVPResult attribute, axis label)
+QUANTITIES = {
+    "C": ("C", r"$\bar C = C/C_{moy}$"),
+    "phi": ("phi", r"$\bar\varphi = \varphi/\varphi_0$"),
+    "D": ("D", r"$\bar D$ (dimensionless induction)"),
+    "E": ("E", r"$\bar E = -d\bar\varphi/d\bar z$"),
+    "rhoZ": ("rhoZ", r"$\overline{\rho Z} = \bar C - 1$"),
+    "p": ("p", r"$\bar p = \bar C/A_2 - A_3\bar\varphi$ ($B_2=0$)"),
+}
+
+#: the layer widths: key of :func:`layer_widths` -> (face, what it measures)
+LAYER_WIDTHS = {
+    "depletion_um": ("anode", f"C_bar rises through {DEPLETION_LEVEL:g} from the anode face"),
+    "devoid_um": ("anode", f"C_bar rises through {DEVOID_LEVEL:g} from the anode face"),
+    "accumulation_um": ("cathode", f"C_bar - 1 falls to {ACCUMULATION_FRACTION:.4g} (B1 - 1) from the "
+                                   "cathode face"),
+    "accumulation_half_um": ("cathode", f"C_bar - 1 falls to {ACCUMULATION_HALF_FRACTION:g} (B1 - 1) "
+                                        "from the cathode face"),
+}
+
+#: the paper's statements (section 6.1), micrometres
+PAPER_LAYERS = {
+    ("constant", "depletion"): 0.2, ("affine", "depletion"): 0.07,
+    ("constant", "accumulation"): 0.2, ("linear", "accumulation"): 2.0, ("affine", "accumulation"): 2.0,
+}
+
+
+def profile(model="constant", strip: Strip | None = None, material: Material = NAFION_LI):
+    """Full-BVP profiles (a :class:`ipmc_asym.bvp.solver.BVPResult`) at ``strip`` (default nominal)."""
+    from ipmc_asym.bvp.solver import solve
+
+    strip = Strip() if strip is None else strip
+    res = solve(strip, model, material)
+    if not res.success:
+        raise RuntimeError(f"BVP for the {model} profiles did not converge: {res.message}")
+    return res
+
+
+def _crossing(d, f, level):
+    """First distance ``d`` (increasing) where ``f - level`` changes sign (linear interp.)."""
+    g = f - level
+    s = np.nonzero(np.sign(g[:-1]) != np.sign(g[1:]))[0]
+    if s.size == 0:
+        return float("nan")
+    k = s[0]
+    if g[k + 1] == g[k]:
+        return float(d[k])
+    return float(d[k] + (d[k + 1] - d[k]) * (-g[k]) / (g[k + 1] - g[k]))
+
+
+def layer_widths(res, e: float) -> dict:
+    """The layer widths of :data:`LAYER_WIDTHS`, in micrometres, from a BVP profile.
+
+    Parameters
+    ----------
+    res : BVPResult (or anything with ``z``, ``C`` arrays of shape (n,), and ``groups.sign``)
+        Profiles on ``z_bar in [-1, 1]``; for a negative voltage (``groups.sign < 0``) the
+        anode is at ``z_bar = +1`` and the profile is mirrored first.
+    e : float
+        HALF thickness (m).
+
+    Returns
+    -------
+    dict
+        ``depletion_um``, ``devoid_um``, ``accumulation_um``, ``accumulation_half_um``
+        (NaN where the level is never crossed).
+    """
+    z, C = np.asarray(res.z, dtype=float), np.asarray(res.C, dtype=float)
+    if getattr(getattr(res, "groups", None), "sign", 1.0) < 0:
+        z, C = -z[::-1], C[::-1]
+    da = (z + 1.0) * e * 1e6  # from the anode, µm, increasing
+    dc = ((1.0 - z) * e * 1e6)[::-1]  # from the cathode, increasing
+    Cc = C[::-1] - 1.0
+    B1m1 = Cc[0]
+    return {"depletion_um": _crossing(da, C, DEPLETION_LEVEL),
+            "devoid_um": _crossing(da, C, DEVOID_LEVEL),
+            "accumulation_um": _crossing(dc, Cc, ACCUMULATION_FRACTION * B1m1),
+            "accumulation_half_um": _crossing(dc, Cc, ACCUMULATION_HALF_FRACTION * B1m1)}
+
+
+def profile_summary(model="constant", strip: Strip | None = None, material: Material = NAFION_LI,
+                    res=None) -> dict:
+    """Layer widths and face values of the profiles for one model (SI / µm / dimensionless).
+
+    Returns
+    -------
+    dict
+        ``model``, ``B1`` (= C_bar at the cathode), ``C_anode``, ``depletion_um``, ``devoid_um``,
+        ``accumulation_um``, ``accumulation_half_um``, ``D_face`` (D_bar at the faces, equal by
+        electroneutrality), ``D_core`` (|D_bar| max over the central half), ``p_anode``,
+        ``p_cathode``, ``E_anode``, ``E_cathode``, ``I``, ``cathode_charge`` (F B1 C_moy, C/m^3),
+        ``debye_um`` (core Debye length), ``e_um`` (HALF thickness), ``n_nodes``.
+    """
+    strip = Strip() if strip is None else strip
+    if res is None:
+        res = profile(model, strip, material)
+    e = strip.e
+    w = layer_widths(res, e)
+    g = res.groups
+    core = np.abs(res.z) < 0.5
+    out = {
+        "model": res.model,
+        "B1": float(res.B1),
+        "C_anode": float(res.C[0]),
+        **w,
+        "D_face": float(res.D[-1]),
+        "D_core": float(np.max(np.abs(res.D[core]))),
+        "p_anode": float(res.p[0]),
+        "p_cathode": float(res.p[-1]),
+        "E_anode": float(res.E[0]),
+        "E_cathode": float(res.E[-1]),
+        "I": float(res.I),
+        "cathode_charge": float(material.F * res.B1 * g.C_moy),
+        "debye_um": float(g.debye * e * 1e6),
+        "e_um": e * 1e6,
+        "n_nodes": int(res.n_nodes),
+    }
+    return out
+
+
+def write_csv(res, path, e: float):
+    """One row per mesh node: z_bar, z (m), distances from anode/cathode (m), and all profiles."""
+    with atomic_write(path) as fh:
+        wr = csv.writer(fh)
+        wr.writerow(["z_bar", "z_m", "dist_anode_m", "dist_cathode_m", "C_bar", "phi_bar", "D_bar",
+                     "E_bar", "rhoZ_bar", "p_bar"])
+        for i in range(len(res.z)):
+            z = float(res.z[i])
+            wr.writerow([f"{z:.17g}", f"{z * e:.10g}", f"{(z + 1) * e:.10g}", f"{(1 - z) * e:.10g}",
+                         f"{res.C[i]:.12g}", f"{res.phi[i]:.12g}", f"{res.D[i]:.12g}",
+                         f"{res.E[i]:.12g}", f"{res.rhoZ[i]:.12g}", f"{res.p[i]:.12g}"])
+
+
+def compute_all(models=model_names(), strip: Strip | None = None, material: Material = NAFION_LI):
+    strip = Strip() if strip is None else strip
+    return {m: profile(m, strip, material) for m in models}

@@ -1,0 +1,1 @@
+"""The paper's claims against the toolkit's numbers: criteria, claims and the report."""
