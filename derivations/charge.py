@@ -1,4 +1,4 @@
-"""Electrode charge, differential capacitance and the small-signal response (issue 11).
+"""Electrode charge, differential capacitance and the small-signal response.
 
 Seed paper section 4: Gauss's law ``dD_z/dz = rho Z``, ``D_z = eps E_z``; blocking electrodes
 carry the surface charge ``sigma = D_z(-e)`` (anode face, where ``phi0`` is applied; the

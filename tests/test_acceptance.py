@@ -1,4 +1,4 @@
-"""Issue 9 acceptance: a CLI fuzz test and the thickness x voltage x model grid against the BVP."""
+"""Acceptance: a CLI fuzz test and the thickness x voltage x model grid against the BVP."""
 
 import contextlib
 import io

@@ -1,4 +1,4 @@
-"""Static electrode charge and capacitance (issue 11): exact limits, the BVP, the derivation."""
+"""Static electrode charge and capacitance: exact limits, the BVP, the derivation."""
 
 import math
 

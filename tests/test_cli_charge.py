@@ -1,4 +1,4 @@
-"""The charge/step/freq commands as a user runs them (issue 11)."""
+"""The charge/step/freq commands as a user runs them."""
 
 import csv
 import json

@@ -142,7 +142,7 @@ def _reference_ode(model, th, v):
 @pytest.mark.parametrize("th,v", [(1e-6, 20.0), (1e-6, -20.0), (1e-6, 1.0), (1.5e-6, -5.0)])
 def test_against_independent_ode_reference_thin(model, th, v):
     """Overlapping layers / non-neutral core (1-1.5 um); at 1 um +-20 V (constant) the BVP
-    reports failure (issue 9).  Measured: within 5e-12 of this reference, which is itself the
+    reports failure.  Measured: within 5e-12 of this reference, which is itself the
     less accurate of the two (3e-13 - 5e-12 from its quad/ODE tolerances)."""
     ref = _reference_ode(model, th, v)
     got = ia.moment_integral(th, v, model, "exact")

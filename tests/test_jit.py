@@ -17,9 +17,30 @@ def test_cache_key_covers_every_jitted_module():
 
 def test_flags_set_in_one_place():
     root = Path(ipmc_asym.__file__).parent
-    offenders = [p.name for p in root.rglob("*.py") if p.name != "_jit.py"
+    offenders = [p.name for p in root.rglob("*.py") if p.resolve() != Path(_jit.__file__).resolve()
                  and re.search(r"numba\.(n)?jit\(|@(nb|numba)\.(n)?jit", p.read_text())]
     assert offenders == []
+
+
+def test_import_leaves_the_users_numba_and_matplotlib_settings():
+    """Importing the package, compiling a kernel and drawing a figure change no setting of
+    the user's process: Numba's cache directory and matplotlib's backend stay as they were."""
+    code = (
+        "import matplotlib, numba; matplotlib.use('svg'); before = (numba.config.CACHE_DIR, matplotlib.get_backend());"
+        "import ipmc_asym as ia, ipmc_asym.plotting as pl; ia.moment_integral(2e-4, 1.0, fidelity='leading');"
+        "fig, ax = pl.pyplot().subplots(); ax.plot([0, 1]);"
+        "after = (numba.config.CACHE_DIR, matplotlib.get_backend()); print(before == after, before, after)"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.startswith("True"), out.stdout
+
+
+def test_compiled_code_is_cached_in_the_package_cache_dir():
+    """The per-function cache puts the compiled kernels under ``CACHE_DIR`` (not numba.config's)."""
+    from ipmc_asym.kernels.closed import moment_closed
+
+    assert moment_closed._cache._impl.locator.get_cache_path().startswith(_jit.CACHE_DIR)
 
 
 # --------------------------------------------------------------------------------------

@@ -1,5 +1,5 @@
 """Charging transient: PNP solver (conservation, energy, convergence, long time), reduced model,
-small-signal response (issue 11)."""
+small-signal response."""
 
 import math
 
@@ -56,6 +56,7 @@ def test_long_time_limit_is_the_static_charge():
         assert r.M_A_profiles[-1] == pytest.approx(Ms, rel=5e-3)
 
 
+@pytest.mark.slow
 def test_mesh_self_convergence():
     """Whole-mesh refinement by 2: second-order convergence to the static charge, and sigma(tau) settles."""
     t = np.array([0.0, TAU, 30 * TAU])
@@ -166,8 +167,5 @@ def test_charge_claims_rows_follow_their_criteria():
     for m in ("constant", "linear", "affine"):
         lam = float(debye_length(S0.thickness, MODELS[m].eps_moy, NAFION_LI))
         assert e0[m] == pytest.approx(MODELS[m].eps_moy / lam, rel=1e-9)
-    ok = all(1e-4 <= e0[m] <= 1e-2 for m in ("linear", "affine"))
-    assert cap["verdict"] == ("reproduced" if ok else "differs")
-    tau = tim["numbers"]["tau"]["constant"]
-    assert tau == pytest.approx(TAU)
-    assert tim["verdict"] == ("reproduced" if 1 / 3 <= tau <= 3 else "differs")
+    # tau against the test's own formula; the verdicts are pinned in the validate golden file
+    assert tim["numbers"]["tau"]["constant"] == pytest.approx(TAU)

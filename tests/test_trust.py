@@ -1,4 +1,4 @@
-"""Issue 9: never a wrong number as a result, one-line failures, bounded memory, atomic output.
+"""Never a wrong number as a result, one-line failures, bounded memory, atomic output.
 
 Each reproducer of the issue has a test here; references are independent of the code path
 under test (the BVP, the quadrature, an independent solver's number, exact limits).
@@ -36,7 +36,7 @@ def _one_line_error(err: str):
 
 
 # ---------------------------------------------------------------------------------------
-# 9.1: every public name is what its documentation says, whatever was imported before
+# every public name is what its documentation says, whatever was imported before
 # ---------------------------------------------------------------------------------------
 def test_public_names_after_importing_every_submodule():
     for mod in pkgutil.walk_packages(ipmc_asym.__path__, "ipmc_asym."):
@@ -57,7 +57,7 @@ def test_public_names_after_importing_every_submodule():
 
 
 # ---------------------------------------------------------------------------------------
-# 9.2-9.4: reproducers
+# reproducers of wrong numbers
 # ---------------------------------------------------------------------------------------
 def test_bvp_at_minus_18_4_volts_no_overflow():
     I = moment_integral(2e-4, -18.4, "constant", "bvp")
@@ -77,7 +77,7 @@ def test_cli_bvp_at_minus_19_volts(capsys):
 
 @pytest.mark.parametrize("v", [20.0, -20.0])
 def test_bvp_converges_at_1um_20V_constant(v):
-    """Independent solver (issue 9): I = 0.10324... at total thickness 1 um, 20 V."""
+    """Independent solver: I = 0.10324... at total thickness 1 um, 20 V."""
     from ipmc_asym.bvp.solver import solve
 
     r = solve(Strip(thickness=1e-6, voltage=v), "constant")
@@ -102,11 +102,12 @@ def test_1nm_refused_in_one_line(capsys):
     assert "thickness" in err and "bvp" not in err.lower().split("error:")[1][:40]
     with pytest.raises(ValueError, match="MIN_THICKNESS"):
         moment(1e-9, 1.0, "constant", "bvp")
-    assert MIN_THICKNESS == pytest.approx(1e-7)
+    # just above the documented floor the BVP answers (the floor is where the refusal starts)
+    assert bool(moment(1.2 * MIN_THICKNESS, 1.0, "constant", "bvp").valid)
 
 
 # ---------------------------------------------------------------------------------------
-# 9.5-9.6: checks, error bounds
+# checks, error bounds
 # ---------------------------------------------------------------------------------------
 def test_valid_covers_strain_and_beam_regime():
     s = Strip(voltage=1000.0)
@@ -148,7 +149,7 @@ def test_corrected_valid_at_10um(model):
     ref = moment_integral_bvp(10e-6, 1.0, model)
     actual = abs(float(c.I) / ref - 1)
     assert actual <= float(c.error)  # a bound...
-    assert float(c.error) <= 100 * max(actual, 1e-11)  # ...no longer overstated by ~e^19 = 2e8
+    assert float(c.error) <= 100 * max(actual, 1e-11)  # the core width counts the layers: no e^19 = 2e8 overstatement
     # valid exactly where the bound is under the rung's ceiling (above it, exact takes over)
     assert bool(c.valid) == (float(c.error) < validity_limit("corrected"))
 
@@ -161,17 +162,15 @@ def test_evaluate_rejects_bad_tol():
 
 def test_escalation_is_generic_over_the_registry(monkeypatch):
     """A rung added to registry.FIDELITIES is climbed without code change (e.g. 'exact')."""
-    import ipmc_asym.base.registry as registry
     from ipmc_asym.forward.estimate import moment_escalating
 
     r = moment_escalating([1e-7, 2e-4], 1.0, "constant", fidelity_names()[0])
     first_valid = next(f for f in fidelity_names() if bool(moment(1e-7, 1.0, "constant", f).valid))
     assert list(r.fidelity_used) == [first_valid, "leading"]
-    assert registry.fidelity_names() == tuple(registry.FIDELITIES)
 
 
 # ---------------------------------------------------------------------------------------
-# 9.7-9.9: sweeps in chunks, paths, atomic files, Ctrl-C
+# sweeps in chunks, paths, atomic files, Ctrl-C
 # ---------------------------------------------------------------------------------------
 def test_iter_sweep_chunks_equal_the_in_memory_sweep(tmp_path):
     from ipmc_asym.studies.sweeps import iter_sweep, sweep, write_csv
@@ -250,7 +249,7 @@ def test_sweep_memory_does_not_grow_with_rows():
 
 
 # ---------------------------------------------------------------------------------------
-# 9.10-9.17: friction
+# friction
 # ---------------------------------------------------------------------------------------
 @pytest.mark.parametrize("argv", [
     ["estimate", "--voltage", "-1V", "--model", "constant", "--fidelity", "leading", "--json"],
@@ -368,7 +367,7 @@ def test_atomic_files_get_the_usual_permissions(tmp_path):
 
 
 def test_voltage_beyond_the_validated_range_is_never_silent(capsys):
-    """9.5: at 1000 V the linear model used to print a clean table."""
+    """At 1000 V (beyond the validated range) the result carries the warning."""
     from ipmc_asym.base.settings import VALIDATED_VOLTAGE
 
     assert main(["estimate", "--model", "linear", "--voltage", f"{50 * VALIDATED_VOLTAGE:g}V"]) in (0, 2)

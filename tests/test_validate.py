@@ -5,6 +5,7 @@ import json
 import math
 import re
 from dataclasses import replace
+from pathlib import Path
 
 import pytest
 
@@ -132,3 +133,22 @@ def test_cli_json_and_markdown(capsys, tmp_path):
     for r in d["claims"]:
         assert {"claim", "section", "paper", "ours", "verdict", "criterion", "key"} <= set(r)
     assert out.read_text().count("\n| ") == len(CLAIMS) + 1  # header + one row per claim
+
+
+# --- golden verdicts: a change of verdict is a reviewed diff ---------------------------------
+GOLDEN = Path(__file__).resolve().parent / "golden" / "validate_verdicts.json"
+
+
+def test_verdicts_match_the_golden_file(rows, request):
+    """Every claim's verdict as pinned in ``tests/golden/validate_verdicts.json``.
+
+    ``pytest --update-golden tests/test_validate.py`` rewrites the file; the diff is then
+    reviewed like a change of code (as ``ipmc-asym derive --check`` does for the kernels)."""
+    now = {k: r["verdict"] for k, r in sorted(rows.items())}
+    if request.config.update_golden:
+        text = json.dumps(now, indent=1, sort_keys=True) + "\n"
+        GOLDEN.write_text(text, encoding="utf-8")
+        pytest.skip("golden file rewritten")
+    pinned = json.loads(GOLDEN.read_text(encoding="utf-8"))
+    changed = {k: (pinned.get(k), now.get(k)) for k in set(pinned) | set(now) if pinned.get(k) != now.get(k)}
+    assert not changed, f"verdicts changed (pinned, now): {changed}; rerun with --update-golden if intended"

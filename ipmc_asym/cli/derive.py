@@ -14,7 +14,7 @@ def register(sub):
 
 def run(args):
     try:
-        import derivations.__main__ as dm  # deferred: SymPy (start-up of the other commands)
+        import ipmc_asym_derivations.__main__ as dm  # deferred: SymPy (start-up of the other commands)
     except ImportError:
         raise UsageError("the derivations/ package is not importable (run from a source checkout)") from None
     argv = (["--check"] if args.check else []) + (["--print"] if args.print else [])

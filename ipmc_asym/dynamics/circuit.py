@@ -1,4 +1,4 @@
-"""Reduced charging model and small-signal response (issue 11).
+"""Reduced charging model and small-signal response.
 
 Matched asymptotics of the transient Nernst-Planck/Gauss problem (``ipmc_asym.dynamics.transient``):
 the two electrode layers stay quasi-static (each in its static state for the charge it

@@ -1,4 +1,4 @@
-"""Static electrode charge and differential capacitance at every fidelity (issue 11).
+"""Static electrode charge and differential capacitance at every fidelity.
 
 Gauss's law with blocking electrodes (seed paper section 4): the face ``z = -e`` (where
 ``phi0`` is applied) carries the surface charge ``sigma = D_z(-e)`` per unit area, the face

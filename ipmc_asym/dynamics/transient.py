@@ -1,4 +1,4 @@
-"""Transient Nernst-Planck/Gauss solver across the thickness (the dynamic cross-check, issue 11).
+"""Transient Nernst-Planck/Gauss solver across the thickness (the dynamic cross-check).
 
 Seed paper eq. "Nernst" with the pressure term neglected (as in §5) and the solvent at rest
 (``V2 = 0``), Gauss's law with ``eps(C)`` (affine models), blocking electrodes, imposed

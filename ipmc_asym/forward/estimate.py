@@ -4,7 +4,7 @@
 (:mod:`ipmc_asym.beam.statics`).  Signs as in the paper: a positive voltage gives ``M_A > 0``,
 ``theta < 0`` and ``w < 0``.
 
-The rule (issue 9): no number whose validity check failed is returned as a result.
+The rule: no number whose validity check failed is returned as a result.
 :func:`moment_escalating` climbs the fidelity ladder (``registry.FIDELITIES``, cheapest
 first, whatever rungs it holds) point by point from the requested rung to the cheapest one
 that is valid there; :func:`evaluate` adds the beam and the four checks

@@ -20,41 +20,13 @@ import json
 
 import numpy as np
 
+from ipmc_asym.base.quantities import BY_NAME
 from ipmc_asym.io.fileio import atomic_path, check_output_path
 
 __all__ = ["VARIABLES", "sweep_dataset", "uq_dataset", "netcdf_engine", "available_engines", "write_netcdf"]
 
-#: name -> (units, long_name) of every coordinate and output the builders know
-VARIABLES = {
-    "length": ("m", "strip length L"),
-    "width": ("m", "total width 2l"),
-    "thickness": ("m", "total thickness 2e"),
-    "voltage": ("V", "voltage phi0 (sign = bending direction)"),
-    "modulus": ("Pa", "Young's modulus E"),
-    "c_moy": ("mol/m^3", "mean cation concentration C_moy"),
-    "I": ("1", "moment integral I (dimensionless)"),
-    "M_A": ("N m", "bending moment M_A"),
-    "moment": ("N m", "bending moment M_A"),
-    "theta": ("rad", "free-end rotation theta"),
-    "rotation": ("rad", "free-end rotation theta"),
-    "w": ("m", "tip deflection w (large displacement)"),
-    "tip_deflection": ("m", "tip deflection w (large displacement)"),
-    "w_small": ("m", "tip deflection w_p (small displacement)"),
-    "F_block": ("N", "blocking force (large displacement)"),
-    "blocking_force": ("N", "blocking force F"),
-    "F_block_small": ("N", "blocking force 3 M_A/(2 L) (small displacement)"),
-    "B1": ("1", "cathode concentration C(e)/C_moy"),
-    "error": ("1", "relative error estimate of I"),
-    "valid": ("1", "fidelity within its validity (1) or not (0)"),
-    "regime": ("", "beam regime (small, large, past-quarter-turn, multi-turn)"),
-    "max_strain": ("1", "largest bending strain e|kappa|"),
-    "fidelity_used": ("", "fidelity the point was computed at (after escalation)"),
-    "escalated": ("1", "escalated above the requested fidelity (1) or not (0)"),
-    "check_electrochemistry": ("1", "check: a valid rung of the fidelity ladder (1) or none (0)"),
-    "check_layer_separation": ("1", "check: electrode layers separated by a neutral core"),
-    "check_beam_regime": ("1", "check: free strip within a quarter turn"),
-    "check_strain": ("1", "check: bending strain within the small-strain limit"),
-}
+#: name -> (units, long_name) of every coordinate and output the builders know (the vocabulary)
+VARIABLES = {name: (q.unit, q.long_name) for name, q in BY_NAME.items()}
 _SWEEP_OUT = ("I", "M_A", "theta", "w", "w_small", "F_block", "F_block_small", "B1", "error", "max_strain",
               "fidelity_used", "escalated", "regime", "check_electrochemistry", "check_layer_separation",
               "check_beam_regime", "check_strain", "valid")

@@ -1,6 +1,6 @@
 """A reference loop for the bench: what "a loop of 7 transcendental calls" costs per point.
 
-Issue 10 states the cost of the closed-form kernels against this yardstick (``leading``
+The bench states the cost of the closed-form kernels against this yardstick (``leading``
 <= 1.5x, ``corrected`` <= 2.0x, API included).  The loop reads two inputs per point and makes
 seven independent libm calls (``exp``, ``log``, ``expm1``, ``log1p``, ``exp``, ``log``,
 ``expm1``) -- independent, so the processor overlaps them: the fastest way of spending seven

@@ -1,4 +1,4 @@
-"""Figures of issue 11: sigma(phi0) and C_d(phi0) per model, a step response, a Bode plot."""
+"""Charge figures: sigma(phi0) and C_d(phi0) per model, a step response, a Bode plot."""
 
 from __future__ import annotations
 

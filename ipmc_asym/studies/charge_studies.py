@@ -2,7 +2,7 @@
 
 :func:`charge_claims` returns rows in the format of :mod:`ipmc_asym.validation.validate` (``claim``,
 ``section``, ``paper``, ``ours``, ``verdict``, ``key``) plus a ``criterion`` string and the
-computed ``numbers``.  :func:`bench_charge` returns the three measurements of issue 11
+computed ``numbers``.  :func:`bench_charge` returns the three charge measurements
 (closed-form ``charge`` ns/point, ``step --fidelity circuit`` for 1000 points, ``step
 --fidelity pnp`` at nominal) measured side by side in one run.
 """
@@ -21,7 +21,7 @@ __all__ = ["charge_claims", "bench_charge", "bench_section", "BENCH_TARGETS"]
 
 MODELS3 = ("constant", "linear", "affine")
 
-#: issue 11 targets
+#: targets of the charge bench
 BENCH_TARGETS = {"charge_ns_per_point": 200.0, "step_circuit_1000_s": 10e-3, "step_pnp_nominal_s": 30.0}
 
 

@@ -46,7 +46,7 @@ def law_table(model=None):
     """Leading-order laws from the derivation: list of dict rows (SymPy objects stringified)."""
     import sympy as sp
 
-    from derivations import scaling
+    from ipmc_asym_derivations import scaling
 
     rows = []
     for r in scaling.laws():
@@ -103,6 +103,6 @@ def law_ranges(model):
 
 def factor_three() -> dict:
     """Ratio of the section 3-4 prefactors of theta, w_p, F^p to the section 6.2 ones (SymPy)."""
-    from derivations import scaling  # deferred: SymPy (start-up)
+    from ipmc_asym_derivations import scaling  # deferred: SymPy (start-up)
 
     return {k: str(v) for k, v in scaling.factor_three().items()}

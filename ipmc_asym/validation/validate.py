@@ -538,7 +538,7 @@ def _none(why):
 
 
 def _charge_claim(key):
-    """Ours for the charge claims of issue 11 (:func:`ipmc_asym.studies.charge_studies.charge_claims`)."""
+    """Ours for the charge claims (:func:`ipmc_asym.studies.charge_studies.charge_claims`)."""
 
     def f(ctx):
         from ipmc_asym.studies.charge_studies import charge_claims
@@ -647,7 +647,7 @@ CLAIMS = (
     Claim("affine_zero", "§6.3", "affine model: the curves do not tend to 0 as phi0 -> 0", None, _affine_zero,
           Criterion("at_least", 0.5, "a nonzero limit leaves M_A nearly unchanged when phi0 -> phi0/10 near 0; "
                     "M_A ~ phi0 scales it by the same factor")),
-    # issue 11: what a capacitance measurement and a step would show
+    # what a capacitance measurement and a step would show
     Claim("capacitance_permittivity", "§5",
           "permittivity deduced from capacitance measurements ~{} F/m, of the order of the linear/affine values",
           1e-3, _charge_claim("capacitance_permittivity"),

@@ -1,0 +1,100 @@
+"""The output vocabulary: every input and output quantity with its unit, long name and, for
+lengths across the strip, which thickness or width is meant.
+
+One table (:data:`QUANTITIES`) that the text tables, CSV headers, JSON, NetCDF attributes and
+plot labels read.  A quantity has its result-row name (``w``, ``F_block``, the keys of JSON
+rows and CSV columns) and may have a scene-file name (``tip_deflection``, ``blocking_force``,
+the names of scene and UQ outputs and of ``design`` specs); both name the same entry.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+__all__ = ["Quantity", "QUANTITIES", "BY_NAME", "quantity", "unit_and_long_name", "axis_label", "markdown_table"]
+
+
+class Quantity(NamedTuple):
+    """One quantity of the vocabulary.
+
+    Attributes
+    ----------
+    name : str          result-row name (JSON key, CSV column, NetCDF variable)
+    unit : str          SI unit ("1": dimensionless, "": no unit, e.g. a label)
+    long_name : str     what it is, in words (NetCDF ``long_name``, plot labels)
+    scene_name : str or None   name in scene files, UQ and design specs, where it has one
+    extent : str or None       for a length across the strip: "total 2e", "total 2l" (never the half)
+    """
+
+    name: str
+    unit: str
+    long_name: str
+    scene_name: str | None = None
+    extent: str | None = None
+
+
+QUANTITIES = (
+    # inputs
+    Quantity("length", "m", "strip length L"),
+    Quantity("width", "m", "total width 2l", extent="total 2l"),
+    Quantity("thickness", "m", "total thickness 2e", extent="total 2e"),
+    Quantity("voltage", "V", "voltage phi0 (sign = bending direction)"),
+    Quantity("modulus", "Pa", "Young's modulus E"),
+    Quantity("c_moy", "mol/m^3", "mean cation concentration C_moy"),
+    # outputs (paper eqs (6), (12)-(15), (27))
+    Quantity("I", "1", "moment integral I (dimensionless)", scene_name="I"),
+    Quantity("M_A", "N m", "bending moment M_A", scene_name="moment"),
+    Quantity("theta", "rad", "free-end rotation theta", scene_name="rotation"),
+    Quantity("w", "m", "tip deflection w (large displacement)", scene_name="tip_deflection"),
+    Quantity("w_small", "m", "tip deflection w_p (small displacement)"),
+    Quantity("x_tip", "m", "tip position along the clamp axis (large displacement)"),
+    Quantity("y_tip", "m", "tip position across the clamp axis (large displacement)"),
+    Quantity("F_block", "N", "blocking force F (large displacement)", scene_name="blocking_force"),
+    Quantity("F_block_small", "N", "blocking force 3 M_A/(2 L) (small displacement)"),
+    Quantity("B1", "1", "cathode concentration C(e)/C_moy"),
+    Quantity("error", "1", "relative error estimate of I"),
+    Quantity("error_estimate", "1", "relative error estimate of I"),
+    Quantity("max_strain", "1", "largest bending strain e|kappa|"),
+    Quantity("debye_length", "m", "Debye length of the neutral core"),
+    # bookkeeping of a row
+    Quantity("valid", "1", "every check passed (1) or not (0)"),
+    Quantity("regime", "", "beam regime (small, large, past-quarter-turn, multi-turn)"),
+    Quantity("fidelity_used", "", "fidelity the point was computed at (after escalation)"),
+    Quantity("escalated", "1", "escalated above the requested fidelity (1) or not (0)"),
+    Quantity("check_electrochemistry", "1", "check: a valid rung of the fidelity ladder (1) or none (0)"),
+    Quantity("check_layer_separation", "1", "check: electrode layers separated by a neutral core"),
+    Quantity("check_beam_regime", "1", "check: free strip within a quarter turn"),
+    Quantity("check_strain", "1", "check: bending strain within the small-strain limit"),
+)
+
+#: every name (result-row name and scene name) -> its quantity
+BY_NAME = {**{q.name: q for q in QUANTITIES}, **{q.scene_name: q for q in QUANTITIES if q.scene_name}}
+
+
+def quantity(name: str) -> Quantity:
+    """The quantity called ``name`` (row or scene name); ``ValueError`` listing the names if unknown."""
+    try:
+        return BY_NAME[name]
+    except KeyError:
+        raise ValueError(f"unknown quantity {name!r}; known: {', '.join(BY_NAME)}") from None
+
+
+def unit_and_long_name(name: str) -> tuple[str, str]:
+    """``(unit, long_name)`` of ``name``; ``("", name)`` for a name outside the vocabulary."""
+    q = BY_NAME.get(name)
+    return (q.unit, q.long_name) if q else ("", name)
+
+
+def axis_label(name: str, unit: str | None = None) -> str:
+    """Plot label: long name and unit (``unit`` overrides the SI unit, e.g. "mm")."""
+    u, ln = unit_and_long_name(name)
+    u = u if unit is None else unit
+    return ln if u in ("", "1") else f"{ln} [{u}]"
+
+
+def markdown_table() -> str:
+    """The vocabulary as a Markdown table (the one in ``docs/design.md``)."""
+    lines = ["| name | scene name | unit | meaning |", "|---|---|---|---|"]
+    for q in QUANTITIES:
+        lines.append(f"| `{q.name}` | {('`' + q.scene_name + '`') if q.scene_name else ''} | {q.unit} | {q.long_name} |")
+    return "\n".join(lines)

@@ -1,0 +1,43 @@
+"""The output vocabulary: one table, read by the datasets and documented in design.md."""
+
+import re
+from pathlib import Path
+
+import pytest
+
+from ipmc_asym.base.quantities import BY_NAME, QUANTITIES, axis_label, markdown_table, quantity
+from ipmc_asym.io.datasets import VARIABLES
+from ipmc_asym.studies.scene_schema import OUTPUTS
+from ipmc_asym.studies.sweeps import DTYPE
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def test_design_document_shows_the_table():
+    text = (ROOT / "docs" / "design.md").read_text(encoding="utf-8")
+    block = re.search(r"<!-- vocabulary -->\n(.*?)\n<!-- /vocabulary -->", text, re.S)
+    assert block and block.group(1) == markdown_table()
+
+
+def test_every_sweep_column_and_scene_output_has_an_entry():
+    missing = [c for c in DTYPE.names if c not in BY_NAME and c not in ("model", "fidelity")]
+    missing += [o for o in OUTPUTS if o not in BY_NAME and o not in ("profiles", "scaling_fit")]
+    assert not missing, missing
+
+
+def test_names_are_unique_and_datasets_read_the_table():
+    names = [q.name for q in QUANTITIES] + [q.scene_name for q in QUANTITIES if q.scene_name not in (None, q.name)]
+    assert len(names) == len(set(names))
+    for n, q in BY_NAME.items():
+        assert VARIABLES[n] == (q.unit, q.long_name)
+
+
+def test_lengths_across_the_strip_say_total():
+    assert "total" in quantity("thickness").long_name and "2e" in quantity("thickness").long_name
+    assert "total" in quantity("width").long_name and "2l" in quantity("width").long_name
+
+
+def test_unknown_name_lists_the_known_ones():
+    with pytest.raises(ValueError, match="known: length"):
+        quantity("deflection_of_the_moon")
+    assert axis_label("tip_deflection", "mm") == "tip deflection w (large displacement) [mm]"
