@@ -5,16 +5,16 @@ from __future__ import annotations
 import argparse
 import sys
 
+from . import codegen, model
+
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m derivations", description=__doc__)
     ap.add_argument("--check", action="store_true", help="regenerate into a temp dir; exit 1 on any difference")
     ap.add_argument("--print", action="store_true", help="print the derivation summary (first integral, B1, laws)")
     args = ap.parse_args(argv)
-    from . import codegen
 
     if args.print:
-        from . import model
 
         model.main()
         if not args.check:  # printing never rewrites the kernels (e.g. inside site-packages)

@@ -40,6 +40,7 @@ import sympy as sp
 
 from . import model as M
 from .kernel import Kernel
+from .kernels_spec import MODEL_RHO
 
 # ---- symbols -------------------------------------------------------------------------
 Y, y, A2, rho, lam = M.Y, M.y, M.A2, M.rho, M.lam
@@ -142,7 +143,6 @@ def large_voltage():
 
 def large_voltage_sigma(model: str):
     """(Dhat_inf(A2), dDhat_inf/dA2) for one model (rho fixed), SymPy expressions in A2."""
-    from .kernels_spec import MODEL_RHO
 
     d2, Bs, b_inf = large_voltage()
     r = MODEL_RHO[model]
@@ -152,7 +152,6 @@ def large_voltage_sigma(model: str):
 
 def debye_hueckel_series(model: str, order: int = 5):
     """Series of Dhat(ln B1(A2)) in A2 about 0 (B1 from the exact electroneutrality)."""
-    from .kernels_spec import MODEL_RHO
 
     r = MODEL_RHO[model]
     q, a, b, c = M.b1_quadratic_rho()
@@ -218,7 +217,6 @@ def small_signal_kernels():
 
 def kernels():
     """Charge kernels: layer capacitance (generic and per model) and the series capacitance."""
-    from .kernels_spec import MODEL_RHO
 
     chat = layer_capacitance()
     ks = [Kernel("layer_capacitance", (y, rho), (chat,),

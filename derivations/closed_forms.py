@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import mpmath as mp
 import sympy as sp
+from sympy.codegen.cfunctions import expm1
 
 from . import model as M
 from .kernel import Kernel
@@ -248,7 +249,6 @@ def kernels():
 
 
 def _kernels():
-    from sympy.codegen.cfunctions import expm1
 
     ks, consts = [], {}
     Y = M.Y

@@ -13,9 +13,10 @@ import sys
 from pathlib import Path
 
 import sympy as sp
+from sympy.printing.numpy import NumPyPrinter
 from sympy.printing.pycode import PythonCodePrinter
 
-from . import exact, kernels_spec
+from . import charge, exact, kernels_spec
 from .kernel import Kernel
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -129,7 +130,7 @@ def render_horner(spec: dict) -> str:
         if name.startswith("patch_"):
             n0, n1 = n
             out += ["", "", "@jit", f"def {name}(t0, t1, row, h):",
-                    f'    """(W0, W1) from row ``row`` of the patch tables ``t0``, ``t1`` at ``h = Y - centre``:',
+                    '    """(W0, W1) from row ``row`` of the patch tables ``t0``, ``t1`` at ``h = Y - centre``:',
                     f'    {n0} and {n1} coefficients, unrolled Horner."""',
                     "    a = t0[row]", "    b = t1[row]"]
             out += _horner_lines("w0", "a", n0, "h") + _horner_lines("w1", "b", n1, "h")
@@ -232,7 +233,6 @@ from ipmc_asym.kernels.special import e2rel, exprel  # noqa: F401
 
 def render_numpy_function(name, args, expr, doc, source) -> str:
     """A vectorised (complex-capable) NumPy function, not jitted."""
-    from sympy.printing.numpy import NumPyPrinter
 
     pr = NumPyPrinter({"fully_qualified_modules": True})
     temps = sp.numbered_symbols("t")
@@ -245,7 +245,6 @@ def render_numpy_function(name, args, expr, doc, source) -> str:
 
 
 def build_charge_source() -> str:
-    from . import charge
 
     body = CHARGE_HEADER.format(ver=sp.__version__)
     for k in sorted(charge.kernels(), key=lambda k: k.name):

@@ -37,8 +37,10 @@ be neutral and the layers may overlap.  From ``model.py`` (seed paper section 4,
 from __future__ import annotations
 
 import sympy as sp
+from sympy.codegen.cfunctions import expm1
 
 from . import model as M
+from .kernel import Kernel
 
 v, t2, kappa, kappa2 = sp.symbols("v t2 kappa kappa2", positive=True)
 Qs = sp.Symbol("Q", positive=True)  # Qhat(y) as a placeholder
@@ -151,7 +153,6 @@ def integrands():
     In the core (``|y| <= 1/2``) ``Qhat - 1`` comes from :func:`qm1_series` and
     ``ehat = 1 + (1 - rho) expm1(y)`` (one transcendental call per node).
     """
-    from sympy.codegen.cfunctions import expm1
 
     Fv = core_change_of_variable()
     gv, gy = ell_derivatives()
@@ -170,7 +171,6 @@ def integrands():
 def outer_split():
     """``F_y, G_y`` from ``(ehat, s2 = y^2 Qhat)`` and ``kappa^2``: the y-nodes do not move with
     ``kappa``, so ``ehat`` and ``s2`` are computed once per point and only this part per Newton step."""
-    from sympy.codegen.cfunctions import expm1
 
     e, s2 = sp.symbols("ehat s2", positive=True)
     _, _, Fy, Gy = integrands()
@@ -243,7 +243,6 @@ if __name__ == "__main__":
 
 def kernels():
     """The kernels of ``ipmc_asym/kernels/_generated_exact.py``."""
-    from .kernel import Kernel
 
     F, G, Fy, Gy = integrands()
     src = "derivations.exact:integrands"

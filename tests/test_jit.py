@@ -95,7 +95,7 @@ def test_interpreted_twins_call_twins_not_dispatchers():
 def test_estimate_interprets_a_few_points_and_loads_nothing_compiled():
     """``estimate`` (one-shot) runs its three points interpreted: no compiled driver is loaded
     (that load is what made start-up 2.6x ``import numba``); ``--compiled`` loads it; same output."""
-    code = ("import sys; from ipmc_asym.cli import main; from ipmc_asym import integral; "
+    code = ("import sys; from ipmc_asym.cli import main; import ipmc_asym.integral.api as integral; "
             "rc = main(['estimate', '--fidelity', 'leading', '--json'] + sys.argv[1:]); "
             "sys.stderr.write('LOADED %d' % len(integral._sweep_fused.signatures))")
     out = {}

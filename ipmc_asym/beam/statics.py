@@ -64,10 +64,15 @@ in ``M``; past a full turn (``|theta| > 2 pi``) ``w`` is periodic in ``M``
 from __future__ import annotations
 
 import functools
+import hashlib
 import math
+import os
+import tempfile
 from dataclasses import dataclass, field
 
 import numpy as np
+
+from ipmc_asym.kernels.jit import CACHE_DIR
 
 __all__ = [
     "KL_BLOCK_MAX",
@@ -475,10 +480,7 @@ def _interp_lagrange(x, xs, ys, q=_INTERP_POINTS):
 
 def _branch_table_path():
     """Disk cache of the branch table, beside the Numba cache and keyed on this file."""
-    import hashlib
-    import os
 
-    from ipmc_asym.kernels.jit import CACHE_DIR
 
     with open(__file__, "rb") as fh:
         h = hashlib.sha256(fh.read()).hexdigest()[:16]
@@ -509,8 +511,6 @@ def _branch_table():
     A damaged or foreign file is ignored and rewritten; the cache is written atomically
     (temporary file + rename), and a read-only cache directory only costs the recomputation.
     """
-    import os
-    import tempfile
 
     path = _branch_table_path()
     n = int(math.ceil(KL_BLOCK_MAX / _TABLE_STEP)) + 1

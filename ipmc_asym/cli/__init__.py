@@ -11,6 +11,7 @@ from __future__ import annotations
 import importlib
 import sys
 
+from ipmc_asym import __version__
 from ipmc_asym.cli.common import Parser, UsageError, join_negative_values
 
 __all__ = ["main", "build_parser", "COMMANDS", "UsageError"]
@@ -56,7 +57,6 @@ SUMMARIES = {
 
 def build_parser(only: str | None = None):
     """The parser: the full options of command ``only`` (its module imported), the others listed."""
-    from ipmc_asym import __version__
 
     ap = Parser(prog="ipmc-asym", description="Electromechanics of IPMC strips (Tixier & Pouget model).")
     ap.add_argument("--version", action="version", version=f"ipmc-asym {__version__}")

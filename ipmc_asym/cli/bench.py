@@ -3,10 +3,10 @@
 from __future__ import annotations
 
 from ipmc_asym.bench.suite import format_table, run_bench
-from ipmc_asym.io.fileio import check_output_path
-from ipmc_asym.io.jsonio import dumps
 from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import count_type
+from ipmc_asym.io.fileio import check_output_path
+from ipmc_asym.io.jsonio import dumps
 
 
 def register(sub):

@@ -2,13 +2,13 @@
 
 from __future__ import annotations
 
-from ipmc_asym.dynamics.electrode import charge
-from ipmc_asym.forward.estimate import model_list
-from ipmc_asym.io.jsonio import dumps
 from ipmc_asym.base.registry import fidelity_names, model_choices
 from ipmc_asym.base.units import fmt_length
 from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import add_strip_options, first_run_notice, material_from_args, strip_from_args
+from ipmc_asym.dynamics.electrode import charge
+from ipmc_asym.forward.estimate import model_list
+from ipmc_asym.io.jsonio import dumps
 
 
 def register(sub):

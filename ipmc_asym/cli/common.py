@@ -11,8 +11,8 @@ import os
 import re
 import sys
 
-from ipmc_asym.model.params import Strip, material_from_spec
 from ipmc_asym.base.units import parse_length, parse_pressure, parse_voltage
+from ipmc_asym.model.params import Strip, material_from_spec
 
 __all__ = ["UsageError", "Parser", "add_strip_options", "material_from_args", "strip_from_args",
            "arg_type", "count_type", "join_negative_values", "fmt_num", "c_moy_label", "length_type", "pressure_type", "voltage_type", "tol_type", "first_run_notice"]
@@ -186,7 +186,7 @@ def new_dir_removed_on_failure(path):
 
 def first_run_notice():
     """Numba compiles on the first run after install: say so instead of hanging silently."""
-    from ipmc_asym.kernels.jit import CACHE_DIR
+    from ipmc_asym.kernels.jit import CACHE_DIR  # deferred: loads Numba; only the first-compile notice needs it
 
     if not (os.path.isdir(CACHE_DIR) and any(f.endswith(".nbi") for _, _, fs in os.walk(CACHE_DIR) for f in fs)):
         sys.stderr.write("ipmc-asym: compiling the Numba kernels (first run after install, ~10-30 s)...\n")

@@ -2,9 +2,6 @@
 
 from __future__ import annotations
 
-from ipmc_asym.forward.estimate import estimate_rows, model_list
-from ipmc_asym.integral.api import interpret_small
-from ipmc_asym.io.jsonio import dumps
 from ipmc_asym.base.registry import fidelity_names, model_choices
 from ipmc_asym.base.units import fmt_length
 from ipmc_asym.cli import SUMMARIES
@@ -17,6 +14,9 @@ from ipmc_asym.cli.common import (
     strip_from_args,
     tol_type,
 )
+from ipmc_asym.forward.estimate import estimate_rows, model_list
+from ipmc_asym.integral.api import interpret_small
+from ipmc_asym.io.jsonio import dumps
 
 
 def register(sub):

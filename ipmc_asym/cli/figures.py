@@ -5,9 +5,9 @@ from __future__ import annotations
 import sys
 
 from ipmc_asym.bench.suite import load_bench
-from ipmc_asym.io.fileio import check_output_path
 from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import count_type, new_dir_removed_on_failure
+from ipmc_asym.io.fileio import check_output_path
 
 
 def register(sub):

@@ -4,12 +4,13 @@ from __future__ import annotations
 
 import sys
 
-from ipmc_asym.studies.calibrate import FREE_PARAMETERS, fit, read_data
-from ipmc_asym.io.fileio import check_output_path
-from ipmc_asym.io.jsonio import dumps
 from ipmc_asym.base.registry import fidelity_names, model_names
 from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import add_strip_options, count_type, material_from_args, strip_from_args
+from ipmc_asym.io.fileio import check_output_path
+from ipmc_asym.io.jsonio import dumps
+from ipmc_asym.parallel.executors import check_scheduler
+from ipmc_asym.studies.calibrate import FREE_PARAMETERS, fit, read_data
 
 
 def register(sub):
@@ -37,7 +38,6 @@ def run(args) -> int:
     if args.plot:
         check_output_path(args.plot, "file", "--plot")
     if args.scheduler is not None:
-        from ipmc_asym.parallel.executors import check_scheduler
 
         check_scheduler(args.scheduler)
     data = read_data(args.data, strip_from_args(args))

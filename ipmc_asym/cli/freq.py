@@ -4,12 +4,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from ipmc_asym.dynamics.circuit import FREQ_METHODS, frequency_response
-from ipmc_asym.io.jsonio import dumps
 from ipmc_asym.base.registry import model_names
 from ipmc_asym.base.units import parse_quantity
 from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import add_strip_options, arg_type, count_type, material_from_args, strip_from_args
+from ipmc_asym.dynamics.circuit import FREQ_METHODS, frequency_response
+from ipmc_asym.io.jsonio import dumps
 
 
 def _freq(name):

@@ -2,12 +2,12 @@
 
 from __future__ import annotations
 
-from ipmc_asym.io.fileio import check_output_path
-from ipmc_asym.io.jsonio import dumps
-from ipmc_asym.studies.profiles import PAPER_LAYERS
 from ipmc_asym.base.registry import model_choices, model_names
 from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import add_strip_options, material_from_args, new_dir_removed_on_failure, strip_from_args
+from ipmc_asym.io.fileio import check_output_path
+from ipmc_asym.io.jsonio import dumps
+from ipmc_asym.studies.profiles import PAPER_LAYERS
 
 
 def register(sub):

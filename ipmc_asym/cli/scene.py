@@ -4,11 +4,11 @@ from __future__ import annotations
 
 import sys
 
-from ipmc_asym.io.jsonio import dumps
-from ipmc_asym.studies.scenes import run_scene
 from ipmc_asym.base.units import fmt_length
 from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import fmt_num
+from ipmc_asym.io.jsonio import dumps
+from ipmc_asym.studies.scenes import run_scene
 
 
 def register(sub):

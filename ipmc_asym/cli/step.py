@@ -7,13 +7,20 @@ import sys
 
 import numpy as np
 
-from ipmc_asym.dynamics.circuit import STEP_FIDELITIES, step_response
-from ipmc_asym.io.fileio import atomic_write, check_output_path
-from ipmc_asym.io.jsonio import dumps
 from ipmc_asym.base.registry import model_names
 from ipmc_asym.base.units import fmt_length, parse_quantity
 from ipmc_asym.cli import SUMMARIES
-from ipmc_asym.cli.common import add_strip_options, arg_type, count_type, first_run_notice, material_from_args, strip_from_args
+from ipmc_asym.cli.common import (
+    add_strip_options,
+    arg_type,
+    count_type,
+    first_run_notice,
+    material_from_args,
+    strip_from_args,
+)
+from ipmc_asym.dynamics.circuit import STEP_FIDELITIES, step_response
+from ipmc_asym.io.fileio import atomic_write, check_output_path
+from ipmc_asym.io.jsonio import dumps
 
 COLUMNS = ("t", "phi0", "sigma", "current_density", "M_A", "theta", "w")
 

@@ -10,8 +10,6 @@ import warnings
 
 import numpy as np
 
-from ipmc_asym.io.fileio import atomic_write, check_output_path
-from ipmc_asym.io.jsonio import dumps
 from ipmc_asym.base.progress import progress
 from ipmc_asym.base.registry import fidelity_names, model_choices, model_names
 from ipmc_asym.base.settings import MAX_ROWS
@@ -24,6 +22,12 @@ from ipmc_asym.cli.common import (
     strip_from_args,
     tol_type,
 )
+from ipmc_asym.io.datasets import sweep_dataset, write_netcdf
+from ipmc_asym.io.fileio import atomic_write, check_output_path
+from ipmc_asym.io.jsonio import dumps
+from ipmc_asym.parallel.executors import check_scheduler
+from ipmc_asym.studies.fits import sweep_fits
+from ipmc_asym.studies.sweep_chunks import sweep_chunked
 
 #: points per axis used for the fits (a subsample of a longer axis fits the same law)
 FIT_POINTS = 2000
@@ -64,7 +68,6 @@ FORMAT_WORKERS = 2
 
 def _fits(vary, args, base, mat):
     """Power-law fits along each swept axis (through the middle of the other axes)."""
-    from ipmc_asym.studies.fits import sweep_fits
     from ipmc_asym.studies.sweeps import sweep, withhold
     fits, notes = [], []
     for var, vals in vary.items():
@@ -121,7 +124,6 @@ def run(args) -> int:
     if args.out:
         check_output_path(args.out, "file")
     if args.scheduler is not None:
-        from ipmc_asym.parallel.executors import check_scheduler
 
         check_scheduler(args.scheduler)
     # deferred: the compiled kernels load only once the sweep is known to be accepted
@@ -146,7 +148,6 @@ def run(args) -> int:
         if args.scheduler is not None or to_nc:
             # the whole grid in memory: a NetCDF dataset is written at once, and distributed
             # chunks come back as arrays (refused above --max-rows like every sweep)
-            from ipmc_asym.studies.sweep_chunks import sweep_chunked
 
             arr = sweep_chunked(vary, args.scheduler, model=args.model, fidelity=args.fidelity, base=base,
                                 material=mat, tol=args.tol, escalate=not args.no_escalate)
@@ -176,7 +177,6 @@ def run(args) -> int:
 
             to_json_file = bool(args.out) and args.out.lower().endswith(".json")
             if to_nc:
-                from ipmc_asym.io.datasets import sweep_dataset, write_netcdf
 
                 write_netcdf(sweep_dataset(chunks[0], vary, base=base, material=mat), args.out)
                 rows = chunks[0].size

@@ -4,11 +4,13 @@ from __future__ import annotations
 
 import sys
 
-from ipmc_asym.io.fileio import check_output_path
-from ipmc_asym.io.jsonio import dumps
 from ipmc_asym.base.registry import FIDELITIES, fidelity_names
 from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import count_type
+from ipmc_asym.io.datasets import uq_dataset, write_netcdf
+from ipmc_asym.io.fileio import check_output_path
+from ipmc_asym.io.jsonio import dumps
+from ipmc_asym.parallel.executors import check_scheduler
 
 
 def register(sub):
@@ -35,12 +37,10 @@ def run(args) -> int:
         if getattr(args, opt):
             check_output_path(getattr(args, opt), "file", f"--{opt}")
     if args.scheduler is not None:
-        from ipmc_asym.parallel.executors import check_scheduler
 
         check_scheduler(args.scheduler)
     res = run_uq(args.scene, args.samples, seed=args.seed, fidelity=args.fidelity, scheduler=args.scheduler)
     if args.out:
-        from ipmc_asym.io.datasets import uq_dataset, write_netcdf
 
         eng = write_netcdf(uq_dataset(res), args.out)
         sys.stderr.write(f"uq: {res.n_samples} samples -> {args.out} (NetCDF, engine {eng})\n")

@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
+from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.io.fileio import atomic_write, check_output_path
 from ipmc_asym.io.jsonio import dumps
 from ipmc_asym.validation.validate import VERDICTS, claims, to_markdown
-from ipmc_asym.cli import SUMMARIES
 
 
 def register(sub):

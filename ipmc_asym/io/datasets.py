@@ -20,6 +20,7 @@ import json
 
 import numpy as np
 
+from ipmc_asym import __version__
 from ipmc_asym.base.quantities import BY_NAME
 from ipmc_asym.io.fileio import atomic_path, check_output_path
 
@@ -39,7 +40,6 @@ def _label(da, name):
 
 
 def _common_attrs(model, fidelity, strip=None, material=None, extra=None) -> dict:
-    from ipmc_asym import __version__
 
     def js(o):
         if o is None:

@@ -36,12 +36,16 @@ from __future__ import annotations
 
 import contextlib
 import math
+import multiprocessing as mp
 import os
 import time
+from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 
-from ipmc_asym.base.registry import FIDELITIES, fidelity_names
+from ipmc_asym.base.registry import FIDELITIES, fidelity_names, model_names
+from ipmc_asym.integral.api import moment
+from ipmc_asym.integral.samples import moment_samples
 
 __all__ = ["run_chunks", "chunk_slices", "warm_kernels", "worker_setup", "BLAS_ENV", "MIN_CHUNK_SECONDS",
            "check_scheduler", "time_per_item"]
@@ -76,9 +80,6 @@ def warm_kernels(fidelities=COMPILED) -> float:
     workers only read it.
     """
     t0 = time.perf_counter()
-    from ipmc_asym.integral.api import moment
-    from ipmc_asym.integral.samples import moment_samples
-    from ipmc_asym.base.registry import model_names
 
     one = np.ones(1)
     for f in fidelities:
@@ -101,10 +102,10 @@ def worker_setup(threads: int = 1, fidelities=COMPILED) -> dict:
     """
     for k, v in BLAS_ENV.items():
         os.environ.setdefault(k, v)
-    import numba
+    import numba  # deferred: after the thread environment above is set
 
     numba.set_num_threads(max(1, min(int(threads), numba.config.NUMBA_NUM_THREADS)))
-    from ipmc_asym.kernels.jit import CACHE_DIR
+    from ipmc_asym.kernels.jit import CACHE_DIR  # deferred: loads Numba: after the thread environment is set
 
     os.makedirs(CACHE_DIR, exist_ok=True)
     with _file_lock(os.path.join(CACHE_DIR, ".warm.lock")):
@@ -116,7 +117,7 @@ def worker_setup(threads: int = 1, fidelities=COMPILED) -> dict:
 @contextlib.contextmanager
 def _file_lock(path):
     try:
-        import fcntl
+        import fcntl  # deferred: POSIX only
     except ImportError:  # pragma: no cover - non-POSIX: no lock, the parent warmed the cache
         yield
         return
@@ -212,8 +213,6 @@ def _on_client(client, func, tasks, threads, fidelities):
 
 
 def _on_pool(func, tasks, nw, threads, fidelities):
-    import multiprocessing as mp
-    from concurrent.futures import ProcessPoolExecutor
 
     with _env(_worker_env(threads)):  # spawned workers inherit this environment
         ctx = mp.get_context("spawn")

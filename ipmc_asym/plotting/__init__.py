@@ -8,6 +8,8 @@ switched (a notebook user's backend stays as it is) and no figure enters pyplot'
 
 from __future__ import annotations
 
+import os
+
 from ipmc_asym.io.fileio import atomic_path
 
 __all__ = ["pyplot", "savefig", "MODEL_COLOURS"]
@@ -38,7 +40,6 @@ def pyplot():
 
 def savefig(fig, path, **kw) -> str:
     """Save ``fig`` to ``path`` atomically and close it; returns the path."""
-    import os
 
     fmt = kw.pop("format", None) or os.path.splitext(os.fspath(path))[1].lstrip(".") or "png"
     with atomic_path(path) as tmp:

@@ -16,14 +16,14 @@ import os
 
 import numpy as np
 
-from ipmc_asym.model.params import NAFION_LI, Material, Strip
 from ipmc_asym.base.registry import model_names
 from ipmc_asym.base.settings import OUTSIDE_REGIMES
-from ipmc_asym.studies.sweeps import sweep
+from ipmc_asym.model.params import NAFION_LI, Material, Strip
 from ipmc_asym.plotting import MODEL_COLOURS, pyplot, savefig
-from ipmc_asym.studies.profiles import compute_all
 from ipmc_asym.plotting.profiles import write_all
 from ipmc_asym.plotting.speed import speed_accuracy_figure
+from ipmc_asym.studies.profiles import compute_all
+from ipmc_asym.studies.sweeps import sweep
 
 __all__ = ["influence_figure", "make_all", "INFLUENCE"]
 

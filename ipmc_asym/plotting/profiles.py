@@ -6,10 +6,10 @@ import os
 
 import numpy as np
 
-from ipmc_asym.model.params import NAFION_LI, Material, Strip
-from ipmc_asym.studies.profiles import QUANTITIES, compute_all, profile_summary, write_csv
 from ipmc_asym.base.registry import model_names
+from ipmc_asym.model.params import NAFION_LI, Material, Strip
 from ipmc_asym.plotting import MODEL_COLOURS, pyplot, savefig
+from ipmc_asym.studies.profiles import QUANTITIES, compute_all, profile_summary, write_csv
 
 __all__ = ["plot_profiles", "write_all"]
 

@@ -37,7 +37,7 @@ def plot_speed_accuracy(res: dict, path="figures/speed_accuracy.png") -> str:
         The path written.
     """
     plt = pyplot()
-    from matplotlib.lines import Line2D
+    from matplotlib.lines import Line2D  # deferred: matplotlib is heavy and only figures need it
 
     markers = {"leading": "o", "corrected": "s", "quadrature": "^", "bvp": "D"}
     colours = {"constant": "tab:blue", "linear": "tab:orange", "affine": "tab:green"}

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-
 from ipmc_asym.plotting import pyplot, savefig
 
 __all__ = ["plot_uq"]

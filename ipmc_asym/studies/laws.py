@@ -10,9 +10,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ipmc_asym.studies.fits import local_exponent
-from ipmc_asym.integral.api import moment
 from ipmc_asym.base.settings import LAW_HOLD_TOL
+from ipmc_asym.integral.api import moment
+from ipmc_asym.studies.fits import local_exponent
 
 __all__ = ["local_exponents", "law_table", "law_ranges", "factor_three"]
 
@@ -44,9 +44,8 @@ LATEX_SYMBOLS = {"eps0": r"\varepsilon_0", "Delta_eps": r"\Delta\varepsilon", "d
 
 def law_table(model=None):
     """Leading-order laws from the derivation: list of dict rows (SymPy objects stringified)."""
-    import sympy as sp
-
-    from ipmc_asym_derivations import scaling
+    import sympy as sp  # deferred: SymPy (start-up)
+    from ipmc_asym_derivations import scaling  # deferred: SymPy (start-up)
 
     rows = []
     for r in scaling.laws():

@@ -35,8 +35,6 @@ import csv
 
 import numpy as np
 
-from ipmc_asym.io.fileio import atomic_write
-from ipmc_asym.model.params import NAFION_LI, Material, Strip
 from ipmc_asym.base.registry import model_names
 from ipmc_asym.base.settings import (
     ACCUMULATION_FRACTION,
@@ -44,6 +42,8 @@ from ipmc_asym.base.settings import (
     DEPLETION_LEVEL,
     DEVOID_LEVEL,
 )
+from ipmc_asym.io.fileio import atomic_write
+from ipmc_asym.model.params import NAFION_LI, Material, Strip
 
 __all__ = ["QUANTITIES", "profile", "layer_widths", "profile_summary", "write_csv",
            "compute_all", "PAPER_LAYERS", "LAYER_WIDTHS"]
@@ -77,7 +77,7 @@ PAPER_LAYERS = {
 
 def profile(model="constant", strip: Strip | None = None, material: Material = NAFION_LI):
     """Full-BVP profiles (a :class:`ipmc_asym.bvp.solver.BVPResult`) at ``strip`` (default nominal)."""
-    from ipmc_asym.bvp.solver import solve
+    from ipmc_asym.bvp.solver import solve  # deferred: SciPy's solve_bvp (start-up)
 
     strip = Strip() if strip is None else strip
     res = solve(strip, model, material)

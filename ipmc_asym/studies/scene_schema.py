@@ -35,6 +35,13 @@ BVP.  Layer rule: stdlib + numpy at import (TOML reader deferred, standard libra
 
 from __future__ import annotations
 
+import sys
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover - Python 3.10
+    import tomli as tomllib
+
 import math
 import os
 from dataclasses import dataclass
@@ -104,10 +111,6 @@ class Scene:
 
 
 def _toml_loads(text: str) -> dict:
-    try:
-        import tomllib  # Python >= 3.11
-    except ModuleNotFoundError:  # pragma: no cover - Python 3.10
-        import tomli as tomllib
     return tomllib.loads(text)
 
 

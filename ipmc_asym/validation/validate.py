@@ -39,15 +39,16 @@ from typing import Callable, NamedTuple
 
 import numpy as np
 
-from ipmc_asym.beam.statics import small_displacement_error
-from ipmc_asym.forward.estimate import evaluate
-from ipmc_asym.studies.fits import fit_power_law, linear_r, scaling_fits, variation_table
-from ipmc_asym.integral.api import moment
-from ipmc_asym.studies.laws import law_ranges
-from ipmc_asym.model.params import NAFION_LI, Material, Strip, make_groups
-from ipmc_asym.studies.profiles import LAYER_WIDTHS, profile_summary
 from ipmc_asym.base.registry import MODELS, model_names
 from ipmc_asym.base.settings import LAW_HOLD_TOL, OUTSIDE_REGIMES
+from ipmc_asym.beam.statics import small_displacement_error
+from ipmc_asym.forward.estimate import evaluate
+from ipmc_asym.integral.api import moment
+from ipmc_asym.model.params import NAFION_LI, Material, Strip, make_groups
+from ipmc_asym.studies.charge_studies import charge_claims
+from ipmc_asym.studies.fits import fit_power_law, linear_r, scaling_fits, variation_table
+from ipmc_asym.studies.laws import law_ranges
+from ipmc_asym.studies.profiles import LAYER_WIDTHS, profile_summary
 from ipmc_asym.studies.sweeps import sweep
 
 __all__ = ["Criterion", "Claim", "Ours", "CLAIMS", "VERDICTS", "PHI0_RANGES", "judge", "claims",
@@ -541,7 +542,6 @@ def _charge_claim(key):
     """Ours for the charge claims (:func:`ipmc_asym.studies.charge_studies.charge_claims`)."""
 
     def f(ctx):
-        from ipmc_asym.studies.charge_studies import charge_claims
 
         rows = {r["key"]: r for r in charge_claims(ctx.m, ctx.s)}
         r = rows[key]
