@@ -96,5 +96,6 @@ def markdown_table() -> str:
     """The vocabulary as a Markdown table (the one in ``docs/design.md``)."""
     lines = ["| name | scene name | unit | meaning |", "|---|---|---|---|"]
     for q in QUANTITIES:
-        lines.append(f"| `{q.name}` | {('`' + q.scene_name + '`') if q.scene_name else ''} | {q.unit} | {q.long_name} |")
+        scene = f"`{q.scene_name}`" if q.scene_name else ""
+        lines.append(f"| `{q.name}` | {scene} | {q.unit} | {q.long_name} |")
     return "\n".join(lines)

@@ -43,8 +43,6 @@ VALIDATED_VOLTAGE = 20.0
 #: assembled with cancellations; measured <= 2.3e-12 against the BVP on 1 um - 10 mm x 0.1 mV - 20 V)
 ROUNDING_ERROR = 1e-11
 
-#: default relative tolerance of a scene and of the "small displacement" beam regime
-DEFAULT_TOL = 1e-2
 DEFAULT_SCENE_TOL = 1e-3
 
 #: a strain above this at the faces is outside linear elasticity (beam check)

@@ -48,7 +48,7 @@ from ipmc_asym.integral.api import moment
 from ipmc_asym.integral.samples import moment_samples
 
 __all__ = ["run_chunks", "chunk_slices", "warm_kernels", "worker_setup", "BLAS_ENV", "MIN_CHUNK_SECONDS",
-           "check_scheduler", "time_per_item"]
+           "check_scheduler"]
 
 #: environment of every worker process: one BLAS/OpenMP thread (the parallelism is the workers)
 BLAS_ENV = {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1",
@@ -127,16 +127,6 @@ def _file_lock(path):
             yield
         finally:
             fcntl.flock(fh, fcntl.LOCK_UN)
-
-
-def time_per_item(func, sample_task, n_items: int, repeat: int = 2) -> float:
-    """Seconds per item of ``func(sample_task)`` (``n_items`` items), best of ``repeat``."""
-    best = math.inf
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        func(sample_task)
-        best = min(best, time.perf_counter() - t0)
-    return best / max(n_items, 1)
 
 
 def chunk_slices(n: int, seconds_per_item: float, workers: int = 1,

@@ -2,17 +2,14 @@
 
 from __future__ import annotations
 
-import os
-
 import numpy as np
 
 from ipmc_asym.dynamics.circuit import frequency_response, step_response, time_constant
 from ipmc_asym.dynamics.electrode import charge
-from ipmc_asym.io.fileio import check_output_path
 from ipmc_asym.model.params import NAFION_LI, Strip
 from ipmc_asym.plotting import MODEL_COLOURS, pyplot, savefig
 
-__all__ = ["charge_figures", "plot_charge_capacitance", "plot_step", "plot_bode"]
+__all__ = ["plot_charge_capacitance", "plot_step", "plot_bode"]
 
 MODELS3 = ("constant", "linear", "affine")
 
@@ -104,12 +101,3 @@ def plot_bode(path, strip: Strip | None = None, material=NAFION_LI) -> str:
     ax[0, 1].set_title("tip deflection / voltage (layers' moment)")
     fig.tight_layout()
     return savefig(fig, path, dpi=110)
-
-
-def charge_figures(out_dir="figures") -> list:
-    """Write ``charge_capacitance.png``, ``step_response.png``, ``bode.png`` into ``out_dir``."""
-    check_output_path(out_dir, "dir")
-    os.makedirs(out_dir, exist_ok=True)
-    return [plot_charge_capacitance(os.path.join(out_dir, "charge_capacitance.png")),
-            plot_step(os.path.join(out_dir, "step_response.png")),
-            plot_bode(os.path.join(out_dir, "bode.png"))]

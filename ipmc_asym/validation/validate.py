@@ -292,10 +292,6 @@ def _rows(arr, model):
     return a, ~np.isin(a["regime"], OUTSIDE_REGIMES)
 
 
-def _mm(x):
-    return f"{x * 1e3:.3f} mm"
-
-
 def _rng(a, b):
     return f"{a:g}-{b:g} V"
 
