@@ -13,10 +13,10 @@ VALIDITY_LIMIT = 1e-2
 #: relative tolerance handed to scipy's solve_bvp on the residuals
 BVP_TOL = 1e-10
 #: the relative error the BVP states for I (measured ~1e-12 against the exact linear
-#: solution and the closed forms, tests/test_bvp.py): the stated bound is looser on purpose
+#: solution and the closed forms, tests/bvp/test_solver.py): the stated bound is looser on purpose
 BVP_STATED_ERROR = 1e-9
 #: the relative error the ``exact`` fidelity states for I (measured <= 2.9e-12 against the
-#: BVP on 1 um - 10 mm x +-(1e-4 - 20) V x 3 models, tests/test_exact.py)
+#: BVP on 1 um - 10 mm x +-(1e-4 - 20) V x 3 models, tests/kernels/test_exact.py)
 EXACT_STATED_ERROR = 1e-11
 #: maximum mesh nodes of one BVP solve
 BVP_MAX_NODES = 300_000

@@ -42,7 +42,7 @@ Blocked end (``z(L) = 0``):
   With ``m = kappa L`` and ``F = psi(m) M/L`` this is
   ``G(psi, m) = int_0^1 sin(m [psi (t - t^2/2) - t]) dt = 0``, evaluated in closed form with
   Fresnel integrals.  ``psi`` is even in ``m`` and the branch continuous with the small
-  solution ``psi(0) = 3/2`` has the series (derived with SymPy, see ``tests/test_beam.py``)
+  solution ``psi(0) = 3/2`` has the series (derived with SymPy, see ``tests/beam/test_statics.py``)
   ``psi = 3/2 - m^2/2240 - 221 m^4/165580800 - 29479 m^6/7232569344000 - ...``, so
   ``|F_small - F|/|F| = m^2/3360 + O(m^4)`` -- 2.5e-4 at ``kappa L = 0.92``, well inside the
   paper's "< 1 %".

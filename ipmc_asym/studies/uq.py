@@ -376,7 +376,7 @@ def _sobol_indices(y, names, N, batches=SOBOL_BATCHES):
     tq = float(stats.t.ppf(0.975, K - 1))
     # SALib's first_order / total_order (Saltelli 2010 CPC; Jansen), written out so that the
     # variance of [A, B] is computed once for all parameters and batches (the functions
-    # recompute it per call); tests/test_uq.py checks equality with SALib's functions.
+    # recompute it per call); tests/studies/test_uq.py checks equality with SALib's functions.
     def est(a, b, ab):  # a, b: (n, ...); ab: (n, ..., D) -> S1, ST of shape (..., D)
         v = np.var(np.concatenate([a, b], axis=0), axis=0)[..., None]
         s1 = np.mean(b[..., None] * (ab - a[..., None]), axis=0) / v

@@ -5,12 +5,13 @@ import os
 
 import numpy as np
 import pytest
+from references import REPO
 
 from ipmc_asym.cli import main
 from ipmc_asym.forward.estimate import evaluate
 from ipmc_asym.model.params import NAFION_LI, Strip
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = str(REPO)
 
 
 @pytest.fixture(scope="module")

@@ -6,25 +6,25 @@ result ``valid`` only if that bound is within its advertised ceiling
 
 * a valid result is within its stated error of the reference -- the full BVP (plus the
   BVP's own stated error); for the BVP itself, the independent references of
-  tests/test_bvp.py (the exact solution of the linear model; first integral + layer
+  tests/bvp/test_solver.py (the exact solution of the linear model; first integral + layer
   quadratures for constant/affine, exact up to the layers' overlap ~exp(-2/lambda));
 * a valid result's stated error is within the fidelity's ceiling;
 * the nominal strip is valid at every fidelity (the contract is not vacuous).
 
-Negative voltages are the mirror image in every rung (tests/test_bvp.py::test_mirror_symmetry).
+Negative voltages are the mirror image in every rung (tests/bvp/test_solver.py::test_mirror_symmetry).
 """
 
 import math
 
 import numpy as np
 import pytest
-from test_bvp import I_layer_quadrature, I_linear_exact
+from references import I_layer_quadrature, I_linear_exact
 
+from ipmc_asym.base.registry import FIDELITIES, fidelity_names, model_names
+from ipmc_asym.base.settings import BVP_STATED_ERROR
 from ipmc_asym.integral.api import moment
 from ipmc_asym.model.params import NAFION_LI, Strip
 from ipmc_asym.model.permittivity import get_model
-from ipmc_asym.base.registry import FIDELITIES, fidelity_names, model_names
-from ipmc_asym.base.settings import BVP_STATED_ERROR
 
 TH = np.array([20e-6, 200e-6, 1e-3])
 V = np.array([0.05, 1.0, 5.0])

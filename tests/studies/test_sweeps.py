@@ -2,8 +2,8 @@ import numpy as np
 import pytest
 
 from ipmc_asym.forward.estimate import evaluate
-from ipmc_asym.studies.fits import fit_power_law, sweep_fits
 from ipmc_asym.model.params import Strip
+from ipmc_asym.studies.fits import fit_power_law, sweep_fits
 from ipmc_asym.studies.sweeps import iter_sweep, parse_vary, sweep
 
 

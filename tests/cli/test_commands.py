@@ -6,11 +6,11 @@ import sys
 
 import pytest
 
+from ipmc_asym.base.units import parse_length, parse_voltage
 from ipmc_asym.bvp.solver import moment_integral_bvp
 from ipmc_asym.cli import main
 from ipmc_asym.integral.api import moment
 from ipmc_asym.model.params import NAFION_LI, Strip
-from ipmc_asym.base.units import parse_length, parse_voltage
 
 KEYS = {"model", "fidelity", "C_moy", "A0", "A1", "A2", "A3", "A5", "B1", "I", "M_A", "theta", "w", "w_small",
         "F_block", "F_block_small", "error_estimate", "seconds"}

@@ -9,9 +9,9 @@ import math
 import numpy as np
 import pytest
 
-from ipmc_asym.studies.calibrate import fit, read_data
 from ipmc_asym.forward.estimate import evaluate
 from ipmc_asym.model.params import NAFION_LI, Strip
+from ipmc_asym.studies.calibrate import fit, read_data
 
 TRUE = {"modulus": 1.0e8, "c_moy": 2600.0}
 VOLTS = np.linspace(0.2, 1.2, 8)

@@ -31,7 +31,7 @@ def test_step_json_and_csv(tmp_path, capsys):
     assert any("Darcy" in n for n in out["notes"]) and any("D = " in n for n in out["notes"])
     f = tmp_path / "s.csv"
     assert main(["step", "--voltage", "1V", "--duration", "20ms", "--points", "30", "--out", str(f)]) == 0
-    rows = list(csv.reader(f.open()))
+    rows = list(csv.reader(f.read_text().splitlines()))
     assert rows[0][0].startswith("# tau =")
     assert rows[1] == ["t", "phi0", "sigma", "current_density", "M_A", "theta", "w"]
     assert len(rows) == 32 and float(rows[-1][0]) == pytest.approx(0.02)

@@ -2,10 +2,10 @@
 
 import json
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
+from references import REPO
 
 from ipmc_asym.beam.statics import blocking_force_large, tip_position
 from ipmc_asym.bvp.solver import solve
@@ -14,7 +14,7 @@ from ipmc_asym.model.params import NAFION_LI, Strip
 from ipmc_asym.studies.profiles import layer_widths
 from ipmc_asym.studies.scenes import LADDER, run_scene
 
-EX = Path(__file__).resolve().parent.parent / "examples"
+EX = REPO / "examples"
 
 
 def _A5(th, width, v):
@@ -87,7 +87,7 @@ def test_tight_tolerance_escalates():
 
 
 def test_escalates_to_exact_where_layers_overlap():
-    # 2e = 0.2 um at 1 V: the anode layer alone (~0.2 um, tests/test_profiles.py) fills the
+    # 2e = 0.2 um at 1 V: the anode layer alone (~0.2 um, tests/studies/test_profiles.py) fills the
     # strip, so no closed form or quadrature is valid and the planner must end on 'exact'
     # (valid at any thickness), checked against the BVP
     r = run_scene({"model": "constant", "voltage": 1.0, "strip": {"thickness": "0.2um"},
@@ -183,7 +183,7 @@ def test_a_uq_scene_runs_as_a_plain_scene_at_its_nominal_values():
     """examples/uq_nominal.toml: `scene` evaluates the nominal strip and says the table is for uq."""
     from ipmc_asym import moment_integral
 
-    res = run_scene(str(Path(__file__).resolve().parents[1] / "examples" / "uq_nominal.toml"))
+    res = run_scene(str(REPO / "examples" / "uq_nominal.toml"))
     assert any("uncertain" in n for n in res["notes"])
     p = res["points"][0]
     ref = moment_integral(p["thickness"], p["voltage"], res["model"], "quadrature")

@@ -2,6 +2,7 @@
 
 import json
 import os
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -68,7 +69,7 @@ def test_write_refuses_bad_path_and_leaves_nothing(tmp_path, monkeypatch):
         pass
 
     def bad(self, path, *a, **k):
-        open(path, "wb").write(b"partial")  # a writer that dies half-way
+        Path(path).write_bytes(b"partial")  # a writer that dies half-way
         raise Boom
 
     monkeypatch.setattr(xr.Dataset, "to_netcdf", bad)  # an error during the write: no file, no temp file

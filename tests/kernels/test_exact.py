@@ -12,13 +12,13 @@ import sympy as sp
 import ipmc_asym as ia
 from derivations import exact as DX
 from derivations import model as M
+from ipmc_asym.base.settings import EXACT_STATED_ERROR as STATED_ERROR
 from ipmc_asym.integral.api import groups_arrays
 from ipmc_asym.kernels import _generated_exact as GX
 from ipmc_asym.kernels.exact import moment_exact, moment_exact_nodes
 from ipmc_asym.kernels.special import gauss_legendre
 from ipmc_asym.model.params import NAFION_LI, Strip
 from ipmc_asym.model.permittivity import get_model
-from ipmc_asym.base.settings import EXACT_STATED_ERROR as STATED_ERROR
 
 MODELS = ("constant", "linear", "affine")
 

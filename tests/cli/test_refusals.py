@@ -17,16 +17,17 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from references import REPO
 
 import ipmc_asym
+from ipmc_asym.base.registry import fidelity_names, model_names
+from ipmc_asym.base.settings import MIN_THICKNESS, STRAIN_LIMIT
 from ipmc_asym.cli import main
 from ipmc_asym.forward.estimate import evaluate
 from ipmc_asym.integral.api import moment, moment_integral
 from ipmc_asym.model.params import Strip
-from ipmc_asym.base.registry import fidelity_names, model_names
-from ipmc_asym.base.settings import MIN_THICKNESS, STRAIN_LIMIT
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = str(REPO)
 
 
 def _one_line_error(err: str):
@@ -142,7 +143,6 @@ def test_leading_error_bound_relative_to_I(model):
 @pytest.mark.parametrize("model", ["linear", "affine"])
 def test_corrected_valid_at_10um(model):
     from ipmc_asym.bvp.solver import moment_integral_bvp
-
     from ipmc_asym.integral.api import validity_limit
 
     c = moment(10e-6, 1.0, model, "corrected")
@@ -343,7 +343,7 @@ def test_one_failed_point_keeps_the_other_rows(monkeypatch):
 
 
 def test_readme_python_blocks_run():
-    text = open(os.path.join(ROOT, "README.md"), encoding="utf-8").read()
+    text = (REPO / "README.md").read_text(encoding="utf-8")
     blocks = [b.split("```", 1)[0] for b in text.split("```python\n")[1:]]
     assert blocks
     for b in blocks:

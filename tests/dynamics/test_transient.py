@@ -15,9 +15,9 @@ from ipmc_asym.dynamics.circuit import (
     waveform,
 )
 from ipmc_asym.dynamics.electrode import charge
+from ipmc_asym.dynamics.transient import solve_transient
 from ipmc_asym.model.params import NAFION_LI, Strip
 from ipmc_asym.model.permittivity import MODELS
-from ipmc_asym.dynamics.transient import solve_transient
 
 S0 = Strip()
 TAU = float(time_constant(S0.thickness))

@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from derivations import codegen, model as M, scaling
+from derivations import codegen, scaling
+from derivations import model as M
 from ipmc_asym.kernels import _generated as G
 from ipmc_asym.kernels.quadrature import layer_functions
 

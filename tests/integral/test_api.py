@@ -1,5 +1,5 @@
 """Leading order at nominal, convergence orders, API behaviour (the fidelity contract on a grid:
-tests/test_fidelity_contract.py)."""
+tests/integral/test_fidelity_contract.py)."""
 
 import math
 

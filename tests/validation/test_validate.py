@@ -142,7 +142,7 @@ GOLDEN = Path(__file__).resolve().parent / "golden" / "validate_verdicts.json"
 def test_verdicts_match_the_golden_file(rows, request):
     """Every claim's verdict as pinned in ``tests/golden/validate_verdicts.json``.
 
-    ``pytest --update-golden tests/test_validate.py`` rewrites the file; the diff is then
+    ``pytest --update-golden tests/validation/test_validate.py`` rewrites the file; the diff is then
     reviewed like a change of code (as ``ipmc-asym derive --check`` does for the kernels)."""
     now = {k: r["verdict"] for k, r in sorted(rows.items())}
     if request.config.update_golden:

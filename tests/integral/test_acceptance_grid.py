@@ -11,10 +11,10 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from ipmc_asym.base.registry import model_names
 from ipmc_asym.bvp.solver import solve
 from ipmc_asym.cli import main
 from ipmc_asym.model.params import Strip
-from ipmc_asym.base.registry import model_names
 
 
 def run_cli(argv):

@@ -5,8 +5,8 @@ from fractions import Fraction
 import numpy as np
 import pytest
 
-import ipmc_asym.studies.sweeps as sweeps
 import ipmc_asym.io.textfmt as textfmt
+import ipmc_asym.studies.sweeps as sweeps
 from ipmc_asym.io.textfmt import format_floats, format_table
 
 
