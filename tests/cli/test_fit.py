@@ -100,6 +100,7 @@ def test_sweep_netcdf_out(tmp_path, capsys):
         assert ds.attrs["fidelity"] == "corrected"
 
 
+@pytest.mark.slow
 def test_sweep_scheduler_local_identical_csv(tmp_path, capsys):
     pytest.importorskip("distributed")
     a, b = tmp_path / "a.csv", tmp_path / "b.csv"

@@ -242,6 +242,7 @@ def _peak_rss_mb(rows: int) -> float:
     return float(out.stdout.strip().splitlines()[-1])
 
 
+@pytest.mark.slow
 def test_sweep_memory_does_not_grow_with_rows():
     small, big = _peak_rss_mb(50_000), _peak_rss_mb(500_000)
     # 10x the rows: the peak may differ by the axis itself (8 bytes/row) and noise only

@@ -128,6 +128,7 @@ def test_small_signal_dc_limit_is_the_static_slope():
         assert -1 / (2 * math.pi * 1e-6 * fr.Z[0].imag) == pytest.approx(C0, rel=1e-6)
 
 
+@pytest.mark.slow
 def test_small_signal_against_a_small_sine_in_the_pnp_solver():
     """Drive the transient solver with 1 mV sines; fit the periodic current; compare Z."""
     amp = 1e-3

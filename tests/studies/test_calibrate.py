@@ -52,6 +52,7 @@ def truth_rows():
     return _truth_rows()
 
 
+@pytest.mark.slow
 def test_round_trip_ten_seeds(truth_rows, tmp_path):
     """Known modulus and c_moy + 2 % noise: within 5 % and inside the 95 % interval for >= 8 of seeds 0-9."""
     good = 0
