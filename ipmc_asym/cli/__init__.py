@@ -73,11 +73,11 @@ def load_plugin(name: str):
     return None if ep is None else ep.load()
 
 
-def build_parser(only: str | None = None):
+def build_parser(only: str | None = None, plugins: dict | None = None):
     """The parser: the full options of command ``only`` (its module imported), the others listed.
 
-    Installed commands (:func:`plugin_commands`) are imported for their summary, listed after
-    this package's own.
+    Installed commands (``plugins``, default :func:`plugin_commands`) are imported for their
+    summary, listed after this package's own.
     """
     from ipmc_asym import __version__
 
@@ -93,7 +93,7 @@ def build_parser(only: str | None = None):
         mod = importlib.import_module(f"{__name__}.{modname}")
         mod.register(sub)
         handlers[name] = mod.run
-    for name, ep in plugin_commands().items():
+    for name, ep in (plugin_commands() if plugins is None else plugins).items():
         try:
             mod = ep.load()
         except ImportError as exc:  # a broken installed package must not break the other commands
@@ -114,10 +114,11 @@ def main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
     argv = join_negative_values(argv)
     only = next((a for a in argv if not a.startswith("-")), None)
-    known = only in COMMANDS or (only is not None and only in plugin_commands())
+    plugins = plugin_commands()
+    known = only in COMMANDS or only in plugins
     command = only if known else "?"
     try:
-        ap, handlers = build_parser(only if known else None)
+        ap, handlers = build_parser(only if known else None, plugins)
         args = ap.parse_args(argv)
         command = args.command
         rc = handlers[args.command](args)
