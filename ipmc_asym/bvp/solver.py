@@ -52,6 +52,7 @@ from types import SimpleNamespace
 import numpy as np
 from scipy.integrate import solve_bvp
 
+from ipmc_asym.base.settings import BVP_MAX_NODES, BVP_MAX_NODES_FIRST, BVP_TOL, BVP_TOL_FALLBACK
 from ipmc_asym.bvp.mesh import first_spacings, initial_guess, make_mesh
 from ipmc_asym.bvp.problems import (
     TINY,
@@ -64,7 +65,6 @@ from ipmc_asym.bvp.problems import (
 )
 from ipmc_asym.model.params import NAFION_LI, Groups, Material, Strip, check_finite, check_positive
 from ipmc_asym.model.permittivity import Permittivity, get_model
-from ipmc_asym.base.settings import BVP_MAX_NODES, BVP_MAX_NODES_FIRST, BVP_TOL, BVP_TOL_FALLBACK
 
 __all__ = ["BVPResult", "solve", "moment_integral_bvp", "b1_guess", "make_mesh"]
 

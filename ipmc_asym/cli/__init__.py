@@ -4,17 +4,26 @@ One module per command in this package, each with ``register(subparsers)`` and
 ``run(args)``: argparse wiring and printing only; the work is done by the library.  Only
 this package imports it.  Bad input exits with status 2 and a one-line message, never a
 traceback.
+
+Other installed packages add commands through the entry point group
+``ipmc_asym.commands`` (:func:`plugin_commands`): each entry point names a module with
+``register(subparsers)``, ``run(args)`` and ``SUMMARY`` (its line in ``--help``), e.g.
+``bench`` from the benchmark package beside the library.
 """
 
 from __future__ import annotations
 
 import importlib
 import sys
+from importlib.metadata import entry_points
 
 from ipmc_asym import __version__
 from ipmc_asym.cli.common import Parser, UsageError, join_negative_values
 
-__all__ = ["main", "build_parser", "COMMANDS", "UsageError"]
+__all__ = ["main", "build_parser", "COMMANDS", "UsageError", "PLUGIN_GROUP", "plugin_commands", "load_plugin"]
+
+#: entry point group of the commands other packages add
+PLUGIN_GROUP = "ipmc_asym.commands"
 
 #: command name -> module in this package providing register(sub) and run(args).
 #: Only the module of the command being run is imported (start-up time); the others
@@ -23,7 +32,6 @@ COMMANDS = {
     "estimate": "estimate",
     "derive": "derive",
     "laws": "laws",
-    "bench": "bench",
     "scene": "scene",
     "profiles": "profiles",
     "sweep": "sweep",
@@ -41,7 +49,6 @@ SUMMARIES = {
     "estimate": "tip deflection, rotation, moment, blocking force of one strip",
     "derive": "regenerate the Numba kernels from the SymPy derivation",
     "laws": "analytic scaling laws (leading order) and where they hold",
-    "bench": "time and accuracy of each fidelity, side by side in one run",
     "scene": "evaluate a TOML scene at the cheapest fidelity meeting its tolerance",
     "profiles": "C, phi, D, E, rhoZ, p through the thickness (paper Figs 4-7)",
     "sweep": "evaluate the strip on a grid of parameters",
@@ -55,8 +62,24 @@ SUMMARIES = {
 }
 
 
-def build_parser(only: str | None = None):
-    """The parser: the full options of command ``only`` (its module imported), the others listed."""
+def plugin_commands() -> dict:
+    """``{name: entry point}`` of the commands installed packages declare in :data:`PLUGIN_GROUP`
+    (a name of this package's own commands is not taken over)."""
+    return {ep.name: ep for ep in entry_points(group=PLUGIN_GROUP) if ep.name not in COMMANDS}
+
+
+def load_plugin(name: str):
+    """The module of the installed command ``name``, or None if no package provides it."""
+    ep = plugin_commands().get(name)
+    return None if ep is None else ep.load()
+
+
+def build_parser(only: str | None = None, plugins: dict | None = None):
+    """The parser: the full options of command ``only`` (its module imported), the others listed.
+
+    Installed commands (``plugins``, default :func:`plugin_commands`) are imported for their
+    summary, listed after this package's own.
+    """
 
     ap = Parser(prog="ipmc-asym", description="Electromechanics of IPMC strips (Tixier & Pouget model).")
     ap.add_argument("--version", action="version", version=f"ipmc-asym {__version__}")
@@ -70,6 +93,19 @@ def build_parser(only: str | None = None):
         mod = importlib.import_module(f"{__name__}.{modname}")
         mod.register(sub)
         handlers[name] = mod.run
+    for name, ep in (plugin_commands() if plugins is None else plugins).items():
+        try:
+            mod = ep.load()
+        except ImportError as exc:  # a broken installed package must not break the other commands
+            if name == only:
+                raise UsageError(f"command {name!r} ({ep.value}) cannot be loaded: {exc}") from None
+            sub.add_parser(name, help=f"(cannot be loaded: {exc.__class__.__name__})", add_help=False)
+            continue
+        if name != only:
+            sub.add_parser(name, help=getattr(mod, "SUMMARY", ""), add_help=False)
+            continue
+        mod.register(sub)
+        handlers[name] = mod.run
     return ap, handlers
 
 
@@ -78,9 +114,11 @@ def main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
     argv = join_negative_values(argv)
     only = next((a for a in argv if not a.startswith("-")), None)
-    command = only if only in COMMANDS else "?"
+    plugins = plugin_commands()
+    known = only in COMMANDS or only in plugins
+    command = only if known else "?"
     try:
-        ap, handlers = build_parser(only if only in COMMANDS else None)
+        ap, handlers = build_parser(only if known else None, plugins)
         args = ap.parse_args(argv)
         command = args.command
         rc = handlers[args.command](args)

@@ -15,7 +15,8 @@ from ipmc_asym.base.units import parse_length, parse_pressure, parse_voltage
 from ipmc_asym.model.params import Strip, material_from_spec
 
 __all__ = ["UsageError", "Parser", "add_strip_options", "material_from_args", "strip_from_args",
-           "arg_type", "count_type", "join_negative_values", "fmt_num", "c_moy_label", "length_type", "pressure_type", "voltage_type", "tol_type", "first_run_notice"]
+           "arg_type", "count_type", "join_negative_values", "fmt_num", "c_moy_label", "length_type", "pressure_type",
+           "voltage_type", "tol_type", "first_run_notice"]
 
 
 class UsageError(Exception):

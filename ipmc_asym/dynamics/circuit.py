@@ -40,7 +40,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ipmc_asym.kernels.jit import jit
+from ipmc_asym.base.registry import check_choice
 from ipmc_asym.dynamics.electrode import (
     _GL_W,
     _GL_X,
@@ -52,9 +52,17 @@ from ipmc_asym.dynamics.electrode import (
     time_constant,
 )
 from ipmc_asym.kernels import _generated_charge as GC
-from ipmc_asym.model.params import D_CATION_SOURCE, NAFION_LI, Material, Strip, check_finite, check_positive, debye_length
+from ipmc_asym.kernels.jit import jit
+from ipmc_asym.model.params import (
+    D_CATION_SOURCE,
+    NAFION_LI,
+    Material,
+    Strip,
+    check_finite,
+    check_positive,
+    debye_length,
+)
 from ipmc_asym.model.permittivity import Permittivity, get_model
-from ipmc_asym.base.registry import check_choice
 
 __all__ = ["DYNAMIC_NOTES", "StepResult", "FrequencyResult", "core_resistance", "time_constant",
            "waveform", "step_response", "frequency_response", "circuit_response", "quasi_static_mechanics"]

@@ -27,17 +27,18 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ipmc_asym.kernels.jit import jit, jit_parallel, prange
-from ipmc_asym.kernels import _generated as G
-from ipmc_asym.kernels import _generated_charge as GC
-from ipmc_asym.kernels.special import gauss_legendre
-from ipmc_asym.model.params import NAFION_LI, Material, Strip, check_positive
-from ipmc_asym.model.permittivity import MODELS, Permittivity, get_model
 from ipmc_asym.base.registry import MODELS as _MODEL_SPECS
 from ipmc_asym.base.registry import check_choice, fidelity_names
 from ipmc_asym.base.settings import BVP_STATED_ERROR, VALIDITY_LIMIT
+from ipmc_asym.kernels import _generated as G
+from ipmc_asym.kernels import _generated_charge as GC
+from ipmc_asym.kernels.jit import jit, jit_parallel, prange
+from ipmc_asym.kernels.special import gauss_legendre
+from ipmc_asym.model.params import NAFION_LI, Material, Strip, check_positive
+from ipmc_asym.model.permittivity import MODELS, Permittivity, get_model
 
-__all__ = ["ChargeResult", "charge", "layer_voltage", "core_resistance", "time_constant", "charge_scale", "capacitance_scale", "charge_hat_point",
+__all__ = ["ChargeResult", "charge", "layer_voltage", "core_resistance", "time_constant", "charge_scale",
+           "capacitance_scale", "charge_hat_point",
            "CLOSED_TRUNCATION"]
 
 #: rounding of the closed forms (B1, Dhat, chat are cancellation-free): relative

@@ -19,12 +19,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ipmc_asym.integral.api import ANY_THICKNESS, check_fidelity, check_min_thickness, moment
-from ipmc_asym.model.params import NAFION_LI, Material, Strip, debye_length
-from ipmc_asym.model.permittivity import MODELS, get_model
 from ipmc_asym.base.registry import FIDELITIES as _FIDELITY_SPECS
 from ipmc_asym.base.registry import check_choice, fidelity_names
 from ipmc_asym.base.settings import OUTSIDE_REGIMES, STRAIN_LIMIT, VALIDATED_VOLTAGE, VALIDITY_LIMIT
+from ipmc_asym.integral.api import ANY_THICKNESS, check_fidelity, check_min_thickness, moment
+from ipmc_asym.model.params import NAFION_LI, Material, Strip, debye_length
+from ipmc_asym.model.permittivity import MODELS, get_model
 
 __all__ = ["evaluate", "estimate_rows", "RESULT_KEYS", "CHECKS", "moment_escalating", "Escalated",
            "check_tol", "FREE_STRIP_KEYS", "MECHANICAL_KEYS"]

@@ -36,12 +36,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ipmc_asym.kernels.jit import interpreted, jit, jit_parallel, prange
-from ipmc_asym.kernels.closed import closed_b1, closed_finish, layer_closed, moment_closed
-from ipmc_asym.kernels.exact import moment_exact
-from ipmc_asym.kernels.quadrature import moment_quadrature
-from ipmc_asym.model.params import NAFION_LI, Material, Strip, debye_length
-from ipmc_asym.model.permittivity import MODELS, Permittivity, get_model
 from ipmc_asym.base.progress import progress as _progress_bar
 from ipmc_asym.base.registry import FIDELITIES as _FIDELITY_SPECS
 from ipmc_asym.base.registry import MODELS as _MODEL_SPECS
@@ -54,6 +48,12 @@ from ipmc_asym.base.settings import (
     ROUNDING_ERROR,
     VALIDITY_LIMIT,
 )
+from ipmc_asym.kernels.closed import closed_b1, closed_finish, layer_closed, moment_closed
+from ipmc_asym.kernels.exact import moment_exact
+from ipmc_asym.kernels.jit import interpreted, jit, jit_parallel, prange
+from ipmc_asym.kernels.quadrature import moment_quadrature
+from ipmc_asym.model.params import NAFION_LI, Material, Strip, debye_length
+from ipmc_asym.model.permittivity import MODELS, Permittivity, get_model
 
 __all__ = ["FIDELITIES", "MomentResult", "moment_integral", "moment", "groups_arrays", "check_fidelity",
            "check_min_thickness", "invalid_message", "validity_limit", "interpret_small"]

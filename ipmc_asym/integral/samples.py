@@ -9,8 +9,8 @@ that editing the UQ driver does not invalidate the Numba cache (hashed sources, 
 
 from __future__ import annotations
 
-from ipmc_asym.kernels.jit import jit_parallel, prange
 from ipmc_asym.integral.api import _point
+from ipmc_asym.kernels.jit import jit_parallel, prange
 
 __all__ = ["moment_samples"]
 

@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import math
 
-from ipmc_asym.kernels.jit import jit
 from ipmc_asym.kernels import _generated as G
+from ipmc_asym.kernels.jit import jit
 
 __all__ = ["layer_closed", "moment_closed", "closed_b1", "closed_finish", "TRUNCATION"]
 

@@ -27,9 +27,9 @@ import math
 
 import numpy as np
 
-from ipmc_asym.kernels.jit import jit
 from ipmc_asym.kernels._generated import b1_exact, dhat
 from ipmc_asym.kernels._generated_exact import assemble_exact, exact_core, exact_outer, exact_outer_parts
+from ipmc_asym.kernels.jit import jit
 from ipmc_asym.kernels.special import gauss_legendre
 
 __all__ = ["moment_exact", "moment_exact_nodes", "NODES"]

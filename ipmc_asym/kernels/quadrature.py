@@ -18,8 +18,8 @@ import math
 
 import numpy as np
 
-from ipmc_asym.kernels.jit import jit
 from ipmc_asym.kernels._generated import assemble_j, b1_exact, dhat, w_layer
+from ipmc_asym.kernels.jit import jit
 from ipmc_asym.kernels.special import gauss_legendre
 
 __all__ = ["layer_functions", "moment_quadrature", "NODES"]

@@ -13,8 +13,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Callable, Optional
 
-from ipmc_asym.model.params import Groups, Material, Strip, check_finite, make_groups
 from ipmc_asym.base.registry import MODELS as _REGISTRY
+from ipmc_asym.model.params import Groups, Material, Strip, check_finite, make_groups
 
 __all__ = ["MODELS", "Permittivity", "get_model"]
 

@@ -5,7 +5,8 @@
 * ``influence_length.png`` (Fig 8), ``influence_thickness.png`` (Fig 9),
   ``influence_voltage.png`` (Fig 10), ``influence_width.png``: deflection, blocking force and
   rotation, three models overlaid; points past a quarter turn drawn dotted (outside the model);
-* ``speed_accuracy.png`` if :func:`ipmc_asym.bench.suite.speed_accuracy_figure` exists.
+* ``speed_accuracy.png`` from a bench result (:func:`ipmc_asym.plotting.speed.plot_speed_accuracy`)
+  when one is given or can be measured.
 
 All matplotlib code lives in :mod:`ipmc_asym.plotting`.
 """
@@ -21,7 +22,7 @@ from ipmc_asym.base.settings import OUTSIDE_REGIMES
 from ipmc_asym.model.params import NAFION_LI, Material, Strip
 from ipmc_asym.plotting import MODEL_COLOURS, pyplot, savefig
 from ipmc_asym.plotting.profiles import write_all
-from ipmc_asym.plotting.speed import speed_accuracy_figure
+from ipmc_asym.plotting.speed import plot_speed_accuracy
 from ipmc_asym.studies.profiles import compute_all
 from ipmc_asym.studies.sweeps import sweep
 
@@ -110,21 +111,22 @@ def influence_figure(var, path, base: Strip | None = None, material: Material = 
 
 
 def make_all(out_dir="figures", dpi=110, base: Strip | None = None, material: Material = NAFION_LI,
-             quick=False, bench: dict | None = None, log=None) -> dict:
+             quick=False, bench=None, log=None) -> dict:
     """Write every figure; returns {"files": [...], "notes": [...], "layers": [...]}.
 
     Parameters
     ----------
     quick : bool
         Fewer points, no speed/accuracy figure (tests).
-    bench : dict, optional
-        A saved bench result for the speed/accuracy figure; without it a quick in-process
-        measurement (10^5 points) is drawn.
+    bench : dict or callable, optional
+        The bench result the speed/accuracy figure is drawn from (the dict of ``ipmc-asym
+        bench --json``), or a function of no arguments returning one (a measurement, run at
+        that step); without it the figure is skipped with a note.
     log : callable, optional
         Called with one progress line per figure (the CLI prints them on stderr).
     """
     log = log or (lambda msg: None)
-    n_total = 2 + len(INFLUENCE) + (0 if quick else 1)
+    n_total = 2 + len(INFLUENCE) + (0 if quick or bench is None else 1)
     step = iter(range(1, n_total + 1))
     os.makedirs(out_dir, exist_ok=True)
     base = Strip() if base is None else base
@@ -142,8 +144,13 @@ def make_all(out_dir="figures", dpi=110, base: Strip | None = None, material: Ma
         files.append(p)
     if quick:
         notes.append("speed_accuracy.png skipped in quick mode")
+    elif bench is None:
+        notes.append("speed_accuracy.png skipped: no bench result (the `bench` command is not installed; "
+                     "--bench FILE draws a saved `bench --json`)")
     else:
-        log(f"[{next(step)}/{n_total}] speed/accuracy " + ("(from the saved bench)" if bench else
-                                                         "(quick in-process measurement)"))
-        files.append(speed_accuracy_figure(os.path.join(out_dir, "speed_accuracy.png"), bench=bench))
+        measure = callable(bench)
+        log(f"[{next(step)}/{n_total}] speed/accuracy " + ("(quick in-process measurement)" if measure else
+                                                         "(from the saved bench)"))
+        res = bench() if measure else bench
+        files.append(plot_speed_accuracy(res, os.path.join(out_dir, "speed_accuracy.png")))
     return {"files": files, "notes": notes, "layers": out["summaries"]}

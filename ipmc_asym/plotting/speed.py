@@ -1,35 +1,40 @@
-"""The speed/accuracy figure of the fidelity ladder (from :func:`ipmc_asym.bench.suite.run_bench`)."""
+"""The speed/accuracy figure of the fidelity ladder, drawn from a bench result.
+
+The data is the dict ``ipmc-asym bench --json`` prints (:func:`load_bench` reads a saved
+one): ``points``, ``bvp_points``, ``targets`` (``{fidelity: {"seconds_per_point", ...}}``)
+and ``results`` (one row per model and fidelity with ``seconds_per_point_serial`` and
+``rel_error_max``).
+"""
 
 from __future__ import annotations
 
-from ipmc_asym.bench.suite import ERR_FLOOR, TARGETS, run_bench
+import json
+
 from ipmc_asym.plotting import pyplot, savefig
 
-__all__ = ["speed_accuracy_figure", "plot_speed_accuracy"]
+__all__ = ["plot_speed_accuracy", "load_bench", "ERR_FLOOR"]
+
+#: relative errors below this are drawn at this value (log axis)
+ERR_FLOOR = 1e-16
 
 
-def speed_accuracy_figure(path="figures/speed_accuracy.png", points: int = 10**5, bvp_points: int = 3,
-                          bench: dict | None = None) -> str:
-    """Draw the speed/accuracy figure from a bench result, or from a quick in-process run.
-
-    Parameters
-    ----------
-    path : str
-    points, bvp_points : int
-        Size of the quick measurement (no compile subprocesses, no further sections) when
-        ``bench`` is not given.
-    bench : dict, optional
-        A saved ``ipmc-asym bench --json`` result (:func:`ipmc_asym.bench.suite.load_bench`).
-    """
-    res = bench if bench is not None else run_bench(points, bvp_points, repeats=1, compile_times=False,
-                                                    sections=[])
-    return plot_speed_accuracy(res, path)
+def load_bench(path) -> dict:
+    """A saved ``ipmc-asym bench --json`` result, checked; one-line ``ValueError`` otherwise."""
+    try:
+        with open(path, encoding="utf-8") as fh:
+            res = json.load(fh)
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise ValueError(f"--bench {path!r}: cannot read a bench JSON file ({exc.__class__.__name__}: {exc})") from None
+    if not isinstance(res, dict) or not isinstance(res.get("results"), list) or "points" not in res:
+        raise ValueError(f"--bench {path!r}: not the output of `ipmc-asym bench --json` (no 'results' list)")
+    return res
 
 
 def plot_speed_accuracy(res: dict, path="figures/speed_accuracy.png") -> str:
     """Log time per point (x) vs log relative error against the BVP (y).
 
-    Marker shape = fidelity, colour = model; the BVP is placed at its stated error estimate.
+    Marker shape = fidelity, colour = model; the BVP is placed at its stated error estimate;
+    a dotted line marks each fidelity's target time per point.
 
     Returns
     -------
@@ -48,7 +53,7 @@ def plot_speed_accuracy(res: dict, path="figures/speed_accuracy.png") -> str:
             continue
         ax.scatter([x], [max(y, ERR_FLOOR)], marker=markers[r["fidelity"]], color=colours[r["model"]],
                    s=70, edgecolor="k", linewidth=0.6, zorder=3)
-    for f, t in TARGETS.items():
+    for f, t in res.get("targets", {}).items():
         ax.axvline(t["seconds_per_point"], color="0.6", ls=":", lw=0.8)
         ax.text(t["seconds_per_point"], 0.5, f" {f} target", rotation=90, fontsize=7, color="0.4",
                 va="top", transform=ax.get_xaxis_transform())

@@ -52,8 +52,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ipmc_asym.base.registry import closed_form_fidelities, fidelity_names
-from ipmc_asym.model.params import NAFION_LI, Material, Strip, moment_scale, second_moment
 from ipmc_asym.base.units import parse_length, parse_pressure, parse_quantity, parse_voltage
+from ipmc_asym.model.params import NAFION_LI, Material, Strip, moment_scale, second_moment
 
 __all__ = [
     "FREE_PARAMETERS",
@@ -623,7 +623,7 @@ def _profile(prob, xhat, j, lo, hi, chi2min, s2, thr, sd):
     for side in (-1, +1):
         bound = lo[j] if side < 0 else hi[j]
         step = min(max(2.0 * sd if np.isfinite(sd) and sd > 0 else 0.05, 1e-3), 0.5)
-        x_prev, d_prev = float(xhat[j]), 0.0
+        x_prev = float(xhat[j])
         ends[side] = None
         for _ in range(60):
             x_new = x_prev + side * step
@@ -647,7 +647,7 @@ def _profile(prob, xhat, j, lo, hi, chi2min, s2, thr, sd):
                            f"{math.exp(bound):.3g}" if side < 0 else
                            f"profile stays within the 95 % threshold up to the bound {math.exp(bound):.3g}")
                 break
-            x_prev, d_prev = x_new, d
+            x_prev = x_new
             step *= 1.6
     if ends[-1] is None and ends[+1] is None:
         kind = "flat profile"

@@ -17,7 +17,7 @@ from ipmc_asym.dynamics.circuit import step_response, time_constant
 from ipmc_asym.dynamics.electrode import charge
 from ipmc_asym.model.params import NAFION_LI, Material, Strip
 
-__all__ = ["charge_claims", "bench_charge", "bench_section", "BENCH_TARGETS"]
+__all__ = ["charge_claims", "bench_charge", "BENCH_TARGETS"]
 
 MODELS3 = ("constant", "linear", "affine")
 
@@ -93,15 +93,3 @@ def bench_charge(points: int = 10**6, repeats: int = 3, pnp: bool = True) -> dic
     out["meets"] = {k: bool(out[k] <= BENCH_TARGETS[k]) for k in BENCH_TARGETS if k in out}
     return out
 
-
-def bench_section(quick: bool = False) -> dict:
-    """The ``charge`` section of ``ipmc-asym bench`` (registered in :data:`ipmc_asym.bench.suite.SECTIONS`)."""
-    r = bench_charge(points=10**5 if quick else 10**6, repeats=1 if quick else 3, pnp=not quick)
-    units = {"charge_ns_per_point": "ns/point", "step_circuit_1000_s": "s", "step_pnp_nominal_s": "s"}
-    what = {"charge_ns_per_point": "closed-form charge() (sigma, C_d, eps_app), 2 threads",
-            "step_circuit_1000_s": "step --fidelity circuit, 1000 time points (incl. moment and beam)",
-            "step_pnp_nominal_s": "step --fidelity pnp, nominal strip, 1 V, 5 tau, 200 output times"}
-    figs = [{"what": what[k], "value": r[k], "unit": units[k], "target": BENCH_TARGETS[k],
-             "pass": bool(r[k] <= BENCH_TARGETS[k]), "note": "wall clock on this machine"}
-            for k in BENCH_TARGETS if k in r]
-    return {"figures": figs}

@@ -16,9 +16,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ipmc_asym.model.params import NAFION_LI, Material, Strip
 from ipmc_asym.base.registry import model_names
 from ipmc_asym.base.settings import OUTSIDE_REGIMES
+from ipmc_asym.model.params import NAFION_LI, Material, Strip
 from ipmc_asym.studies.sweeps import sweep
 
 __all__ = ["fit_power_law", "local_exponent", "sweep_fits", "RANGES", "scaling_fits", "variation_table", "QUANTITIES",

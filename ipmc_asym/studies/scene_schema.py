@@ -49,10 +49,10 @@ from typing import Callable, Union
 
 import numpy as np
 
-from ipmc_asym.model.params import NOMINAL_STRIP, Material, Strip, material_from_spec
 from ipmc_asym.base.registry import model_names
-from ipmc_asym.base.settings import MAX_ROWS, DEFAULT_SCENE_TOL
+from ipmc_asym.base.settings import DEFAULT_SCENE_TOL, MAX_ROWS
 from ipmc_asym.base.units import parse_length, parse_voltage
+from ipmc_asym.model.params import NOMINAL_STRIP, Material, Strip, material_from_spec
 
 __all__ = ["Scene", "OUTPUTS", "AXES", "load_scene", "parse_scene", "read_scene"]
 

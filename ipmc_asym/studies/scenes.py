@@ -40,6 +40,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ipmc_asym.base.registry import fidelity_names
+from ipmc_asym.base.settings import BVP_STATED_ERROR, OUTSIDE_REGIMES, STRAIN_LIMIT
 from ipmc_asym.beam.statics import (
     blocking_force_error,
     blocking_force_large,
@@ -51,13 +53,11 @@ from ipmc_asym.beam.statics import (
     tip_deflection_small,
 )
 from ipmc_asym.beam.statics import regime as beam_regime
-from ipmc_asym.studies.fits import fit_power_law
-from ipmc_asym.model.params import moment_scale, second_moment
-from ipmc_asym.studies.profiles import LAYER_WIDTHS, layer_widths
-from ipmc_asym.base.registry import fidelity_names
-from ipmc_asym.studies.scene_schema import OUTPUTS, Scene, load_scene, read_scene
 from ipmc_asym.forward.estimate import moment_escalating
-from ipmc_asym.base.settings import BVP_STATED_ERROR, OUTSIDE_REGIMES, STRAIN_LIMIT
+from ipmc_asym.model.params import moment_scale, second_moment
+from ipmc_asym.studies.fits import fit_power_law
+from ipmc_asym.studies.profiles import LAYER_WIDTHS, layer_widths
+from ipmc_asym.studies.scene_schema import OUTPUTS, Scene, load_scene, read_scene
 
 __all__ = ["run_scene", "load_scene", "OUTPUTS", "LADDER", "Scene"]
 

@@ -24,18 +24,18 @@ import sys
 
 import numpy as np
 
-from ipmc_asym.beam.statics import REGIMES, max_strain, solve_beam
-from ipmc_asym.forward.estimate import check_tol, moment_escalating
-from ipmc_asym.io.fileio import atomic_write
-from ipmc_asym.integral.api import check_fidelity
-from ipmc_asym.model.params import NAFION_LI, Material, Strip, moment_scale, second_moment
-from ipmc_asym.model.permittivity import get_model
 from ipmc_asym.base.progress import progress as progress_bar
 from ipmc_asym.base.registry import model_names
 from ipmc_asym.base.settings import CHUNK_ROWS, MAX_ROWS, OUTSIDE_REGIMES, STRAIN_LIMIT
-from ipmc_asym.io.textfmt import format_table
 from ipmc_asym.base.units import SWEEP_VARIABLES as VARIABLES
 from ipmc_asym.base.units import parse_vary, parse_vary_spec, vary_values
+from ipmc_asym.beam.statics import REGIMES, max_strain, solve_beam
+from ipmc_asym.forward.estimate import check_tol, moment_escalating
+from ipmc_asym.integral.api import check_fidelity
+from ipmc_asym.io.fileio import atomic_write
+from ipmc_asym.io.textfmt import format_table
+from ipmc_asym.model.params import NAFION_LI, Material, Strip, moment_scale, second_moment
+from ipmc_asym.model.permittivity import get_model
 
 __all__ = ["VARIABLES", "DTYPE", "LABELS", "CHECK_COLS", "parse_vary", "parse_vary_spec", "vary_values", "sweep", "iter_sweep",
            "prefetched", "count_rows",

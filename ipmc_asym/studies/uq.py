@@ -46,12 +46,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ipmc_asym.io.datasets import VARIABLES
-from ipmc_asym.integral.api import ANY_THICKNESS, closed_model_id, validity_limit
-from ipmc_asym.integral.samples import moment_samples
-from ipmc_asym.model.params import moment_scale, second_moment
 from ipmc_asym.base.registry import FIDELITIES, fidelity_names
 from ipmc_asym.base.settings import CHUNK_ROWS
+from ipmc_asym.integral.api import ANY_THICKNESS, closed_model_id, validity_limit
+from ipmc_asym.integral.samples import moment_samples
+from ipmc_asym.io.datasets import VARIABLES
+from ipmc_asym.model.params import moment_scale, second_moment
 
 __all__ = ["UNCERTAIN", "DISTRIBUTIONS", "OUTPUT_UNITS", "UQResult", "parse_uncertain", "run_uq",
            "evaluate_samples", "uq_chunk"]
@@ -479,36 +479,3 @@ def run_uq(scene, samples: int = 10**6, *, seed: int = 0, fidelity: str | None =
                     timings={"sampling": t_sample - t0, "evaluation": t_eval1 - t_eval0,
                              "analysis": time.perf_counter() - t_eval1})
 
-
-def bench_section(quick: bool = False) -> dict:
-    """``ipmc-asym bench`` section: UQ samples per second at ``leading`` (in-process, warm).
-
-    The nominal scene with five uncertain inputs (examples/uq_nominal.toml, inline), every
-    output; ``10^6`` runs requested (``N (D+2)`` actually run).  Figures: end-to-end rate
-    (sampling + evaluation + Sobol' analysis), evaluation-only rate, wall time.
-    """
-    scene = {"name": "bench_uq", "model": "constant", "voltage": "1V", "tolerance": 1e-2,
-             "outputs": list(OUTPUT_UNITS), "strip": {"width": "5mm"},
-             "uncertain": {"thickness": {"dist": "normal", "mean": "200um", "sd": "8um"},
-                           "length": {"dist": "uniform", "low": "1.95cm", "high": "2.05cm"},
-                           "voltage": {"dist": "triangular", "low": "0.95V", "mode": "1V", "high": "1.05V"},
-                           "modulus": {"dist": "lognormal", "median": "130MPa", "sigma": 0.15},
-                           "c_moy": {"dist": "normal", "mean": 3082, "sd": 60}}}
-    n = 10**5 if quick else 10**6
-    run_uq(scene, 1000, fidelity="leading")  # warm: kernels, the beam's branch table
-    best = None
-    for _ in range(1 if quick else 2):
-        r = run_uq(scene, n, fidelity="leading")
-        if best is None or r.seconds < best.seconds:
-            best = r
-    rate = best.n_samples / best.seconds
-    ev = best.n_samples / best.timings["evaluation"]
-    return {"figures": [
-        {"what": "uq end to end at leading (sampling + 5 outputs + Sobol')", "value": rate, "unit": "samples/s",
-         "target": 1e6, "pass": bool(rate >= 1e6), "note": f"{best.n_samples} runs in {best.seconds:.3g} s"},
-        {"what": "uq model evaluation only at leading", "value": ev, "unit": "samples/s", "target": None,
-         "pass": None, "note": f"{best.timings['evaluation']:.3g} s"},
-        {"what": "uq wall time for the 10^6-run request", "value": best.seconds, "unit": "s",
-         "target": 3.0 if not quick else None, "pass": bool(best.seconds <= 3.0) if not quick else None,
-         "note": "in-process, kernels warm (process start-up not included)"},
-    ], "timings": best.timings, "n_samples": best.n_samples}

@@ -19,7 +19,8 @@ def _w(y, r):
 
 @pytest.mark.parametrize("mid", [0, 1, 2])
 def test_patches_and_asymptotics_match_quadrature(mid):
-    Ys = np.concatenate([np.linspace(-80, 1.9, 800), [-31.7501, -31.7499, -31.5001, -31.4999, -31.0001, -30.9999, -1e-9, 1e-9, 0.2499, 0.2501, 0.4999, 0.5001]])
+    Ys = np.concatenate([np.linspace(-80, 1.9, 800), [-31.7501, -31.7499, -31.5001, -31.4999, -31.0001, -30.9999,
+                                                        -1e-9, 1e-9, 0.2499, 0.2501, 0.4999, 0.5001]])
     if mid == 0:
         Ys = np.concatenate([Ys, np.linspace(2, 9.7, 50), [9.4999, 9.5, 9.7499, 9.75]])
     for Y in Ys:

@@ -1,18 +1,41 @@
-"""Bench section: a 2-D BVP sweep on a 2-worker dask LocalCluster against 1 worker."""
+"""Bench section ``distributed``: a 2-D BVP sweep on a 2-worker dask LocalCluster against 1 worker."""
 
 from __future__ import annotations
 
 import contextlib
 import math
+import os
 import time
 
 import numpy as np
 
-from ipmc_asym.parallel.executors import _env, _worker_env, warm_kernels, worker_setup
-from ipmc_asym.studies.sweep_chunks import _sweep_task, sweep_chunked
+from ipmc_asym.parallel.executors import BLAS_ENV, warm_kernels, worker_setup
+from ipmc_asym.studies.sweep_chunks import sweep_chunked
 from ipmc_asym.studies.sweeps import sweep
 
-def bench_section(quick: bool = False, shape: tuple | None = None, repeats: int | None = None) -> dict:
+__all__ = ["section", "WORKER_ENV"]
+
+#: environment of the worker processes: one BLAS and one Numba thread each
+WORKER_ENV = {**BLAS_ENV, "NUMBA_NUM_THREADS": "1"}
+
+
+@contextlib.contextmanager
+def environment(values):
+    """``values`` set in ``os.environ`` while the clusters run (their worker processes inherit
+    them: the thread counts must be set before a worker imports NumPy); restored after."""
+    old = {k: os.environ.get(k) for k in values}
+    os.environ.update(values)
+    try:
+        yield
+    finally:
+        for k, v in old.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
+
+
+def section(quick: bool = False, shape: tuple | None = None, repeats: int | None = None) -> dict:
     """``ipmc-asym bench`` section: a 2-D BVP sweep on a 2-worker LocalCluster vs 1 worker.
 
     LocalClusters of 1 and 2 worker processes (one thread each), started and warmed first;
@@ -24,7 +47,7 @@ def bench_section(quick: bool = False, shape: tuple | None = None, repeats: int 
     except ImportError:
         return {"figures": [{"what": "distributed BVP sweep speed-up", "value": None, "unit": "x", "target": 1.7,
                              "pass": None, "note": "dask.distributed not installed (pip install \".[dask]\")"}]}
-    # 200 points (10 x 20), the size issue 10 states its target for; few chunks of a tiny
+    # 200 points (10 x 20), the size the target is stated for; few chunks of a tiny
     # sweep cannot balance two workers, so a smaller grid understates the speed-up
     nt, nv = shape if shape is not None else ((2, 4) if quick else (10, 20))
     vary = {"thickness": np.geomspace(100e-6, 400e-6, nt), "voltage": np.linspace(0.5, 2.0, nv)}
@@ -32,17 +55,17 @@ def bench_section(quick: bool = False, shape: tuple | None = None, repeats: int 
     warm_kernels()
     sweep({"thickness": vary["thickness"][:1], "voltage": vary["voltage"][:1]}, progress=False, **kw)
     times, results = {1: math.inf, 2: math.inf}, {}
-    env = _worker_env(1)
-    warm_task = ({"thickness": vary["thickness"][:1], "voltage": vary["voltage"][:1]}, dict(kw, progress=False))
+    env = dict(WORKER_ENV)
+    warm_vary = {"thickness": vary["thickness"][:1], "voltage": vary["voltage"][:1]}
     with contextlib.ExitStack() as stack:
-        stack.enter_context(_env(env))
+        stack.enter_context(environment(env))
         clients = {}
         for nw in (1, 2):
             cl = stack.enter_context(distributed.LocalCluster(n_workers=nw, threads_per_worker=1, processes=True,
                                                               dashboard_address=":0", env=env))
             clients[nw] = stack.enter_context(distributed.Client(cl))
             clients[nw].run(worker_setup, 1)
-            clients[nw].run(_sweep_task, warm_task)  # SciPy imports, first-call costs on every worker
+            clients[nw].run(sweep, warm_vary, progress=False, **kw)  # SciPy imports, first calls on every worker
         # alternate 1 / 2 workers and keep the best of each: the machine is shared, and a
         # burst of someone else's load should not decide the ratio
         for _ in range(repeats if repeats is not None else (1 if quick else 2)):

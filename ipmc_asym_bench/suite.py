@@ -1,42 +1,42 @@
-"""Speed/accuracy benchmark of the fidelity ladder (``ipmc-asym bench``).
+"""Speed/accuracy benchmark of the fidelity ladder (``ipmc-asym bench``): the runner.
 
 For each permittivity model (constant, linear, affine) and each fidelity:
 
-* time per point of the compiled sweep driver on ``N`` (default 10^6) random
-  ``(thickness, voltage)`` points -- thickness log-uniform in 10 um - 4 mm, voltage
-  log-uniform in 1 mV - 10 V -- single-threaded (``numba.set_num_threads(1)`` around the
-  ``prange`` driver) and parallel (all Numba threads, at most 2 here).  The groups
-  (``lambda``, ``A2``) are precomputed, so the figure is the kernel cost per point;
+* time per point of the compiled kernels on ``N`` (default 10^6) points (a log grid, or
+  random: thickness log-uniform in 10 um - 4 mm, voltage log-uniform in 1 mV - 10 V),
+  single-threaded (``numba.set_num_threads(1)`` around the ``prange`` driver) and parallel
+  (all Numba threads, at most 2 here).  The groups (``lambda``, ``A2``) are precomputed, so
+  the figure is the kernel cost per point (:func:`ipmc_asym_bench.kernels.bare_driver`);
 * first-call compile time (a subprocess with ``NUMBA_CACHE_DIR`` pointing to a fresh
   temporary directory) and cached-load time (a second subprocess with the same directory).
   ``leading`` and ``corrected`` share one compiled driver, hence one compile time;
 * the wall time of one BVP solve, averaged over a small sample (``--bvp-points`` per model)
   of the same distribution;
-* the relative error ``|I_f - I_bvp| / |I_bvp|`` of each fidelity on that sample (max and
-  median).
+* the relative error ``|I_f - I_bvp| / |I_bvp|`` of each fidelity (``moment()``) on that
+  sample (max and median).
 
 Targets (checked side by side in one run, single-threaded): leading <= 50 ns/point,
 corrected <= 200 ns/point, quadrature <= 5 us/point; leading and corrected >= 1e6x and
 quadrature >= 1e4x faster per point than the BVP.
 
-:func:`run_bench` returns one JSON-ready dict; :func:`ipmc_asym.plotting.speed.plot_speed_accuracy`
-draws ``figures/speed_accuracy.png``.  Module-level imports are stdlib + numpy only.
+Further sections (:data:`SECTIONS`, one module each) add their figures.  :func:`run_bench`
+returns one JSON-ready dict; :func:`ipmc_asym.plotting.speed.plot_speed_accuracy` draws it.
+Only the public API of ``ipmc_asym`` is used.
 """
 
 from __future__ import annotations
 
-import json
-import os
-import subprocess
-import sys
-import tempfile
-import time
+import importlib
 
+import numba
 import numpy as np
 
 from ipmc_asym.base.registry import model_names
+from ipmc_asym.integral.api import moment
+from ipmc_asym_bench.kernels import bvp_sample, startup_time, time_driver
 
-__all__ = ["run_bench", "bare_driver", "load_bench", "run_sections", "SECTIONS", "sample_points", "format_table", "TARGETS", "MODELS", "ERR_FLOOR"]
+__all__ = ["run_bench", "run_sections", "SECTIONS", "sample_points", "format_table", "TARGETS",
+           "MODELS", "ERR_FLOOR", "quick_bench"]
 
 MODELS = model_names()
 FAST = ("leading", "corrected", "quadrature")
@@ -92,130 +92,6 @@ def sample_points(n: int, seed: int = 0, layout: str = "random"):
     return th, v
 
 
-def bare_driver(fidelity, model, th, v):
-    """The compiled sweep driver on precomputed groups: the kernel cost with no API around it.
-
-    Returns
-    -------
-    call : callable
-        Runs the driver once over all points.
-    outs : list of ndarray, shape (n,)
-        Its outputs ``I, error, B1, core``.
-    """
-    from ipmc_asym.integral.api import _ORDER, _sweep, closed_model_id, groups_arrays
-    from ipmc_asym.model.params import NAFION_LI
-    from ipmc_asym.model.permittivity import get_model
-
-    perm = get_model(model)
-    lam, A2, A3, rho, sign = groups_arrays(th, v, perm, NAFION_LI)
-    lam, A2, sign = (np.ascontiguousarray(a, dtype=float) for a in (lam, A2, sign))
-    outs = [np.empty(lam.size) for _ in range(4)]
-    mid, order = closed_model_id(perm, fidelity), _ORDER[fidelity]
-
-    def call():
-        _sweep(lam, A2, A3, rho, mid, order, sign, *outs)
-
-    return call, outs
-
-
-def _time_driver(fidelity, model, th, v, threads, repeats):
-    """Best-of-``repeats`` seconds per point of the sweep driver with ``threads`` threads."""
-    import numba
-
-    call, outs = bare_driver(fidelity, model, th, v)
-    old = numba.get_num_threads()
-    numba.set_num_threads(max(1, min(int(threads), numba.config.NUMBA_NUM_THREADS)))
-    try:
-        call()  # warm-up (compile or load from cache)
-        best = np.inf
-        for _ in range(repeats):
-            t0 = time.perf_counter()
-            call()
-            best = min(best, time.perf_counter() - t0)
-    finally:
-        numba.set_num_threads(old)
-    return best / outs[0].size, int(np.count_nonzero(~np.isfinite(outs[0])))
-
-
-_COMPILE_SNIPPET = """
-import json, time
-t0 = time.perf_counter()
-from ipmc_asym.integral.api import moment
-t1 = time.perf_counter()
-moment(2e-4, 1.0, "constant", {fid!r})
-t2 = time.perf_counter()
-print(json.dumps({{"import": t1 - t0, "first_call": t2 - t1}}))
-"""
-
-
-def _compile_times(fidelity_group: str):
-    """(compile s, cached-load s) of the driver used by ``fidelity_group`` in fresh processes."""
-    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-    env = dict(os.environ)
-    env["PYTHONPATH"] = root + (os.pathsep + env["PYTHONPATH"] if env.get("PYTHONPATH") else "")
-    code = _COMPILE_SNIPPET.format(fid=fidelity_group)
-    out = []
-    with tempfile.TemporaryDirectory(prefix="ipmc_bench_cache_") as d:
-        env["NUMBA_CACHE_DIR"] = d
-        for _ in range(2):
-            p = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True,
-                               timeout=600)
-            if p.returncode != 0:
-                raise RuntimeError(f"bench: compile-time subprocess failed: {p.stderr.strip().splitlines()[-1:]}")
-            out.append(json.loads(p.stdout.strip().splitlines()[-1])["first_call"])
-    return out[0], out[1]
-
-
-#: issue target: a quick estimate in a fresh process, Numba cache warm
-STARTUP_TARGET_S = 1.5
-
-
-def startup_time(repeats: int = 3) -> dict:
-    """Wall time of ``ipmc-asym estimate --fidelity leading`` in a fresh process (cache warm).
-
-    One untimed run first fills the cache; the best of ``repeats`` timed runs is reported,
-    with the heavy modules that process imported (must not include SymPy, SciPy's
-    ``integrate`` or matplotlib).
-    """
-    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-    env = dict(os.environ)
-    env["PYTHONPATH"] = root + (os.pathsep + env["PYTHONPATH"] if env.get("PYTHONPATH") else "")
-    code = ("import sys; from ipmc_asym.cli import main; rc = main(['estimate', '--fidelity', 'leading']); "
-            "print('MODULES', ','.join(m for m in ('sympy', 'scipy.integrate', 'matplotlib') if m in sys.modules))")
-    cmd = [sys.executable, "-c", code]
-    subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=600)  # warm the cache
-    best, heavy = float("inf"), ""
-    for _ in range(max(1, int(repeats))):
-        t0 = time.perf_counter()
-        p = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=600)
-        best = min(best, time.perf_counter() - t0)
-        if p.returncode != 0:
-            raise RuntimeError(f"bench: estimate subprocess failed: {p.stderr.strip().splitlines()[-1:]}")
-        heavy = p.stdout.strip().splitlines()[-1].split(" ", 1)[-1] if "MODULES" in p.stdout else "?"
-    return {"estimate_leading_wall_s": best, "target_s": STARTUP_TARGET_S, "pass": best <= STARTUP_TARGET_S,
-            "heavy_modules_imported": [m for m in heavy.split(",") if m.strip() and m != "MODULES"]}
-
-
-def _bvp_sample(model, th, v):
-    """BVP solve times and ``I`` on the sample; points where it fails are dropped."""
-    from ipmc_asym.bvp.solver import solve
-    from ipmc_asym.model.params import NAFION_LI, Strip
-
-    times, I, keep = [], [], []
-    for k, (t, u) in enumerate(zip(th, v)):
-        t0 = time.perf_counter()
-        try:
-            r = solve(Strip(thickness=float(t), voltage=float(u)), model, NAFION_LI)
-        except (ValueError, RuntimeError, FloatingPointError):
-            continue
-        dt = time.perf_counter() - t0
-        if r.success and np.isfinite(r.I) and r.I != 0.0:
-            times.append(dt)
-            I.append(r.I)
-            keep.append(k)
-    return np.array(times), np.array(I), np.array(keep, dtype=int)
-
-
 #: further bench sections: name -> "module:function" (imported only when run).  Each function
 #: takes ``quick: bool`` and returns ``{"figures": [{"what", "value", "unit", "target", "pass",
 #: "note"}, ...], ...}``: figures measured side by side in one run, as ratios where a target is
@@ -223,18 +99,16 @@ def _bvp_sample(model, th, v):
 SECTIONS: dict[str, str] = {
     # first: fresh-process wall times, measured before the dask section (after it, the same
     # sweep measured 3.6 s instead of 2.9 s: what the cluster leaves behind is not the sweep's)
-    "commands": "ipmc_asym.bench.commands:section",  # issue 10: sweep --out 10^6 rows, figures
-    "exact_api": "ipmc_asym.bench.exact:section",
-    "uq": "ipmc_asym.studies.uq:bench_section",
-    "distributed": "ipmc_asym.bench.distributed:bench_section",
-    "charge": "ipmc_asym.studies.charge_studies:bench_section",  # issue 11: charge, step circuit/pnp
+    "commands": "ipmc_asym_bench.commands:section",  # sweep --out 10^6 rows, figures
+    "exact_api": "ipmc_asym_bench.exact:section",
+    "uq": "ipmc_asym_bench.uq:section",
+    "distributed": "ipmc_asym_bench.distributed:section",
+    "charge": "ipmc_asym_bench.charge:section",  # charge, step circuit/pnp
 }
 
 
 def run_sections(names=None, quick: bool = False) -> dict:
     """Run the registered sections ``names`` (default all); ``{name: result}``."""
-    import importlib
-
     names = list(SECTIONS) if names is None else list(names)
     out = {}
     for name in names:
@@ -276,10 +150,6 @@ def run_bench(points: int = 10**6, bvp_points: int = 5, repeats: int = 3, seed: 
         ``error_estimate_max`` (the fidelity's own estimate on the sample), ``speedup_vs_bvp``,
         ``target_seconds_per_point``, ``target_speedup``, ``pass_time``, ``pass_speedup``.
     """
-    import numba
-
-    from ipmc_asym.integral.api import moment
-
     points = int(points)
     th, v = sample_points(points, seed, layout)
     ths, vs = sample_points(max(int(bvp_points), 1), seed + 1)
@@ -287,8 +157,8 @@ def run_bench(points: int = 10**6, bvp_points: int = 5, repeats: int = 3, seed: 
     comp = {}
     startup = startup_time() if compile_times else None
     if compile_times:
-        closed = _compile_times("leading")
-        quad = _compile_times("quadrature")
+        closed = compile_times("leading")
+        quad = compile_times("quadrature")
         comp = {
             "leading": {"compile_s": closed[0], "cached_load_s": closed[1], "shared_with": "corrected"},
             "corrected": {"compile_s": closed[0], "cached_load_s": closed[1], "shared_with": "leading"},
@@ -296,7 +166,7 @@ def run_bench(points: int = 10**6, bvp_points: int = 5, repeats: int = 3, seed: 
         }
     rows = []
     for model in MODELS:
-        bt, bI, keep = _bvp_sample(model, ths, vs)
+        bt, bI, keep = bvp_sample(model, ths, vs)
         t_bvp = float(np.mean(bt)) if bt.size else None
         sub_th, sub_v = ths[keep], vs[keep]
         rows.append({
@@ -308,8 +178,8 @@ def run_bench(points: int = 10**6, bvp_points: int = 5, repeats: int = 3, seed: 
             "note": "BVP error is its stated estimate (solve_bvp tol 1e-10), not measured",
         })
         for fid in FAST:
-            s1, bad = _time_driver(fid, model, th, v, 1, repeats)
-            s2, _ = _time_driver(fid, model, th, v, threads, repeats)
+            s1, bad = time_driver(fid, model, th, v, 1, repeats)
+            s2, _ = time_driver(fid, model, th, v, threads, repeats)
             if bt.size:
                 r = moment(sub_th, sub_v, model, fid)
                 rel = np.maximum(np.abs(r.I - bI) / np.abs(bI), ERR_FLOOR)
@@ -339,16 +209,10 @@ def run_bench(points: int = 10**6, bvp_points: int = 5, repeats: int = 3, seed: 
     }
 
 
-def load_bench(path) -> dict:
-    """A saved ``ipmc-asym bench --json`` result, checked; one-line ``ValueError`` otherwise."""
-    try:
-        with open(path, encoding="utf-8") as fh:
-            res = json.load(fh)
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise ValueError(f"--bench {path!r}: cannot read a bench JSON file ({exc.__class__.__name__}: {exc})") from None
-    if not isinstance(res, dict) or not isinstance(res.get("results"), list) or "points" not in res:
-        raise ValueError(f"--bench {path!r}: not the output of `ipmc-asym bench --json` (no 'results' list)")
-    return res
+def quick_bench(points: int = 10**5, bvp_points: int = 3) -> dict:
+    """A quick in-process measurement for the speed/accuracy figure of ``ipmc-asym figures``:
+    no compile subprocesses, no further sections, one repeat."""
+    return run_bench(points, bvp_points, repeats=1, compile_times=False, sections=[])
 
 
 def _t(x):
@@ -367,7 +231,8 @@ def _pf(b):
 def format_table(res: dict) -> str:
     """Human-readable table of :func:`run_bench`'s result."""
     lines = [f"ipmc-asym bench: N = {res['points']} points (thickness 10 um - 4 mm, voltage 1 mV - 10 V, "
-             f"log-uniform, {res['ranges'].get('layout', 'random')}), parallel = {res['threads']} threads, BVP sample {res['bvp_points']}/model"]
+             f"log-uniform, {res['ranges'].get('layout', 'random')}), parallel = {res['threads']} threads, "
+             f"BVP sample {res['bvp_points']}/model"]
     hdr = (f"{'model':9s} {'fidelity':10s} {'t/pt serial':>12s} {'t/pt par':>10s} {'target':>9s} {'time':>5s} "
            f"{'x vs BVP':>9s} {'target':>7s} {'spd':>5s} {'err max':>9s} {'err med':>9s} {'estimate':>9s}")
     lines.append(hdr)

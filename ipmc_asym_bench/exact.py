@@ -1,33 +1,43 @@
-"""Bench section ``exact_api`` (issue 10): the ``exact`` fidelity and the cost of the API.
+"""Bench section ``exact_api``: the ``exact`` fidelity and the cost of the API.
 
 Every figure is measured side by side in one run, as a ratio where the target is a ratio:
 
 * ``exact`` time per point (1 thread) on 1 um - 10 mm x +-(1e-4 - 20) V x 3 models, and its
   speed-up over one BVP solve on a sample of the same distribution;
 * ``exact`` vs the BVP on that sample (max relative difference of ``I``);
-* the API (``moment_integral``, fused driver) vs the bare sweep driver on precomputed groups
-  at ``10^7`` points (``leading``, 1 thread), ``moment()`` beside it, and the API's 2-thread
+* the API (``moment_integral``, fused driver) vs the bare compiled kernels on precomputed
+  groups (:func:`ipmc_asym_bench.kernels.bare_driver`) at ``10^7`` points (``leading``, 1 thread),
+  ``moment()`` beside it, and the API's 2-thread
   speed-up;
 * ``leading`` / ``corrected`` API time per point (``moment_integral``, 1 thread, each model)
   over a compiled loop of 7 transcendental calls per point (:mod:`ipmc_asym.kernels.reference`);
 * temporaries of one ``moment()`` call beyond its inputs and outputs (tracemalloc peak),
   bytes per point;
 * one scalar ``moment_integral(2e-4, 1.0, fidelity="leading")`` call (warm), and its ratio to
-  the bare compiled point;
+  the bare compiled point (:func:`ipmc_asym_bench.kernels.point_kernel` on the point's groups);
 * warm ``ipmc-asym estimate --fidelity leading`` over ``python -c "import numba"``.
 
-Module-level imports are stdlib + numpy only.
+Only the public API of ``ipmc_asym`` is used.
 """
 
 from __future__ import annotations
 
 import math
-import os
 import subprocess
 import sys
 import time
+import timeit
+import tracemalloc
 
+import numba
 import numpy as np
+
+from ipmc_asym.base.registry import FIDELITIES
+from ipmc_asym.integral.api import closed_model_id, groups_arrays, moment, moment_integral
+from ipmc_asym.kernels.reference import seven_transcendentals
+from ipmc_asym.model.params import NAFION_LI, Strip
+from ipmc_asym.model.permittivity import get_model
+from ipmc_asym_bench.kernels import bare_driver, point_kernel, subprocess_env
 
 __all__ = ["section", "exact_sample", "api_vs_kernel", "api_vs_transcendentals", "temporaries_per_point",
            "scalar_call", "startup_ratio"]
@@ -46,8 +56,6 @@ def _fig(what, value, unit, target, ok, note=""):
 
 
 def _threads(n):
-    import numba
-
     old = numba.get_num_threads()
     numba.set_num_threads(max(1, min(int(n), numba.config.NUMBA_NUM_THREADS)))
     return old
@@ -73,9 +81,7 @@ def exact_sample(n: int, seed: int = 0):
 def exact_timing(n: int = 3000, bvp_n: int = 2, repeats: int = 3, seed: int = 0) -> dict:
     """``exact`` seconds per point (1 thread, each model) and the BVP seconds per solve and
     max relative difference on ``bvp_n`` points per model of the same distribution."""
-    from ipmc_asym.bvp.solver import solve  # deferred: heavy import (start-up): scipy.integrate
-    from ipmc_asym.integral.api import moment
-    from ipmc_asym.model.params import Strip
+    from ipmc_asym.bvp.solver import solve  # deferred: heavy import (scipy.integrate)
 
     th, v = exact_sample(n, seed)
     out = {}
@@ -105,14 +111,11 @@ def exact_timing(n: int = 3000, bvp_n: int = 2, repeats: int = 3, seed: int = 0)
 def api_vs_kernel(n: int = 10**7, repeats: int = 3, threads: int = 2) -> dict:
     """The API vs the bare driver on precomputed groups, ``leading``, constant model.
 
-    The API is ``moment_integral(th, v, on_invalid="nan")`` (what the issue measured: the
-    array in, ``I`` out, invalid points NaN); ``moment()`` (every bookkeeping array: error,
+    The API is ``moment_integral(th, v, on_invalid="nan")`` (the array in, ``I`` out,
+    invalid points NaN); ``moment()`` (every bookkeeping array: error,
     B1, core, lam, A2, valid) is timed beside it.  Best of ``repeats``, kernel and API
     interleaved so that both see the same machine load.
     """
-    from ipmc_asym.bench.suite import bare_driver
-    from ipmc_asym.integral.api import moment, moment_integral
-
     th = np.exp(np.linspace(np.log(10e-6), np.log(4e-3), n))
     v = np.exp(np.linspace(np.log(1e-3), np.log(10.0), n))[::-1].copy()
     kernel, _ = bare_driver("leading", "constant", th, v)
@@ -143,9 +146,6 @@ def api_vs_transcendentals(n: int = 10**7, repeats: int = 3) -> dict:
     """Seconds per point, 1 thread, of ``moment_integral`` (``leading``, ``corrected``; each
     model) and of the 7-transcendental reference loop (:mod:`ipmc_asym.kernels.reference`),
     on the points of :func:`api_vs_kernel`, interleaved (same machine load)."""
-    from ipmc_asym.integral.api import moment_integral
-    from ipmc_asym.kernels.reference import seven_transcendentals
-
     th = np.exp(np.linspace(np.log(10e-6), np.log(4e-3), n))
     v = np.exp(np.linspace(np.log(1e-3), np.log(10.0), n))[::-1].copy()
     out = np.empty(n)
@@ -170,10 +170,6 @@ def api_vs_transcendentals(n: int = 10**7, repeats: int = 3) -> dict:
 
 def temporaries_per_point(n: int = 10**6) -> float:
     """Peak bytes allocated by one ``moment()`` call beyond its outputs, per point (tracemalloc)."""
-    import tracemalloc
-
-    from ipmc_asym.integral.api import moment
-
     th = np.exp(np.linspace(np.log(10e-6), np.log(4e-3), n))
     v = np.linspace(-2.0, 2.0, n)
     moment(th[:10], v[:10], "constant", "leading")
@@ -191,23 +187,22 @@ def temporaries_per_point(n: int = 10**6) -> float:
 
 def scalar_call(number: int = 20000) -> dict:
     """Seconds per warm ``moment_integral(2e-4, 1.0, fidelity="leading")`` and per bare
-    compiled point (the same work without the API)."""
-    import timeit
-
-    from ipmc_asym.integral.api import _SCALAR_CACHE, _scalar_point, moment_integral
-
-    moment_integral(2e-4, 1.0, fidelity="leading")
-    consts = _SCALAR_CACHE[("constant", "leading")]
+    compiled point (:func:`ipmc_asym_bench.kernels.point_kernel` on the groups of that point,
+    precomputed: the kernel without the API)."""
+    perm = get_model("constant")
+    lam, A2, A3, rho, _ = groups_arrays(np.array([2e-4]), np.array([1.0]), perm, NAFION_LI)
+    args = (float(lam[0]), float(A2[0]), float(A3), float(rho), closed_model_id(perm, "leading"),
+            FIDELITIES["leading"].order)
+    moment_integral(2e-4, 1.0, fidelity="leading")  # the first call sets up what later calls reuse
+    point_kernel(*args)
     api = min(timeit.repeat(lambda: moment_integral(2e-4, 1.0, fidelity="leading"), number=number, repeat=5)) / number
-    bare = min(timeit.repeat(lambda: _scalar_point(2e-4, 1.0, *consts), number=number, repeat=5)) / number
+    bare = min(timeit.repeat(lambda: point_kernel(*args), number=number, repeat=5)) / number
     return {"api_s": api, "bare_s": bare}
 
 
 def startup_ratio(repeats: int = 3) -> dict:
     """Best-of wall times of warm ``estimate --fidelity leading`` and ``import numba``, fresh processes."""
-    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-    env = dict(os.environ)
-    env["PYTHONPATH"] = root + (os.pathsep + env["PYTHONPATH"] if env.get("PYTHONPATH") else "")
+    env = subprocess_env()
     est = [sys.executable, "-c", "from ipmc_asym.cli import main; main(['estimate', '--fidelity', 'leading'])"]
     nb = [sys.executable, "-c", "import numba"]
     subprocess.run(est, env=env, capture_output=True, timeout=600)  # warm every cache

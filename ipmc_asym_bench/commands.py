@@ -1,4 +1,4 @@
-"""Bench section ``commands`` (issue 10): wall time of the long commands, as a user runs them.
+"""Bench section ``commands``: wall time of the long commands, as a user runs them.
 
 * ``ipmc-asym sweep --vary thickness=50um:500um:1000 --vary voltage=0.1V:3V:1000 --fidelity
   leading --out F.csv`` (10^6 rows, leading), target <= 3 s;
@@ -6,7 +6,7 @@
 
 Each in a fresh process (the Numba cache warm: one untimed run first), best of ``repeats``.
 Quick mode: a 10^4-row sweep only, reported without a target.  Module-level imports are
-stdlib only.
+stdlib and :mod:`ipmc_asym_bench.kernels` (which loads the kernels).
 """
 
 from __future__ import annotations
@@ -18,6 +18,8 @@ import sys
 import tempfile
 import time
 
+from ipmc_asym_bench.kernels import subprocess_env
+
 __all__ = ["section", "command_seconds", "TARGETS"]
 
 TARGETS = {"sweep_csv_1e6_s": 3.0, "figures_s": 15.0}
@@ -27,9 +29,7 @@ SWEEP_1E6 = ["sweep", "--vary", "thickness=50um:500um:1000", "--vary", "voltage=
 
 def command_seconds(args, repeats: int = 2) -> float:
     """Best wall time of ``python -m ipmc_asym ARGS`` in fresh processes (after one warm-up run)."""
-    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-    env = dict(os.environ)
-    env["PYTHONPATH"] = root + (os.pathsep + env["PYTHONPATH"] if env.get("PYTHONPATH") else "")
+    env = subprocess_env()
     cmd = [sys.executable, "-m", "ipmc_asym", *args]
     best = math.inf
     for k in range(1 + max(1, int(repeats))):

@@ -1,16 +1,26 @@
-"""``ipmc-asym bench``: time and accuracy of each fidelity, side by side in one run."""
+"""``ipmc-asym bench``: time and accuracy of each fidelity, side by side in one run.
+
+A command of ``ipmc-asym`` found through the entry point group ``ipmc_asym.commands``
+(``bench = "ipmc_asym_bench.cli"`` in pyproject.toml): :data:`SUMMARY`, :func:`register`
+and :func:`run` as the command modules of :mod:`ipmc_asym.cli`, and
+:func:`speed_accuracy_data`, the measurement ``ipmc-asym figures`` draws its
+speed/accuracy plot from when it is given no ``--bench FILE``.
+"""
 
 from __future__ import annotations
 
-from ipmc_asym.bench.suite import format_table, run_bench
-from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import count_type
 from ipmc_asym.io.fileio import check_output_path
 from ipmc_asym.io.jsonio import dumps
 
+__all__ = ["SUMMARY", "register", "run", "speed_accuracy_data"]
+
+#: one line in ``ipmc-asym --help``
+SUMMARY = "time and accuracy of each fidelity, side by side in one run"
+
 
 def register(sub):
-    p = sub.add_parser("bench", help=SUMMARIES["bench"])
+    p = sub.add_parser("bench", help=SUMMARY)
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--points", type=count_type("--points"), default=10**6, help="sweep size N (default 10^6)")
     p.add_argument("--bvp-points", type=count_type("--bvp-points"), default=5,
@@ -26,6 +36,11 @@ def register(sub):
 
 
 def run(args) -> int:
+    from ipmc_asym_bench.suite import (  # deferred: numba and the compiled kernels (start-up of --help)
+        format_table,
+        run_bench,
+    )
+
     if args.figure:
         check_output_path(args.figure, "file", "--figure")
     res = run_bench(args.points, args.bvp_points, compile_times=not args.no_compile, layout=args.layout,
@@ -43,3 +58,11 @@ def run(args) -> int:
         if args.figure:
             print(f"figure: {res['figure']}")
     return 0
+
+
+def speed_accuracy_data(points: int = 10**5, bvp_points: int = 3) -> dict:
+    """A quick in-process bench result (no compile subprocesses, no further sections), in the
+    format of ``ipmc-asym bench --json``."""
+    from ipmc_asym_bench.suite import quick_bench  # deferred: numba and the compiled kernels
+
+    return quick_bench(points, bvp_points)

@@ -1,1 +1,0 @@
-"""Benchmark of speed and accuracy (``ipmc-asym bench``)."""
