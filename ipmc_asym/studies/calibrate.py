@@ -135,6 +135,16 @@ def read_data(path, base: Strip | None = None) -> CalibrationData:
     column takes ``base``), measured ``deflection`` (|w|, m) and/or ``blocking_force``
     (|F|, N), optional ``sigma_deflection``, ``sigma_blocking_force``.  An empty measured
     cell means "not measured in this row".  Every error is one line naming the row/column.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> path = os.path.join(tempfile.mkdtemp(), "data.csv")
+    >>> with open(path, "w") as fh:
+    ...     _ = fh.write("voltage,deflection\\n0.5V,1.0mm\\n1V,2.1mm\\n1.5V,2.9mm\\n")
+    >>> data = read_data(path)
+    >>> data.n_points
+    3
     """
     base = Strip() if base is None else base
     p = os.fspath(path)
@@ -449,6 +459,16 @@ def fit(data: CalibrationData, free, model="constant", material: Material = NAFI
     ValueError
         One line: unknown parameter, too many free parameters for the data (the request is
         refused before any work), a fidelity outside its validity at every rung.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> path = os.path.join(tempfile.mkdtemp(), "data.csv")
+    >>> with open(path, "w") as fh:
+    ...     _ = fh.write("voltage,deflection\\n0.5V,1.0mm\\n1V,2.1mm\\n1.5V,2.9mm\\n")
+    >>> res = fit(read_data(path), "modulus", fidelity="corrected")
+    >>> res.success, res.parameters["modulus"]["identifiable"]
+    (True, True)
     """
     from scipy import stats  # deferred: heavy import (start-up)
 

@@ -140,6 +140,12 @@ def profile_summary(model="constant", strip: Strip | None = None, material: Mate
         electroneutrality), ``D_core`` (|D_bar| max over the central half), ``p_anode``,
         ``p_cathode``, ``E_anode``, ``E_cathode``, ``I``, ``cathode_charge`` (F B1 C_moy, C/m^3),
         ``debye_um`` (core Debye length), ``e_um`` (HALF thickness), ``n_nodes``.
+
+    Examples
+    --------
+    >>> r = profile_summary("constant")
+    >>> r["model"], r["e_um"]
+    ('constant', 100.0)
     """
     strip = Strip() if strip is None else strip
     if res is None:
