@@ -137,7 +137,7 @@ def profile_summary(model="constant", strip: Strip | None = None, material: Mate
     dict
         ``model``, ``B1`` (= C_bar at the cathode), ``C_anode``, ``depletion_um``, ``devoid_um``,
         ``accumulation_um``, ``accumulation_half_um``, ``D_face`` (D_bar at the faces, equal by
-        electroneutrality), ``D_core`` (|D_bar| max over the central half), ``p_anode``,
+        electroneutrality), ``D_core`` (``|D_bar|`` max over the central half), ``p_anode``,
         ``p_cathode``, ``E_anode``, ``E_cathode``, ``I``, ``cathode_charge`` (F B1 C_moy, C/m^3),
         ``debye_um`` (core Debye length), ``e_um`` (HALF thickness), ``n_nodes``.
 
