@@ -27,12 +27,18 @@ for ax in axes:
     ax.set_xlabel("z / e")
 
 # %%
-# The layers are thin: a zoom at the cathode, in micrometres from the face.
+# The layers are thin: concentration against the distance from each face, in micrometres,
+# on logarithmic axes.  Near the anode the cations are depleted: the curve is drawn where
+# C / C_moy stays above 1e-12.
 fig, ax = plt.subplots(figsize=(5, 3.4))
-near = res.z > 0.9
-ax.semilogy(1e6 * (1 - res.z[near]) * strip.e, res.C[near])
-ax.set_xlabel("distance from the cathode [µm]")
+d_cathode = (1 - res.z) * strip.e
+d_anode = (1 + res.z) * strip.e
+near_c, near_a = (d_cathode > 0) & (res.z > 0), (d_anode > 0) & (res.z < 0) & (res.C > 1e-12)
+ax.loglog(1e6 * d_cathode[near_c], res.C[near_c], label="from the cathode (z = +e)")
+ax.loglog(1e6 * d_anode[near_a], res.C[near_a], label="from the anode (z = -e)")
+ax.set_xlabel("distance from the face [µm]")
 ax.set_ylabel("C / C_moy")
-ax.set_xlim(0, 1e6 * 0.1 * strip.e)
+ax.set_xlim(1e-4, 1e6 * strip.e)
+ax.legend(fontsize=8)
 fig.tight_layout()
 plt.show()

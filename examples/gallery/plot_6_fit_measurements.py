@@ -29,13 +29,17 @@ print(f"modulus = {p['value'] / 1e6:.4g} MPa +- {p['stderr'] / 1e6:.2g} MPa, "
       f"95 % interval [{p['ci95'][0] / 1e6:.4g}, {p['ci95'][1] / 1e6:.4g}] MPa")
 
 # %%
-# Data with their one-sigma error bars, and the fitted model.
+# Data with their one-sigma error bars, and the fitted model, for each total thickness.
 v = data.geometry["voltage"]
-o = np.argsort(v)
+th = data.geometry["thickness"]
 fig, axes = plt.subplots(1, 2, figsize=(9, 3.6))
 for ax, key, unit in zip(axes, ("deflection", "blocking_force"), ("mm", "mN")):
-    ax.errorbar(v, 1e3 * data.measured[key], yerr=1e3 * data.sigma[key], fmt="o", ms=4, label="data")
-    ax.plot(v[o], 1e3 * res.predictions[key][o], "-", label="fit")
+    for j, t in enumerate(np.unique(th)):
+        s = th == t
+        o = np.argsort(v[s])
+        ax.errorbar(v[s], 1e3 * data.measured[key][s], yerr=1e3 * data.sigma[key][s], fmt="o", ms=4,
+                    color=f"C{j}", label=f"data, 2e = {1e6 * t:g} µm")
+        ax.plot(v[s][o], 1e3 * res.predictions[key][s][o], "-", color=f"C{j}", label="fitted model" if j == 0 else None)
     ax.set_xlabel("voltage φ0 [V]")
     ax.set_ylabel(f"{key.replace('_', ' ')} [{unit}]")
     ax.legend(fontsize=8)
