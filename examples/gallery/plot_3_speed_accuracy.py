@@ -27,7 +27,8 @@ for fid in ("leading", "corrected", "quadrature", "exact"):
     val = ia.moment_integral(thickness, voltage, model="constant", fidelity=fid)
     seconds[fid] = time.perf_counter() - t0
     errors[fid] = float(np.max(np.abs(val / ref - 1)))
-    print(f"{fid:10s} {1e9 * seconds[fid] / thickness.size:8.1f} ns a point   max rel. error vs exact {errors[fid]:.2e}")
+    ns = 1e9 * seconds[fid] / thickness.size
+    print(f"{fid:10s} {ns:8.1f} ns a point   max rel. error vs exact {errors[fid]:.2e}")
 
 # %%
 fig, ax = plt.subplots(figsize=(5, 3.6))

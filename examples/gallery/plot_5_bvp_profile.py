@@ -8,7 +8,6 @@ cathode at +1): concentration, potential, field, pressure.
 """
 
 import matplotlib.pyplot as plt
-import numpy as np
 
 import ipmc_asym as ia
 
