@@ -20,6 +20,7 @@ import importlib
 import importlib.abc
 import importlib.util
 import sys
+import types
 
 __version__ = "0.1.0"
 
@@ -41,6 +42,13 @@ __all__ = [
     "charge",
     "step_response",
     "frequency_response",
+    "fit",
+    "read_fit_data",
+    "uq",
+    "profiles",
+    "validate",
+    "laws",
+    "scene",
 ]
 
 _LAZY = {
@@ -61,6 +69,13 @@ _LAZY = {
     "charge": ("ipmc_asym.dynamics.electrode", "charge"),
     "step_response": ("ipmc_asym.dynamics.circuit", "step_response"),
     "frequency_response": ("ipmc_asym.dynamics.circuit", "frequency_response"),
+    "fit": ("ipmc_asym.studies.calibrate", "fit"),
+    "read_fit_data": ("ipmc_asym.studies.calibrate", "read_data"),
+    "uq": ("ipmc_asym.studies.uq", "run_uq"),
+    "profiles": ("ipmc_asym.studies.profiles", "profile_summary"),
+    "validate": ("ipmc_asym.validation.validate", "claims"),
+    "laws": ("ipmc_asym.studies.laws", "law_table"),
+    "scene": ("ipmc_asym.studies.scenes", "run_scene"),
 }
 
 
@@ -101,6 +116,18 @@ class _MovedFinder(importlib.abc.MetaPathFinder):
             return None
         return importlib.util.spec_from_loader(fullname, _MovedLoader(f"{__name__}.{MOVED[old]}"))
 
+
+class _Package(types.ModuleType):
+    """The package module: a flat module path imported (``import ipmc_asym.uq``) does not shadow
+    the public function of the same name (``ipmc_asym.uq`` stays :func:`run_uq`)."""
+
+    def __setattr__(self, name, value):
+        if name in _LAZY and isinstance(value, types.ModuleType):
+            return
+        super().__setattr__(name, value)
+
+
+sys.modules[__name__].__class__ = _Package
 
 if not any(isinstance(f, _MovedFinder) for f in sys.meta_path):
     sys.meta_path.append(_MovedFinder())

@@ -26,7 +26,7 @@ assumes it.
 
 Weights: a ``sigma_<measured>`` column is one standard deviation (absolute, chi^2 with
 known scale, threshold ``chi2.ppf(0.95, 1) = 3.84``).  Without it the weights are equal and
-relative (residual / |measured|) and the scale is estimated from the residuals
+relative (``residual / |measured|``) and the scale is estimated from the residuals
 (``s^2 = chi^2/(n - p)``; covariance scaled by ``s^2``; profile threshold ``t_{0.975,n-p}^2``).
 
 Fidelity: the cheapest rung of ``leading -> corrected -> quadrature -> bvp`` whose error
@@ -132,9 +132,19 @@ def read_data(path, base: Strip | None = None) -> CalibrationData:
     """Read a calibration CSV (header row; SI numbers or values with units).
 
     Columns: any of ``length, width, thickness, voltage`` (width/thickness TOTAL; a missing
-    column takes ``base``), measured ``deflection`` (|w|, m) and/or ``blocking_force``
-    (|F|, N), optional ``sigma_deflection``, ``sigma_blocking_force``.  An empty measured
+    column takes ``base``), measured ``deflection`` (``|w|``, m) and/or ``blocking_force``
+    (``|F|``, N), optional ``sigma_deflection``, ``sigma_blocking_force``.  An empty measured
     cell means "not measured in this row".  Every error is one line naming the row/column.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> path = os.path.join(tempfile.mkdtemp(), "data.csv")
+    >>> with open(path, "w") as fh:
+    ...     _ = fh.write("voltage,deflection\\n0.5V,1.0mm\\n1V,2.1mm\\n1.5V,2.9mm\\n")
+    >>> data = read_data(path)
+    >>> data.n_points
+    3
     """
     base = Strip() if base is None else base
     p = os.fspath(path)
@@ -449,6 +459,16 @@ def fit(data: CalibrationData, free, model="constant", material: Material = NAFI
     ValueError
         One line: unknown parameter, too many free parameters for the data (the request is
         refused before any work), a fidelity outside its validity at every rung.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> path = os.path.join(tempfile.mkdtemp(), "data.csv")
+    >>> with open(path, "w") as fh:
+    ...     _ = fh.write("voltage,deflection\\n0.5V,1.0mm\\n1V,2.1mm\\n1.5V,2.9mm\\n")
+    >>> res = fit(read_data(path), "modulus", fidelity="corrected")
+    >>> res.success, res.parameters["modulus"]["identifiable"]
+    (True, True)
     """
     from scipy import stats  # deferred: heavy import (start-up)
 

@@ -43,7 +43,14 @@ LATEX_SYMBOLS = {"eps0": r"\varepsilon_0", "Delta_eps": r"\Delta\varepsilon", "d
 
 
 def law_table(model=None):
-    """Leading-order laws from the derivation: list of dict rows (SymPy objects stringified)."""
+    """Leading-order laws from the derivation: list of dict rows (SymPy objects stringified).
+
+    Examples
+    --------
+    >>> rows = law_table("constant")
+    >>> {r["model"] for r in rows}, "I" in {r["quantity"] for r in rows}
+    ({'constant'}, True)
+    """
     import sympy as sp  # deferred: SymPy (start-up)
     from ipmc_asym_derivations import scaling  # deferred: SymPy (start-up)
 

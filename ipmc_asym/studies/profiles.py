@@ -137,9 +137,15 @@ def profile_summary(model="constant", strip: Strip | None = None, material: Mate
     dict
         ``model``, ``B1`` (= C_bar at the cathode), ``C_anode``, ``depletion_um``, ``devoid_um``,
         ``accumulation_um``, ``accumulation_half_um``, ``D_face`` (D_bar at the faces, equal by
-        electroneutrality), ``D_core`` (|D_bar| max over the central half), ``p_anode``,
+        electroneutrality), ``D_core`` (``|D_bar|`` max over the central half), ``p_anode``,
         ``p_cathode``, ``E_anode``, ``E_cathode``, ``I``, ``cathode_charge`` (F B1 C_moy, C/m^3),
         ``debye_um`` (core Debye length), ``e_um`` (HALF thickness), ``n_nodes``.
+
+    Examples
+    --------
+    >>> r = profile_summary("constant")
+    >>> r["model"], r["e_um"]
+    ('constant', 100.0)
     """
     strip = Strip() if strip is None else strip
     if res is None:

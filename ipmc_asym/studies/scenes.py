@@ -139,6 +139,12 @@ def run_scene(scene) -> dict:
     ValueError
         Unknown section/key, wrong type, impossible value or unreadable file (the message
         names the key).
+
+    Examples
+    --------
+    >>> r = run_scene({"name": "demo", "model": "constant", "voltage": "1V", "outputs": ["I"]})
+    >>> r["valid"], r["points"][0]["thickness"]
+    (True, 0.0002)
     """
     raw = scene
     if not isinstance(scene, (dict, Scene)):

@@ -420,6 +420,14 @@ def run_uq(scene, samples: int = 10**6, *, seed: int = 0, fidelity: str | None =
     Returns
     -------
     UQResult
+
+    Examples
+    --------
+    >>> scene = {"name": "demo", "model": "constant", "voltage": "1V", "outputs": ["I"],
+    ...          "uncertain": {"thickness": {"dist": "normal", "mean": "200um", "sd": "8um"}}}
+    >>> res = run_uq(scene, 64, fidelity="leading")
+    >>> res.n_samples, sorted(res.summary)
+    (96, ['I'])
     """
     t0 = time.perf_counter()
     if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 1:

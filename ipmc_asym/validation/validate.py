@@ -666,6 +666,12 @@ def claims(material: Material = NAFION_LI, strip: Strip | None = None, table=CLA
         (our numbers, formatted from computed values), ``verdict`` (:data:`VERDICTS`, from
         :func:`judge`), ``key``, ``criterion`` (the test applied), ``reason`` (why) and
         ``value`` (the number(s) judged).
+
+    Examples
+    --------
+    >>> rows = claims(table=CLAIMS[:1])
+    >>> rows[0]["key"], rows[0]["verdict"] in VERDICTS
+    ('slip1_cmoy', True)
     """
     ctx = Context(material, strip)
     rows = []
