@@ -52,6 +52,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ipmc_asym.base.registry import closed_form_fidelities, fidelity_names
+from ipmc_asym.beam.statics import blocking_force_ratio
 from ipmc_asym.model.params import NAFION_LI, Material, Strip
 from ipmc_asym.base.units import parse_length, parse_pressure, parse_quantity, parse_voltage
 
@@ -287,8 +288,7 @@ def predict(values: dict, geometry: dict, model="constant", fidelity="leading",
         ``1 + d ln psi / d ln(kappa L)`` (by a central difference).
     valid : ndarray of bool (n_rows,)
     """
-    from ipmc_asym.beam.statics import blocking_force_ratio  # deferred: layer rule (numpy-only import)
-    from ipmc_asym.forward.model import forward  # deferred: layer rule (compiled kernels)
+    from ipmc_asym.forward.model import forward  # deferred: heavy import (Numba kernels), start-up
 
     mat = _material(material, values)
     perm = _perm(model, values)
