@@ -19,7 +19,7 @@ from ipmc_asym.base.registry import FIDELITIES as _FIDELITY_SPECS
 from ipmc_asym.base.registry import fidelity_names
 from ipmc_asym.base.settings import VALIDITY_LIMIT
 
-__all__ = ["moment_escalating", "Escalated", "check_tol"]
+__all__ = ["moment_escalating", "Escalated", "check_tol", "rung_checks"]
 
 
 def check_tol(tol, what="tol"):
@@ -30,6 +30,18 @@ def check_tol(tol, what="tol"):
             or not 0.0 < float(tol) < 1.0:
         raise ValueError(f"{what} must be a relative tolerance in (0, 1), e.g. 0.01 for 1 %; got {tol!r}")
     return float(tol)
+
+
+def rung_checks(I, error, core, fidelity: str, limit: float):
+    """``(electrochemistry, layer_separation)`` of one rung's values, bool arrays.
+
+    ``electrochemistry``: ``I`` finite and its error bound <= ``limit``; ``layer_separation``:
+    the neutral core between the layers is positive, or the rung holds at any thickness
+    (``integral.api.ANY_THICKNESS``).
+    """
+    with np.errstate(invalid="ignore"):
+        e_ok = np.isfinite(I) & (error <= limit)
+    return e_ok, (core > 0) | (fidelity in ANY_THICKNESS)
 
 
 @dataclass
@@ -120,8 +132,7 @@ def moment_escalating(thickness, voltage, model="constant", fidelity="quadrature
         except ValueError as exc:  # e.g. closed forms for a non-paper Permittivity
             why.append(f"{f}: {exc}")
             continue
-        e_ok = np.isfinite(r.I) & (r.error <= limit)
-        l_ok = (r.core > 0) | (f in ANY_THICKNESS)
+        e_ok, l_ok = rung_checks(r.I, r.error, r.core, f, limit)
         # r.valid adds the rung's own ceiling (registry) to the checks here
         ok = e_ok & l_ok & np.asarray(r.success) & np.asarray(r.valid)
         sel = idx[ok]

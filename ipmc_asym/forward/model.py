@@ -26,8 +26,8 @@ from ipmc_asym.beam.statics import REGIMES, solve_beam
 from ipmc_asym.base.registry import FIDELITIES as _FIDELITY_SPECS
 from ipmc_asym.base.registry import fidelity_names
 from ipmc_asym.base.settings import OUTSIDE_REGIMES, STRAIN_LIMIT, VALIDITY_LIMIT
-from ipmc_asym.forward.escalation import Escalated, check_tol, moment_escalating
-from ipmc_asym.integral.api import ANY_THICKNESS, check_fidelity, check_min_thickness, closed_model_id, validity_limit
+from ipmc_asym.forward.escalation import Escalated, check_tol, moment_escalating, rung_checks
+from ipmc_asym.integral.api import check_fidelity, check_min_thickness, closed_model_id, validity_limit
 from ipmc_asym.integral.samples import moment_samples
 from ipmc_asym.model.params import NAFION_LI, Material, moment_scale, second_moment
 from ipmc_asym.model.permittivity import get_model
@@ -219,9 +219,8 @@ def _moment_per_point_material(th, v, perm, fidelity, material, c_moy, tol, esca
         mid = closed_model_id(perm, f)
         Ii, ei, ci = np.empty(todo.size), np.empty(todo.size), np.empty(todo.size)
         moment_samples(lam[todo], A2[todo], A3[todo], rho, mid, _FIDELITY_SPECS[f].order, sign[todo], Ii, ei, ci)
-        with np.errstate(invalid="ignore"):
-            e_ok = np.isfinite(Ii) & (ei <= limit) & (ei < validity_limit(f))
-        l_ok = (ci > 0) | (f in ANY_THICKNESS)
+        e_ok, l_ok = rung_checks(Ii, ei, ci, f, limit)
+        e_ok &= ei < validity_limit(f)  # the rung's own ceiling (integral.api.validity_limit)
         ok = e_ok & l_ok
         sel = todo[ok]
         I[sel], err[sel], core[sel], used[sel] = Ii[ok], ei[ok], ci[ok], f

@@ -6,9 +6,10 @@ structured array with one row per grid point (and per model), SI columns::
     length width thickness voltage modulus  (inputs; width/thickness are TOTAL 2l / 2e)
     model fidelity I M_A theta w w_small F_block F_block_small regime B1 error valid
 
-``I`` comes from the vectorised :func:`ipmc_asym.integral.api.moment` (one call per model for the
-whole grid) and the mechanics from the vectorised :func:`ipmc_asym.beam.statics.solve_beam`; nothing
-loops over points in Python except the ``bvp`` fidelity.
+Each chunk of rows is one call of the vectorised forward model
+:func:`ipmc_asym.forward.model.forward` (the moment integral once per distinct (thickness,
+voltage) pair, then :func:`ipmc_asym.beam.statics.solve_beam` and the checks); nothing loops over
+points in Python except the ``bvp`` fidelity.
 
 CLI spec: ``--vary NAME=START:STOP:N`` (N points, linear) or ``NAME=START:STOP:N:log``;
 NAME in length, width, thickness, voltage, modulus; units as in ``estimate``
