@@ -51,6 +51,7 @@ from ipmc_asym.dynamics.electrode import (
     core_resistance,
     time_constant,
 )
+from ipmc_asym.forward.model import forward
 from ipmc_asym.kernels import _generated_charge as GC
 from ipmc_asym.kernels.jit import jit
 from ipmc_asym.model.params import (
@@ -222,22 +223,16 @@ def quasi_static_mechanics(u, strip: Strip, perm: Permittivity, material: Materi
     """``(M_A, theta, w, F_block)`` of the static strip at the layer voltage(s) ``u`` (V).
 
     The layers' state at a given charge is the static one at the voltage ``u = V(sigma)``
-    across them: moment at fidelity ``corrected`` (``quadrature`` for a non-paper affine
-    model), then the beam (no inertia).
+    across them: the forward model :func:`ipmc_asym.forward.model.forward` from fidelity
+    ``corrected`` (``quadrature`` for a non-paper affine model), escalated per point to the
+    first valid rung, then the beam (no inertia).  Arrays of the shape of ``u``: moment (N m),
+    rotation (rad), arc tip deflection (m), large-displacement blocking force (N).
     """
-    from ipmc_asym.beam.statics import blocking_force_large, rotation, tip_deflection
-    from ipmc_asym.integral.api import moment
-    from ipmc_asym.model.params import moment_scale
-
     fid = "corrected" if _model_id(perm, "corrected") >= 0 else "quadrature"
-    u = np.asarray(u, dtype=float)
-    r = moment(strip.thickness, u, perm, fid, material=material)
-    M = moment_scale(strip.width, strip.thickness, u, material.F, material.C_moy) * r.I
-    EI = material.E * strip.I_p
-    th = np.asarray(rotation(M, strip.length, EI), dtype=float)
-    w = np.asarray(tip_deflection(M, strip.length, EI), dtype=float)
-    Fb = np.asarray(blocking_force_large(M, strip.length, EI), dtype=float)
-    return M, th, w, Fb
+    r = forward(strip.length, strip.width, strip.thickness, np.asarray(u, dtype=float), material=material,
+                model=perm, fidelity=fid)
+    return (np.asarray(r.M_A, dtype=float), np.asarray(r.theta, dtype=float), np.asarray(r.w, dtype=float),
+            np.asarray(r.F_block, dtype=float))
 
 
 def _time_grid(duration, t, points):

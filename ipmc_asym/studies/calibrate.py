@@ -53,7 +53,8 @@ import numpy as np
 
 from ipmc_asym.base.registry import closed_form_fidelities, fidelity_names
 from ipmc_asym.base.units import parse_length, parse_pressure, parse_quantity, parse_voltage
-from ipmc_asym.model.params import NAFION_LI, Material, Strip, moment_scale, second_moment
+from ipmc_asym.beam.statics import blocking_force_ratio
+from ipmc_asym.model.params import NAFION_LI, Material, Strip
 
 __all__ = [
     "FREE_PARAMETERS",
@@ -297,29 +298,28 @@ def predict(values: dict, geometry: dict, model="constant", fidelity="leading",
         ``1 + d ln psi / d ln(kappa L)`` (by a central difference).
     valid : ndarray of bool (n_rows,)
     """
-    from ipmc_asym.beam.statics import blocking_force_large, blocking_force_ratio, tip_deflection
-    from ipmc_asym.integral.api import moment
+    from ipmc_asym.forward.model import forward  # deferred: heavy import (Numba kernels), start-up
 
     mat = _material(material, values)
     perm = _perm(model, values)
     g = geometry
-    r = moment(g["thickness"], g["voltage"], perm, fidelity, material=mat, progress=False)
-    M = moment_scale(g["width"], g["thickness"], g["voltage"], mat.F, mat.C_moy) * np.asarray(r.I)
-    EI = mat.E * second_moment(g["width"], g["thickness"])
+    # the forward model at the one rung asked for (the fit chooses the rung; no escalation)
+    r = forward(g["length"], g["width"], g["thickness"], g["voltage"], material=mat, model=perm,
+                fidelity=fidelity, escalate=False)
     err = np.asarray(r.error, float)
     with np.errstate(all="ignore"):
-        w = np.abs(np.asarray(tip_deflection(M, g["length"], EI), dtype=float))
-        F = np.abs(np.asarray(blocking_force_large(M, g["length"], EI), dtype=float))
-        u = 0.5 * np.abs(M) * g["length"] / EI
+        w = np.abs(np.asarray(r.w, dtype=float))
+        F = np.abs(np.asarray(r.F_block, dtype=float))
+        m = np.abs(np.asarray(r.theta, dtype=float))  # |kappa L|
+        u = 0.5 * m
         sw = np.where(u < 1e-4, 1.0, 2.0 * u / np.tan(np.where(u < 1e-4, 1.0, u)) - 1.0)
-        m = 2.0 * u
         h = 1e-4
         dpsi = (np.asarray(blocking_force_ratio(m * (1 + h)), float)
                 - np.asarray(blocking_force_ratio(m * (1 - h)), float)) / (2 * h)
         sF = 1.0 + dpsi / np.asarray(blocking_force_ratio(m), float)
         errors = {"deflection": np.abs(sw) * err, "blocking_force": np.abs(sF) * err}
     errors = {k: np.where(np.isfinite(v), v, np.inf) for k, v in errors.items()}
-    return {"deflection": w, "blocking_force": F}, errors, np.asarray(r.valid, bool)
+    return {"deflection": w, "blocking_force": F}, errors, np.asarray(r.moment_valid, bool)
 
 
 # ---- the fit ---------------------------------------------------------------------------------

@@ -12,9 +12,9 @@ the arc otherwise; small blocking force where :func:`ipmc_asym.beam.statics.bloc
 
 The file format and every check live in :mod:`ipmc_asym.studies.scene_schema` (TOML -> a typed
 :class:`~ipmc_asym.studies.scene_schema.Scene`); this module is the planner.  It calls the same
-functions as everything else: :func:`ipmc_asym.integral.api.moment` for ``I``, the beam formulas
-of :mod:`ipmc_asym.beam.statics`, :func:`ipmc_asym.studies.fits.fit_power_law`, and the layer widths of
-:func:`ipmc_asym.studies.profiles.layer_widths`.
+functions as everything else: the forward model :func:`ipmc_asym.forward.model.forward` for ``I``,
+the moment, the beam outputs and their checks, :func:`ipmc_asym.studies.fits.fit_power_law`, and
+the layer widths of :func:`ipmc_asym.studies.profiles.layer_widths`.
 
 Result (JSON-ready dict)::
 
@@ -41,20 +41,8 @@ from __future__ import annotations
 import numpy as np
 
 from ipmc_asym.base.registry import fidelity_names
-from ipmc_asym.base.settings import BVP_STATED_ERROR, OUTSIDE_REGIMES, STRAIN_LIMIT
-from ipmc_asym.beam.statics import (
-    blocking_force_error,
-    blocking_force_large,
-    blocking_force_small,
-    max_strain,
-    rotation,
-    small_displacement_error,
-    tip_deflection,
-    tip_deflection_small,
-)
-from ipmc_asym.beam.statics import regime as beam_regime
-from ipmc_asym.forward.estimate import moment_escalating
-from ipmc_asym.model.params import moment_scale, second_moment
+from ipmc_asym.base.settings import BVP_STATED_ERROR
+from ipmc_asym.forward.model import forward
 from ipmc_asym.studies.fits import fit_power_law
 from ipmc_asym.studies.profiles import LAYER_WIDTHS, layer_widths
 from ipmc_asym.studies.scene_schema import OUTPUTS, Scene, load_scene, read_scene
@@ -68,15 +56,17 @@ _MECHANICAL = {"moment", "tip_deflection", "rotation", "blocking_force"}
 _ANODE_WIDTH, _CATHODE_WIDTH = "devoid_um", "accumulation_um"
 
 
-def _plan_moment(sc: Scene):
-    """I, error bound and fidelity per point: the cheapest rung meeting the tolerance
-    (:func:`ipmc_asym.forward.estimate.moment_escalating`, generic over the registry's ladder).
-    Where no rung is valid: a one-line ``ValueError`` (never a number that failed its check)."""
-    r = moment_escalating(sc.points["thickness"], sc.points["voltage"], sc.model, LADDER[0], sc.material,
-                          tol=min(sc.tolerance, 0.5), progress=False)
-    if not np.all(r.valid):
-        raise ValueError(r.message)
-    return r.I, r.error, r.fidelity_used
+def _plan(sc: Scene):
+    """The forward model at the scene's points (:func:`ipmc_asym.forward.model.forward`): ``I``
+    at the cheapest rung meeting the tolerance, escalating along the registry's ladder, then the
+    beam and its checks.  Where no rung is valid: a one-line ``ValueError`` (never a number that
+    failed its check)."""
+    pts = sc.points
+    r = forward(pts["length"], pts["width"], pts["thickness"], pts["voltage"], material=sc.material,
+                model=sc.model, fidelity=LADDER[0], tol=min(sc.tolerance, 0.5))
+    if not np.all(r.moment_valid):
+        raise ValueError(r.moment_message)
+    return r
 
 
 def _scaling_fit(x, y, what):
@@ -172,48 +162,48 @@ def run_scene(scene) -> dict:
     vals = {}
     fl = []
     if set(outputs) & (_MECHANICAL | {"I", "scaling_fit"}):
-        I, err, fid = _plan_moment(sc)
-        fl = [str(f) for f in fid]
+        r = _plan(sc)
+        I, err = np.atleast_1d(r.I), np.atleast_1d(r.error)
+        fl = [str(f) for f in np.atleast_1d(r.fidelity_used)]
         el = [float(x) for x in err]
         vals["I"] = I
         if "I" in outputs:
             out["I"] = {"values": I.tolist(), "unit": "dimensionless", "fidelity": fl, "error_estimate": el}
-        M = moment_scale(pts["width"], pts["thickness"], pts["voltage"], material.F, material.C_moy) * I
+        M = np.atleast_1d(r.M_A)
         vals["moment"] = M
         if "moment" in outputs:
             out["moment"] = {"values": M.tolist(), "unit": "N m", "fidelity": fl, "error_estimate": el}
-        L = pts["length"]
-        EI = material.E * second_moment(pts["width"], pts["thickness"])
-        # beam checks: free-strip outputs past a quarter turn, and every mechanical output above
-        # the strain limit, are outside the model and withheld (None), point by point
-        reg = np.atleast_1d(beam_regime(M, L, EI, tol))
-        strain = np.atleast_1d(max_strain(M, EI, 0.5 * pts["thickness"]))
-        mech_ok = strain <= STRAIN_LIMIT
-        free_ok = ~np.isin(reg, OUTSIDE_REGIMES) & mech_ok
+        # beam checks (forward.model.WITHHOLD): free-strip outputs past a quarter turn, and every
+        # mechanical output above the strain limit, are outside the model and withheld (None)
+        free_ok = ~np.atleast_1d(r.withheld_mask("theta"))
+        mech_ok = ~np.atleast_1d(r.withheld_mask("F_block"))
+        reg_ok, strain = np.atleast_1d(r.beam_regime), np.atleast_1d(r.max_strain)
         res["checks"] = [{"electrochemistry": True, "layer_separation": True,
-                          "beam_regime": bool(not np.isin(reg[i], OUTSIDE_REGIMES)),
-                          "strain": bool(mech_ok[i]), "max_strain": float(strain[i])} for i in range(n)]
+                          "beam_regime": bool(reg_ok[i]), "strain": bool(mech_ok[i]),
+                          "max_strain": float(strain[i])} for i in range(n)]
         res["valid"] = bool(np.all(free_ok))
 
         def _kept(a, ok):
             return [float(x) if o else None for x, o in zip(np.atleast_1d(a), ok)]
         if "rotation" in outputs:
-            th = np.atleast_1d(rotation(M, L, EI))
+            th = np.atleast_1d(r.theta)  # -M L/EI, paper eq. 12
             vals["rotation"] = np.where(free_ok, th, np.nan)
             out["rotation"] = {"values": _kept(th, free_ok), "unit": "rad", "fidelity": fl, "error_estimate": el,
                                "beam": ["exact"] * n}
         if "tip_deflection" in outputs:
-            serr = np.atleast_1d(small_displacement_error(M, L, EI))
+            # the small-displacement formula (eq. 13) where its deviation from the arc is within tol
+            serr = np.atleast_1d(r.small_error)
             small = serr <= tol
-            w = np.where(small, tip_deflection_small(M, L, EI), tip_deflection(M, L, EI))
+            w = np.where(small, np.atleast_1d(r.w_small), np.atleast_1d(r.w))
             vals["tip_deflection"] = np.where(free_ok, w, np.nan)
             out["tip_deflection"] = {"values": _kept(w, free_ok), "unit": "m", "fidelity": fl,
                                      "error_estimate": (err + np.where(small, serr, 0.0)).tolist(),
                                      "beam": ["small" if s else "large" for s in small]}
         if "blocking_force" in outputs:
-            berr = np.atleast_1d(blocking_force_error(M, L, EI))
+            # 3M/(2L) (eq. 14) where its deviation from the large-displacement root is within tol
+            berr = np.atleast_1d(r.block_error)
             small = berr <= tol
-            F = np.where(small, blocking_force_small(M, L), blocking_force_large(M, L, EI))
+            F = np.where(small, np.atleast_1d(r.F_block_small), np.atleast_1d(r.F_block))
             if not np.all(np.isfinite(F) | ~mech_ok):
                 k = int(np.flatnonzero(~np.isfinite(F) & mech_ok)[0])
                 raise ValueError(f"blocking_force: no large-displacement blocking force at point {k} "

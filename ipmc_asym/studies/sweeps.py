@@ -6,9 +6,10 @@ structured array with one row per grid point (and per model), SI columns::
     length width thickness voltage modulus  (inputs; width/thickness are TOTAL 2l / 2e)
     model fidelity I M_A theta w w_small F_block F_block_small regime B1 error valid
 
-``I`` comes from the vectorised :func:`ipmc_asym.integral.api.moment` (one call per model for the
-whole grid) and the mechanics from the vectorised :func:`ipmc_asym.beam.statics.solve_beam`; nothing
-loops over points in Python except the ``bvp`` fidelity.
+Each chunk of rows is one call of the vectorised forward model
+:func:`ipmc_asym.forward.model.forward` (the moment integral once per distinct (thickness,
+voltage) pair, then :func:`ipmc_asym.beam.statics.solve_beam` and the checks); nothing loops over
+points in Python except the ``bvp`` fidelity.
 
 CLI spec: ``--vary NAME=START:STOP:N`` (N points, linear) or ``NAME=START:STOP:N:log``;
 NAME in length, width, thickness, voltage, modulus; units as in ``estimate``
@@ -26,15 +27,15 @@ import numpy as np
 
 from ipmc_asym.base.progress import progress as progress_bar
 from ipmc_asym.base.registry import model_names
-from ipmc_asym.base.settings import CHUNK_ROWS, MAX_ROWS, OUTSIDE_REGIMES, STRAIN_LIMIT
+from ipmc_asym.base.settings import CHUNK_ROWS, MAX_ROWS, OUTSIDE_REGIMES
 from ipmc_asym.base.units import SWEEP_VARIABLES as VARIABLES
 from ipmc_asym.base.units import parse_vary, parse_vary_spec, vary_values
-from ipmc_asym.beam.statics import REGIMES, max_strain, solve_beam
-from ipmc_asym.forward.estimate import check_tol, moment_escalating
+from ipmc_asym.forward.escalation import check_tol
+from ipmc_asym.forward.model import CHECKS, FREE_STRIP_KEYS, MECHANICAL_KEYS, WITHHOLD, forward
 from ipmc_asym.integral.api import check_fidelity
 from ipmc_asym.io.fileio import atomic_write
 from ipmc_asym.io.textfmt import format_table
-from ipmc_asym.model.params import NAFION_LI, Material, Strip, moment_scale, second_moment
+from ipmc_asym.model.params import NAFION_LI, Material, Strip
 from ipmc_asym.model.permittivity import get_model
 
 __all__ = ["VARIABLES", "DTYPE", "LABELS", "CHECK_COLS", "parse_vary", "parse_vary_spec", "vary_values", "sweep", "iter_sweep",
@@ -45,7 +46,7 @@ __all__ = ["VARIABLES", "DTYPE", "LABELS", "CHECK_COLS", "parse_vary", "parse_va
 _FLOAT_COLS = ("length", "width", "thickness", "voltage", "modulus", "I", "M_A", "theta", "w", "w_small",
                "F_block", "F_block_small", "B1", "error", "max_strain")
 #: per-row validity checks (columns ``check_<name>``); ``valid`` is their conjunction
-CHECK_COLS = tuple(f"check_{c}" for c in ("electrochemistry", "layer_separation", "beam_regime", "strain"))
+CHECK_COLS = tuple(f"check_{c}" for c in CHECKS)
 DTYPE = np.dtype([(c, "f8") for c in _FLOAT_COLS[:5]] + [("model", "U8"), ("fidelity", "U10"),
                  ("fidelity_used", "U10"), ("escalated", "?")]
                  + [(c, "f8") for c in _FLOAT_COLS[5:]] + [("regime", "U17")]
@@ -54,9 +55,9 @@ DTYPE = np.dtype([(c, "f8") for c in _FLOAT_COLS[:5]] + [("model", "U8"), ("fide
 #: ambiguous: width and thickness are TOTAL (2l, 2e).  All columns are SI (m, V, Pa, N m, N, rad).
 LABELS = {"width": "width_total_2l", "thickness": "thickness_total_2e"}
 OUTSIDE = OUTSIDE_REGIMES
-#: outputs of the free strip (not valid past a quarter turn) and all mechanical outputs (strain)
-_FREE = ("theta", "w", "w_small")
-_MECH = _FREE + ("F_block", "F_block_small")
+#: the free-strip and mechanical outputs (forward.model) that are columns here (no tip position)
+_FREE = tuple(c for c in FREE_STRIP_KEYS if c in DTYPE.names)
+_MECH = tuple(c for c in MECHANICAL_KEYS if c in DTYPE.names)
 
 
 def _models(model):
@@ -212,72 +213,24 @@ def _pair_code(names, axes, idx, k):
     return code
 
 
-def _distinct(code):
-    """``(first, inverse)``: rows holding each distinct code, and each row's distinct index;
-    ``(None, None)`` when every row is distinct.
-
-    Rows come in C order, so when thickness and voltage are the fastest-varying axes (or the
-    only ones) every code is new and nothing is sorted or gathered.
-    """
-    if code.size < 2 or bool(np.all(code[1:] > code[:-1])):
-        return None, None
-    _, first, inv = np.unique(code, return_index=True, return_inverse=True)
-    return first, np.asarray(inv).reshape(-1)
-
-
 def _chunk(cols, perm, fidelity, material, tol, escalate, failures, code):
-    k = cols["length"].size
-    A5 = moment_scale(cols["width"], cols["thickness"], cols["voltage"], material.F, material.C_moy)
-    EI = cols["modulus"] * second_moment(cols["width"], cols["thickness"])
-    # I depends on (thickness, voltage) only: evaluate each distinct pair once (``code``: the
-    # pair's grid code, :func:`_pair_code`; an integer sort at most, not a sort of float pairs)
-    first, inv = _distinct(code)
-
-    def rows(a):  # per-distinct-pair values -> per-row values
-        return a if inv is None else a[inv]
-
-    def pairs(a):  # per-row values -> one per distinct pair
-        return a if first is None else a[first]
-
-    r = moment_escalating(pairs(cols["thickness"]), pairs(cols["voltage"]), perm, fidelity, material, tol=tol,
-                          escalate=escalate, progress=False)
-    arr = np.empty(k, dtype=DTYPE)
+    """One chunk of rows (dtype :data:`DTYPE`) from :func:`ipmc_asym.forward.model.forward`;
+    ``code``: the rows' (thickness, voltage) grid codes (:func:`_pair_code`), so that ``I`` is
+    evaluated once per distinct pair."""
+    r = forward(cols["length"], cols["width"], cols["thickness"], cols["voltage"], modulus=cols["modulus"],
+                material=material, model=perm, fidelity=fidelity, tol=tol, escalate=escalate, pair_code=code)
+    arr = np.empty(cols["length"].size, dtype=DTYPE)
     for c in VARIABLES:
         arr[c] = cols[c]
     arr["model"] = perm.name
     arr["fidelity"] = fidelity
-    used = rows(r.fidelity_used)
-    arr["fidelity_used"] = used
-    arr["escalated"] = (used != fidelity) & (used != "")
-    ok = rows(r.valid)
-    all_ok = bool(np.all(ok))
-    I = rows(r.I)
-    Mok = A5 * I if all_ok else np.where(ok, A5 * np.where(ok, I, 0.0), 0.0)
-    with np.errstate(all="ignore"):
-        b = solve_beam(Mok, cols["length"], EI, tol=tol)
-        strain = np.asarray(max_strain(Mok, EI, 0.5 * cols["thickness"]))
-
-    def masked(x, fill):  # outputs only where a rung is valid
-        x = np.broadcast_to(np.asarray(x), (k,))
-        return x if all_ok else np.where(ok, x, fill)
-
-    arr["I"] = I
-    arr["M_A"] = masked(Mok, np.nan)
-    for c in _MECH:
-        arr[c] = masked(np.asarray(getattr(b, c), dtype=float), np.nan)
-    arr["regime"] = masked(b.regime, "")
-    arr["max_strain"] = masked(strain, np.nan)
-    arr["B1"] = rows(r.B1)
-    arr["error"] = rows(r.error)
-    arr["check_electrochemistry"] = rows(r.electrochemistry)
-    arr["check_layer_separation"] = rows(r.layer_separation)
-    outside = np.isin(b.regime_code, [REGIMES.index(o) for o in OUTSIDE_REGIMES])  # ints, not strings
-    arr["check_beam_regime"] = ok & ~outside
-    arr["check_strain"] = ok & (strain <= STRAIN_LIMIT)
-    arr["valid"] = (arr["check_electrochemistry"] & arr["check_layer_separation"] & arr["check_beam_regime"]
-                    & arr["check_strain"])
-    if failures is not None and not all_ok:
-        failures.append(r.message)
+    for c in ("fidelity_used", "escalated", "I", "M_A") + _MECH + ("regime", "max_strain", "B1", "error"):
+        arr[c] = getattr(r, c)
+    for c in CHECK_COLS:
+        arr[c] = getattr(r, c[len("check_"):])
+    arr["valid"] = r.valid
+    if failures is not None and not bool(np.all(r.moment_valid)):
+        failures.append(r.moment_message)
     return arr
 
 
@@ -334,12 +287,14 @@ def withhold(arr: np.ndarray, copy: bool = True) -> np.ndarray:
     above the strain limit; everything computed where no rung is valid (already NaN).
     """
     out = arr.copy() if copy else arr
-    for check, cols in (("check_beam_regime", _FREE), ("check_strain", _MECH)):
-        bad = ~out[check]
+    # the rule of forward.model.WITHHOLD; rows with no valid rung are NaN already
+    for check, keys in WITHHOLD[1:]:
+        bad = ~out["check_" + check]
         if bad.any():  # only the rows concerned are written (strided fields are slow to sweep)
             idx = np.flatnonzero(bad)
-            for c in cols:
-                out[c][idx] = np.nan
+            for c in keys:
+                if c in out.dtype.names:
+                    out[c][idx] = np.nan
     return out
 
 

@@ -30,9 +30,11 @@ blocking force uses the small-displacement ``3M/(2L)`` where its relative deviat
 ``(kappa L)^2/3360`` (times 1.05 to cover the next terms for ``|kappa L| <= 2``) is within
 the tolerance, the large-displacement root otherwise; the tip deflection is always the arc.
 
+Every sample goes through the forward model :func:`ipmc_asym.forward.model.forward`.
 ``C_moy`` per sample changes ``A3`` per sample, which the shared sweep driver takes as a
-scalar: :func:`ipmc_asym.integral.samples.moment_samples` is the same loop with ``A3`` an
-array (it calls the same compiled point kernel).
+scalar: ``forward`` given ``c_moy`` per point uses
+:func:`ipmc_asym.integral.samples.moment_samples`, the same loop with ``A3`` an array (it
+calls the same compiled point kernel).
 
 Layer rule: stdlib + numpy + the compiled kernels at import; SciPy statistics, SALib
 deferred.
@@ -46,12 +48,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ipmc_asym.base.registry import FIDELITIES, fidelity_names
 from ipmc_asym.base.settings import CHUNK_ROWS
-from ipmc_asym.integral.api import ANY_THICKNESS, closed_model_id, validity_limit
-from ipmc_asym.integral.samples import moment_samples
+from ipmc_asym.forward.model import SAMPLING_FIDELITIES, forward
 from ipmc_asym.io.datasets import VARIABLES
-from ipmc_asym.model.params import moment_scale, second_moment
 
 __all__ = ["UNCERTAIN", "DISTRIBUTIONS", "OUTPUT_UNITS", "UQResult", "parse_uncertain", "run_uq",
            "evaluate_samples", "uq_chunk"]
@@ -72,8 +71,6 @@ OUTPUT_UNITS = {
     "rotation": ("rad", "free-end rotation theta"),
     "blocking_force": ("N", "blocking force F"),
 }
-#: the compiled rungs (a kernel order in the registry), cheapest first: the sampling ladder
-SAMPLING_FIDELITIES = tuple(f for f in fidelity_names() if FIDELITIES[f].order >= 0)
 
 
 # ---- scene ----------------------------------------------------------------------------------
@@ -166,76 +163,47 @@ def _transform(u, dist, vals):
 def evaluate_samples(cols: dict, outputs, model, material, tol, fidelity=None):
     """Outputs at sample columns (SI arrays of one length); returns (dict of arrays, fidelity counts).
 
-    ``fidelity`` forces one rung (no escalation; samples outside its validity or above
-    ``tol`` are refused); default escalates per sample up to ``quadrature``.
+    The forward model :func:`ipmc_asym.forward.model.forward` with ``modulus`` and ``c_moy``
+    per sample.  ``fidelity`` forces one rung (no escalation; samples outside its validity or
+    above ``tol`` are refused); default escalates per sample along :data:`SAMPLING_FIDELITIES`.
+    The blocking force is ``3M/(2L)`` (paper eq. 14) where ``1.05 (kappa L)^2/3360 <= tol`` and
+    ``|kappa L| <= 2``, the large-displacement root otherwise; the tip deflection is the arc.
     """
-    from ipmc_asym.beam.statics import blocking_force_large
-    from ipmc_asym.model.permittivity import get_model
-
-    perm = get_model(model)
-    n = cols["thickness"].size
-    C = cols["c_moy"]
-    m = material
-    th, v = cols["thickness"], cols["voltage"]
-    e = 0.5 * th
-    eps_core = perm.eps0 + perm.deps
-    lam = np.sqrt(eps_core * m.R * m.T / (e * e * m.phi4 * m.F * m.F * C))
-    A2 = m.F * np.abs(v) / (m.R * m.T)
-    A3 = -m.rho2 * m.Z3 / (C * m.F)
-    rho = perm.eps0 / eps_core
-    sign = np.sign(v)
-    I = np.empty(n)
-    err = np.full(n, np.inf)
-    core = np.empty(n)
-    todo = np.arange(n)
+    if fidelity and fidelity not in SAMPLING_FIDELITIES:
+        raise ValueError(f"uq: fidelity {fidelity!r} is not available for sampling; use one of "
+                         f"{', '.join(SAMPLING_FIDELITIES)}")
     ladder = [fidelity] if fidelity else list(SAMPLING_FIDELITIES)
+    n = cols["thickness"].size
+    with np.errstate(all="ignore"):
+        r = forward(cols["length"], cols["width"], cols["thickness"], cols["voltage"], modulus=cols["modulus"],
+                    c_moy=cols["c_moy"], material=material, model=model, fidelity=ladder[0],
+                    tol=min(float(tol), 0.5), escalate=not fidelity)
+    if not np.all(r.moment_valid):
+        raise ValueError(f"uq: {r.moment_message}; narrow the distributions or loosen the tolerance")
     counts = {}
-    for fid in ladder:
-        if fid not in SAMPLING_FIDELITIES:
-            raise ValueError(f"uq: fidelity {fid!r} is not available for sampling; use one of "
-                             f"{', '.join(SAMPLING_FIDELITIES)}")
-        if todo.size == 0:
+    left = n
+    for fid in ladder:  # samples settled at each rung climbed
+        if left == 0:
             break
-        mid = closed_model_id(perm, fid)
-        Ii, ei, ci = np.empty(todo.size), np.empty(todo.size), np.empty(todo.size)
-        moment_samples(lam[todo], A2[todo], A3[todo], rho, mid, FIDELITIES[fid].order, sign[todo], Ii, ei, ci)
-        # the same validity as integral.moment: the rung's limit, and separate layers unless
-        # the rung holds at any thickness (exact)
-        with np.errstate(invalid="ignore"):
-            ok = (ei <= tol) & (ei < validity_limit(fid)) & ((ci > 0) | (fid in ANY_THICKNESS)) & np.isfinite(Ii)
-        I[todo], err[todo], core[todo] = Ii, ei, ci
-        counts[fid] = int(np.count_nonzero(ok))
-        todo = todo[~ok]
-    if todo.size:
-        raise ValueError(f"uq: {todo.size} of {n} samples are outside the validity of "
-                         f"{' / '.join(ladder)} at tolerance {tol:g} (worst error estimate "
-                         f"{float(np.max(err[todo])):.2g}); narrow the distributions or loosen the tolerance")
+        counts[fid] = int(np.count_nonzero(r.fidelity_used == fid))
+        left -= counts[fid]
     out = {}
     if "I" in outputs:
-        out["I"] = I
-    M = moment_scale(cols["width"], th, v, m.F, C) * I
+        out["I"] = r.I
     if "moment" in outputs:
-        out["moment"] = M
-    L = cols["length"]
-    EI = cols["modulus"] * second_moment(cols["width"], th)
-    kL = M * L / EI
+        out["moment"] = r.M_A
     if "rotation" in outputs:
-        out["rotation"] = -kL
+        out["rotation"] = r.theta  # -M L/EI, paper eq. 12
     if "tip_deflection" in outputs:
-        u = 0.5 * kL
-        with np.errstate(invalid="ignore", divide="ignore"):
-            s = np.where(u == 0.0, 1.0, np.sin(u) / np.where(u == 0.0, 1.0, u))
-        out["tip_deflection"] = -0.5 * kL * L * s * s  # -(kappa L^2/2) sinc^2(kappa L/2)
+        out["tip_deflection"] = r.w  # the arc, -(kappa L^2/2) sinc^2(kappa L/2)
     if "blocking_force" in outputs:
-        F = 1.5 * M / L
+        kL = r.theta
         big = ~((np.abs(kL) <= 2.0) & (1.05 * kL * kL / 3360.0 <= tol))
-        if np.any(big):
-            with np.errstate(all="ignore"):
-                F[big] = blocking_force_large(M[big], L[big], EI[big])
-            if not np.all(np.isfinite(F[big])):
-                bad = int(np.count_nonzero(~np.isfinite(F[big])))
-                raise ValueError(f"uq: large-displacement blocking force undefined for {bad} sample(s) "
-                                 f"(|kappa L| beyond the tracked branch); narrow the distributions")
+        F = np.where(big, r.F_block, r.F_block_small)
+        if np.any(big) and not np.all(np.isfinite(F[big])):
+            bad = int(np.count_nonzero(~np.isfinite(F[big])))
+            raise ValueError(f"uq: large-displacement blocking force undefined for {bad} sample(s) "
+                             f"(|kappa L| beyond the tracked branch); narrow the distributions")
         out["blocking_force"] = F
     return out, counts
 

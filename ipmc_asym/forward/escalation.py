@@ -1,0 +1,159 @@
+"""The fidelity ladder climbed point by point: ``I`` at the cheapest valid rung.
+
+:func:`moment_escalating` climbs ``registry.FIDELITIES`` (cheapest first, whatever rungs it
+holds) from the requested rung to the cheapest one valid at each point; a point with no valid
+rung gets NaN and the reason (:attr:`Escalated.message`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ipmc_asym.base.registry import FIDELITIES as _FIDELITY_SPECS
+from ipmc_asym.base.registry import fidelity_names
+from ipmc_asym.base.settings import VALIDITY_LIMIT
+from ipmc_asym.integral.api import ANY_THICKNESS, check_fidelity, check_min_thickness, moment
+from ipmc_asym.model.params import NAFION_LI, Material
+from ipmc_asym.model.permittivity import get_model
+
+__all__ = ["moment_escalating", "Escalated", "check_tol", "rung_checks"]
+
+
+def check_tol(tol, what="tol"):
+    """``tol`` if it is a relative tolerance in (0, 1), else a one-line ``ValueError``."""
+    if tol is None:
+        return None
+    if isinstance(tol, bool) or not isinstance(tol, (int, float, np.floating)) or not math.isfinite(tol) \
+            or not 0.0 < float(tol) < 1.0:
+        raise ValueError(f"{what} must be a relative tolerance in (0, 1), e.g. 0.01 for 1 %; got {tol!r}")
+    return float(tol)
+
+
+def rung_checks(I, error, core, fidelity: str, limit: float):
+    """``(electrochemistry, layer_separation)`` of one rung's values, bool arrays.
+
+    ``electrochemistry``: ``I`` finite and its error bound <= ``limit``; ``layer_separation``:
+    the neutral core between the layers is positive, or the rung holds at any thickness
+    (``integral.api.ANY_THICKNESS``).
+    """
+    with np.errstate(invalid="ignore"):
+        e_ok = np.isfinite(I) & (error <= limit)
+    return e_ok, (core > 0) | (fidelity in ANY_THICKNESS)
+
+
+@dataclass
+class Escalated:
+    """Moment integral after escalation; arrays of the broadcast input shape.
+
+    Attributes
+    ----------
+    I : ndarray      moment integral (NaN where no rung is valid)
+    error : ndarray  relative error bound of ``I`` (inf where no rung is valid)
+    B1 : ndarray
+    core : ndarray   neutral core length (units of e) of the rung used
+    fidelity_used : ndarray of str   rung that produced the value ("" where none)
+    electrochemistry : ndarray of bool   error bound <= the tolerance (and finite)
+    layer_separation : ndarray of bool   the rung's layers do not overlap (core > 0)
+    valid : ndarray of bool   both of the above
+    success : ndarray of bool   same as ``valid`` (solver-style name)
+    message : str    one line: why the first invalid point has no valid rung ("" if none)
+    """
+
+    I: np.ndarray
+    error: np.ndarray
+    B1: np.ndarray
+    core: np.ndarray
+    fidelity_used: np.ndarray
+    electrochemistry: np.ndarray
+    layer_separation: np.ndarray
+    valid: np.ndarray
+    success: np.ndarray
+    message: str
+
+
+def moment_escalating(thickness, voltage, model="constant", fidelity="quadrature",
+                      material: Material = NAFION_LI, *, tol=None, escalate: bool = True,
+                      progress: bool | None = None) -> Escalated:
+    """``I`` at the cheapest rung, from ``fidelity`` up, that is valid at each point.
+
+    A rung is valid at a point where its error bound is <= ``min(tol, VALIDITY_LIMIT)``,
+    its layers are separate and (BVP) it converged.  The ladder is the registry's ordered
+    ``FIDELITIES``: a rung added there (e.g. ``exact``) is climbed without change here.
+
+    Parameters
+    ----------
+    thickness, voltage : array_like
+        TOTAL thickness ``2e`` (m) and voltage (V), broadcast.
+    model : str or Permittivity or callable
+    fidelity : str
+        The cheapest rung tried.
+    tol : float, optional
+        Relative accuracy required of ``I`` (default: ``settings.VALIDITY_LIMIT``).
+    escalate : bool
+        ``False``: only ``fidelity`` (points where it is invalid get NaN).
+
+    Returns
+    -------
+    Escalated
+    """
+    check_fidelity(fidelity)
+    tol = check_tol(tol)
+    limit = VALIDITY_LIMIT if tol is None else min(tol, VALIDITY_LIMIT)
+    th, v = np.broadcast_arrays(np.asarray(thickness, float), np.asarray(voltage, float))
+    shape = th.shape
+    th, v = th.reshape(-1), v.reshape(-1)
+    check_min_thickness(th)
+    perm = get_model(model)
+    n = th.size
+    I = np.full(n, np.nan)
+    err = np.full(n, np.inf)
+    B1 = np.full(n, np.nan)
+    core = np.full(n, np.nan)
+    used = np.full(n, "", dtype=f"U{max(len(f) for f in fidelity_names())}")
+    elec = np.zeros(n, bool)
+    layer = np.zeros(n, bool)
+    todo = np.ones(n, bool)
+    why = []
+    names = fidelity_names()
+    rungs = names[names.index(fidelity):] if escalate else (fidelity,)
+    for f in rungs:
+        idx = np.flatnonzero(todo)
+        if idx.size == 0:
+            break
+        if perm.is_custom and _FIDELITY_SPECS[f].order >= 0:
+            why.append(f"{f}: not available for a custom eps(C)")
+            continue
+        try:
+            r = moment(th[idx], v[idx], perm, f, material=material,
+                       progress=(progress if not _FIDELITY_SPECS[f].order >= 0 else False))
+        except ValueError as exc:  # e.g. closed forms for a non-paper Permittivity
+            why.append(f"{f}: {exc}")
+            continue
+        e_ok, l_ok = rung_checks(r.I, r.error, r.core, f, limit)
+        # r.valid adds the rung's own ceiling (registry) to the checks here
+        ok = e_ok & l_ok & np.asarray(r.success) & np.asarray(r.valid)
+        sel = idx[ok]
+        I[sel], err[sel], B1[sel], core[sel], used[sel] = r.I[ok], r.error[ok], r.B1[ok], r.core[ok], f
+        elec[idx], layer[idx] = e_ok, l_ok
+        todo[sel] = False
+        bad = ~ok
+        if np.any(bad):
+            k = int(np.flatnonzero(bad)[0])
+            if r.message and not r.success[k]:
+                why.append(f"{f}: {r.message}")
+            else:
+                why.append(f"{f}: error bound {float(r.error[k]):.2g} > {limit:g}"
+                           + ("" if l_ok[k] else ", electrode layers overlap"))
+    valid = ~todo
+    msg = ""
+    if np.any(todo):
+        k = int(np.flatnonzero(todo)[0])
+        msg = (f"no valid fidelity at thickness (total 2e) {th[k]:.3g} m, voltage {v[k]:.3g} V "
+               f"(model {perm.name}): " + "; ".join(why[-3:]))
+    rs = (lambda a: a.reshape(shape))
+    return Escalated(I=rs(I), error=rs(err), B1=rs(B1), core=rs(core), fidelity_used=rs(used),
+                     electrochemistry=rs(elec | valid), layer_separation=rs(layer | valid),
+                     valid=rs(valid), success=rs(valid), message=msg)

@@ -1,0 +1,348 @@
+"""The forward model, vectorised: strip -> moment integral ``I`` -> ``M_A = A5 I`` -> beam -> checks.
+
+Every command and study that turns a strip into mechanical outputs calls :func:`forward`
+(``estimate``, ``sweep``, scenes, uncertainty propagation, calibration, the transient's
+quasi-static mechanics).  The chain (paper sections 3-4):
+
+* ``I`` at the cheapest valid rung of the fidelity ladder from ``fidelity`` up
+  (:func:`ipmc_asym.forward.estimate.moment_escalating`);
+* ``M_A = A5 I`` with ``A5 = 6 l e^2 F |phi0| C_moy`` (:func:`ipmc_asym.model.params.moment_scale`);
+* the cantilever (:func:`ipmc_asym.beam.statics.solve_beam`): ``theta = -M_A L/EI`` (eq. 12),
+  the arc deflection and ``w_small = -M_A L^2/(2 EI)`` (eq. 13), ``F_small = 3 M_A/(2L)``
+  (eq. 14) and the large-displacement blocking force;
+* the four checks of :data:`CHECKS` and the withholding rule (:data:`WITHHOLD`): no number
+  whose check failed is returned as a result.
+
+Signs as in the paper: a positive voltage gives ``M_A > 0``, ``theta < 0`` and ``w < 0``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from ipmc_asym.base.registry import FIDELITIES as _FIDELITY_SPECS
+from ipmc_asym.base.registry import fidelity_names
+from ipmc_asym.base.settings import OUTSIDE_REGIMES, STRAIN_LIMIT, VALIDITY_LIMIT
+from ipmc_asym.beam.statics import REGIMES, solve_beam
+from ipmc_asym.forward.escalation import Escalated, check_tol, moment_escalating, rung_checks
+from ipmc_asym.integral.api import check_fidelity, check_min_thickness, closed_model_id, validity_limit
+from ipmc_asym.integral.samples import moment_samples
+from ipmc_asym.model.params import NAFION_LI, Material, moment_scale, second_moment
+from ipmc_asym.model.permittivity import get_model
+
+__all__ = ["forward", "ForwardResult", "CHECKS", "MOMENT_KEYS", "FREE_STRIP_KEYS", "MECHANICAL_KEYS",
+           "WITHHOLD", "SAMPLING_FIDELITIES", "distinct_pairs", "strain_reason", "regime_reason"]
+
+#: the validity checks of a result, in the order of the chain (electrochemistry -> beam)
+CHECKS = ("electrochemistry", "layer_separation", "beam_regime", "strain")
+#: outputs of the moment integral (withheld where no rung is valid)
+MOMENT_KEYS = ("I", "M_A", "B1")
+#: outputs of the free strip (outside the model past a quarter turn / above the strain limit)
+FREE_STRIP_KEYS = ("theta", "w", "w_small", "x_tip", "y_tip")
+#: every mechanical output (all withheld where the strain check fails)
+MECHANICAL_KEYS = FREE_STRIP_KEYS + ("F_block", "F_block_small")
+#: the withholding rule, most severe first: (what failed, outputs withheld).  ``"moment"``: no
+#: rung is valid (electrochemistry or layer separation failed at every rung tried); ``"strain"``:
+#: ``e |kappa| > STRAIN_LIMIT``; ``"beam_regime"``: the free strip is past a quarter turn (the
+#: blocking forces are kept there: the blocked strip is held straight)
+WITHHOLD = (("moment", MOMENT_KEYS + MECHANICAL_KEYS), ("strain", MECHANICAL_KEYS),
+            ("beam_regime", FREE_STRIP_KEYS))
+#: rungs with a compiled point kernel (those :func:`forward` climbs with per-point ``c_moy``)
+SAMPLING_FIDELITIES = tuple(f for f in fidelity_names() if _FIDELITY_SPECS[f].order >= 0)
+_OUTSIDE_CODES = [REGIMES.index(o) for o in OUTSIDE_REGIMES]
+
+
+def strain_reason(strain) -> str:
+    """One line: why the strain check withholds the mechanical outputs (``strain`` = ``e|kappa|``)."""
+    return (f"strain at the faces e|kappa| = {float(strain):.3g} > STRAIN_LIMIT {STRAIN_LIMIT:g}: "
+            "outside the small-strain beam model; mechanical outputs withheld")
+
+
+def regime_reason(regime) -> str:
+    """One line: why the beam-regime check withholds the free-strip outputs."""
+    return (f"free strip {regime} (|theta| > pi/2): outside the beam model; "
+            "free-strip outputs withheld (blocking forces kept: the strip is held straight)")
+
+
+@dataclass
+class ForwardResult:
+    """Outputs of :func:`forward`; arrays of the broadcast input shape (0-d for scalars), SI.
+
+    The values are computed wherever a rung is valid; where no rung is valid the moment and
+    mechanical outputs are NaN (``regime`` ""), whatever the other checks.  The beam checks
+    do not blank anything here: :meth:`withheld_mask` / :meth:`withhold` apply the rule of
+    :data:`WITHHOLD`.
+
+    Attributes
+    ----------
+    I : ndarray      moment integral (dimensionless, signed like the voltage)
+    M_A : ndarray    end moment ``A5 I`` (N m)
+    theta : ndarray  free-end rotation (rad), paper eq. 12
+    w, w_small : ndarray   arc and small-displacement tip deflections (m), eq. 13
+    F_block, F_block_small : ndarray   large- and small-displacement blocking forces (N), eq. 14
+    x_tip, y_tip : ndarray   tip coordinates of the free strip (m); ``y_tip = w``
+    regime : ndarray of str   :data:`ipmc_asym.beam.statics.REGIMES` label ("" where no rung is valid)
+    regime_code : ndarray of int   index into ``REGIMES``
+    max_strain : ndarray   ``e |M_A|/EI`` at the faces
+    small_error, block_error : ndarray   relative deviations of ``w_small`` and ``F_block_small``
+        from the large-displacement values
+    B1 : ndarray     cathode concentration ``C(1)/C_moy``
+    error : ndarray  relative error bound of ``I`` (inf where no rung is valid)
+    fidelity_used : ndarray of str   rung that produced ``I`` ("" where none)
+    escalated : ndarray of bool   ``fidelity_used`` is a rung above the requested one
+    electrochemistry, layer_separation, beam_regime, strain : ndarray of bool   the checks
+    moment_valid : ndarray of bool   a rung is valid (``I`` computed)
+    valid : ndarray of bool   all four checks
+    message : str    why the first invalid point fails ("" if every point is valid)
+    moment_message : str   why the first point without a valid rung has none ("" if none)
+    beam_warnings : list of str   :func:`ipmc_asym.beam.statics.solve_beam` warnings
+    fidelity : str   the rung requested
+    """
+
+    I: np.ndarray
+    M_A: np.ndarray
+    theta: np.ndarray
+    w: np.ndarray
+    w_small: np.ndarray
+    F_block: np.ndarray
+    F_block_small: np.ndarray
+    x_tip: np.ndarray
+    y_tip: np.ndarray
+    regime: np.ndarray
+    regime_code: np.ndarray
+    max_strain: np.ndarray
+    small_error: np.ndarray
+    block_error: np.ndarray
+    B1: np.ndarray
+    error: np.ndarray
+    fidelity_used: np.ndarray
+    escalated: np.ndarray
+    electrochemistry: np.ndarray
+    layer_separation: np.ndarray
+    beam_regime: np.ndarray
+    strain: np.ndarray
+    moment_valid: np.ndarray
+    valid: np.ndarray
+    message: str = ""
+    moment_message: str = ""
+    beam_warnings: list = field(default_factory=list)
+    fidelity: str = ""
+
+    def checks(self, index=()) -> dict:
+        """``{check: bool}`` of one point (``index`` into the arrays; ``()`` for 0-d results)."""
+        return {c: bool(getattr(self, c)[index]) for c in CHECKS}
+
+    def failed(self, index=()) -> str | None:
+        """The most severe failure of :data:`WITHHOLD` at one point (None if every check passed)."""
+        if not bool(self.moment_valid[index]):
+            return "moment"
+        if not bool(self.strain[index]):
+            return "strain"
+        if not bool(self.beam_regime[index]):
+            return "beam_regime"
+        return None
+
+    def withheld(self, index=()) -> tuple:
+        """Output names withheld at one point, by :data:`WITHHOLD` (empty if none)."""
+        f = self.failed(index)
+        return () if f is None else dict(WITHHOLD)[f]
+
+    def withheld_mask(self, key: str) -> np.ndarray:
+        """Bool array: where output ``key`` is withheld (False everywhere for an unaffected key)."""
+        ok = {"moment": self.moment_valid, "strain": self.strain, "beam_regime": self.beam_regime}
+        bad = np.zeros(np.shape(self.valid), bool)
+        for check, keys in WITHHOLD:
+            if key in keys:
+                bad |= ~ok[check]
+        return bad
+
+    def withhold(self) -> "ForwardResult":
+        """A copy with every withheld output set to NaN (``regime`` kept)."""
+        out = {}
+        for k in MOMENT_KEYS + MECHANICAL_KEYS:
+            bad = self.withheld_mask(k)
+            a = getattr(self, k)
+            out[k] = np.where(bad, np.nan, a) if np.any(bad) else a
+        return replace(self, **out)
+
+
+def distinct_pairs(code):
+    """``(first, inverse)``: rows holding each distinct code, and each row's distinct index;
+    ``(None, None)`` when every row is distinct.
+
+    Rows of a C-order grid whose (thickness, voltage) axes vary fastest have increasing codes:
+    then nothing is sorted or gathered.
+    """
+    code = np.asarray(code).reshape(-1)
+    if code.size < 2 or bool(np.all(code[1:] > code[:-1])):
+        return None, None
+    _, first, inv = np.unique(code, return_index=True, return_inverse=True)
+    return first, np.asarray(inv).reshape(-1)
+
+
+def _moment_per_point_material(th, v, perm, fidelity, material, c_moy, tol, escalate) -> Escalated:
+    """:func:`moment_escalating` with ``C_moy`` per point (flat arrays): the compiled rungs of
+    :data:`SAMPLING_FIDELITIES` through :func:`ipmc_asym.integral.samples.moment_samples`,
+    whose ``A3 = -rho2 Z3/(C_moy F)`` and ``lam`` are arrays.  Same validity as
+    :func:`moment_escalating`: error bound <= ``min(tol, VALIDITY_LIMIT)`` and below the rung's
+    ceiling, separate layers unless the rung holds at any thickness, finite ``I``."""
+    if fidelity not in SAMPLING_FIDELITIES:
+        raise ValueError(f"fidelity {fidelity!r} is not available with a per-point c_moy; use one of "
+                         f"{', '.join(SAMPLING_FIDELITIES)}")
+    check_min_thickness(th)
+    limit = VALIDITY_LIMIT if tol is None else min(tol, VALIDITY_LIMIT)
+    m = material
+    C = c_moy
+    e = 0.5 * th
+    eps_core = perm.eps0 + perm.deps
+    lam = np.sqrt(eps_core * m.R * m.T / (e * e * m.phi4 * m.F * m.F * C))  # core Debye length / e
+    A2 = m.F * np.abs(v) / (m.R * m.T)
+    A3 = -m.rho2 * m.Z3 / (C * m.F)
+    rho = perm.eps0 / eps_core
+    sign = np.sign(v)
+    n = th.size
+    I = np.full(n, np.nan)
+    err = np.full(n, np.inf)
+    last_err = np.full(n, np.inf)
+    B1 = np.full(n, np.nan)
+    core = np.full(n, np.nan)
+    used = np.full(n, "", dtype=f"U{max(len(f) for f in fidelity_names())}")
+    elec = np.zeros(n, bool)
+    layer = np.zeros(n, bool)
+    todo = np.arange(n)
+    ladder = SAMPLING_FIDELITIES[SAMPLING_FIDELITIES.index(fidelity):] if escalate else (fidelity,)
+    for f in ladder:
+        if todo.size == 0:
+            break
+        mid = closed_model_id(perm, f)
+        Ii, ei, ci = np.empty(todo.size), np.empty(todo.size), np.empty(todo.size)
+        moment_samples(lam[todo], A2[todo], A3[todo], rho, mid, _FIDELITY_SPECS[f].order, sign[todo], Ii, ei, ci)
+        e_ok, l_ok = rung_checks(Ii, ei, ci, f, limit)
+        e_ok &= ei < validity_limit(f)  # the rung's own ceiling (integral.api.validity_limit)
+        ok = e_ok & l_ok
+        sel = todo[ok]
+        I[sel], err[sel], core[sel], used[sel] = Ii[ok], ei[ok], ci[ok], f
+        elec[todo], layer[todo], last_err[todo] = e_ok, l_ok, ei
+        todo = todo[~ok]
+    valid = np.ones(n, bool)
+    valid[todo] = False
+    msg = ""
+    if todo.size:
+        msg = (f"{todo.size} of {n} points are outside the validity of {' / '.join(ladder)} at tolerance "
+               f"{limit:g} (worst error estimate {float(np.max(last_err[todo])):.2g})")
+    return Escalated(I=I, error=err, B1=B1, core=core, fidelity_used=used, electrochemistry=elec | valid,
+                     layer_separation=layer | valid, valid=valid, success=valid, message=msg)
+
+
+def forward(length, width, thickness, voltage, *, modulus=None, c_moy=None, material: Material = NAFION_LI,
+            model="constant", fidelity="quadrature", tol=None, escalate: bool = True,
+            pair_code=None) -> ForwardResult:
+    """Mechanical outputs of the strip(s), with the validity checks (SI units).
+
+    Parameters
+    ----------
+    length : array_like
+        Strip length ``L`` (m).
+    width, thickness : array_like
+        TOTAL width ``2l`` and thickness ``2e`` (m).
+    voltage : array_like
+        Applied voltage ``phi0`` (V), any sign.
+    modulus : array_like, optional
+        Young's modulus (Pa), per point; default ``material.E``.
+    c_moy : array_like, optional
+        Mean cation concentration ``C_moy`` (mol/m^3), per point; default ``material.C_moy``.
+        Given, ``I`` comes from the per-point compiled driver
+        (:func:`ipmc_asym.integral.samples.moment_samples`; compiled rungs only; ``B1`` NaN).
+    material : Material
+    model : str or Permittivity or callable
+    fidelity : str
+        The cheapest rung tried; with ``escalate`` the first rung from there valid at each point.
+    tol : float, optional
+        Relative accuracy required of ``I``, in (0, 1) (default ``settings.VALIDITY_LIMIT``);
+        also the tolerance of the "small" beam regime.
+    escalate : bool
+        ``False``: only ``fidelity`` (points where it is invalid fail the moment checks).
+    pair_code : array_like of int, optional
+        Per point: equal codes mean equal (thickness, voltage) (and, with ``c_moy``, equal
+        ``c_moy``); ``I`` is then evaluated once per distinct code.
+
+    All inputs broadcast to one shape ``S``.
+
+    Returns
+    -------
+    ForwardResult
+        Arrays of shape ``S``.
+
+    Raises
+    ------
+    ValueError
+        Unknown fidelity, bad ``tol``, a thickness below ``settings.MIN_THICKNESS``, a
+        non-positive length or stiffness (one line each).
+    """
+    check_fidelity(fidelity)
+    tol = check_tol(tol)
+    perm = get_model(model)
+    E = material.E if modulus is None else modulus
+    C = material.C_moy if c_moy is None else c_moy
+    L, wd, th, v, E, C = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in
+                                               (length, width, thickness, voltage, E, C)))
+    shape = L.shape
+    L, wd, th, v, E, C = (a.reshape(-1) for a in (L, wd, th, v, E, C))
+    k = L.size
+    A5 = moment_scale(wd, th, v, material.F, material.C_moy if c_moy is None else C)
+    EI = E * second_moment(wd, th)
+    # I depends on (thickness, voltage) (and C_moy) only: each distinct pair once
+    first, inv = (None, None) if pair_code is None else distinct_pairs(np.broadcast_to(pair_code, shape))
+
+    def rows(a):  # per-distinct-pair values -> per-point values
+        return a if inv is None else a[inv]
+
+    def pairs(a):  # per-point values -> one per distinct pair
+        return a if first is None else a[first]
+
+    if c_moy is None:
+        r = moment_escalating(pairs(th), pairs(v), perm, fidelity, material, tol=tol, escalate=escalate,
+                              progress=False)
+    else:
+        r = _moment_per_point_material(pairs(th), pairs(v), perm, fidelity, material, pairs(C), tol, escalate)
+    used = rows(r.fidelity_used.reshape(-1))
+    ok = rows(r.valid.reshape(-1))
+    all_ok = bool(np.all(ok))
+    I = rows(r.I.reshape(-1))
+    Mok = A5 * I if all_ok else np.where(ok, A5 * np.where(ok, I, 0.0), 0.0)
+    with np.errstate(all="ignore"):
+        b = solve_beam(Mok, L, EI, tol=tol, e=0.5 * th)
+
+    def masked(x, fill):  # outputs only where a rung is valid
+        x = np.broadcast_to(np.asarray(x), (k,))
+        return x if all_ok else np.where(ok, x, fill)
+
+    strain = np.asarray(b.max_strain, dtype=float).reshape(-1)
+    rcode = np.broadcast_to(np.asarray(b.regime_code), (k,))
+    beam_regime = ok & ~np.isin(rcode, _OUTSIDE_CODES)  # ints, not strings
+    strain_ok = ok & (strain <= STRAIN_LIMIT)
+    elec = rows(r.electrochemistry.reshape(-1))
+    layer = rows(r.layer_separation.reshape(-1))
+    valid = elec & layer & beam_regime & strain_ok
+    mech = {c: masked(np.asarray(getattr(b, c), dtype=float), np.nan)
+            for c in ("theta", "w", "w_small", "x_tip", "y_tip", "F_block", "F_block_small", "small_error",
+                      "block_error")}
+    reg = masked(np.asarray(b.regime), "")
+    message = ""
+    if not bool(np.all(valid)):
+        j = int(np.argmin(valid))
+        message = (r.message if not ok[j] else strain_reason(strain[j]) if not strain_ok[j]
+                   else regime_reason(reg[j]))
+
+    def rs(a):
+        return np.asarray(a).reshape(shape)
+
+    return ForwardResult(
+        I=rs(I), M_A=rs(masked(Mok, np.nan)), regime=rs(reg), regime_code=rs(rcode),
+        max_strain=rs(masked(strain, np.nan)), B1=rs(rows(r.B1.reshape(-1))), error=rs(rows(r.error.reshape(-1))),
+        fidelity_used=rs(used), escalated=rs((used != fidelity) & (used != "")),
+        electrochemistry=rs(elec), layer_separation=rs(layer), beam_regime=rs(beam_regime), strain=rs(strain_ok),
+        moment_valid=rs(ok), valid=rs(valid), message=message, moment_message=r.message,
+        beam_warnings=list(b.warnings), fidelity=fidelity, **{c: rs(a) for c, a in mech.items()})
