@@ -52,7 +52,8 @@ from ipmc_asym.dynamics.electrode import (
     time_constant,
 )
 from ipmc_asym.kernels import _generated_charge as GC
-from ipmc_asym.model.params import D_CATION_SOURCE, NAFION_LI, Material, Strip, check_finite, check_positive, debye_length
+from ipmc_asym.model import groups
+from ipmc_asym.model.params import D_CATION_SOURCE, NAFION_LI, Material, Strip, check_finite, check_positive
 from ipmc_asym.model.permittivity import Permittivity, get_model
 from ipmc_asym.base.registry import check_choice
 
@@ -248,7 +249,7 @@ def _time_grid(duration, t, points):
 def circuit_response(t, phi0_fun, strip: Strip, perm: Permittivity, material: Material, substeps: int = 2):
     """Integrate the reduced model on the time grid ``t`` (s); returns ``(sigma, u, J)``."""
     m = material
-    VT = m.R * m.T / m.F
+    VT = groups.thermal_voltage(m)
     tau = float(time_constant(strip.thickness, perm, m))
     # substeps between output times (BDF2 accuracy): at least `substeps`, and h <= tau/200;
     # times in units of tau
@@ -270,7 +271,7 @@ def circuit_response(t, phi0_fun, strip: Strip, perm: Permittivity, material: Ma
     # the bulk is a leaky dielectric: besides the layers' charge the electrodes carry the
     # displacement charge C_g (phi0 - u) of the core, C_g = eps_core/(2e) (its relaxation time
     # R C_g = lambda^2 e^2/D is instantaneous on the scale tau); C_g/C_d(0) = lambda
-    Cg = perm.eps_moy / strip.thickness
+    Cg = groups.geometric_capacitance(strip.thickness, perm.eps_moy)
     ub = phi0_fun(t) - u
     sigma = charge_scale(perm, m) * s + Cg * ub
     J = ub / float(core_resistance(strip.thickness, m))
@@ -411,9 +412,9 @@ def frequency_response(f, *, strip: Strip | None = None, model="constant", mater
     if not np.all(np.isfinite(f)) or np.any(f <= 0):
         raise ValueError("frequencies must be finite and > 0 Hz")
     e = s.e
-    lam = float(debye_length(s.thickness, perm.eps_moy, m))
-    kappa = m.phi4 * m.F**2 * m.D * m.C_moy / (m.R * m.T)
-    A3 = -m.rho2 * m.Z3 / (m.C_moy * m.F)
+    lam = float(groups.debye_length(s.thickness, perm.eps_moy, m))
+    kappa = float(groups.kappa(m))
+    A3 = float(groups.A3(m))
     omega = 2.0 * math.pi * f
     tau = float(time_constant(s.thickness, perm, m))
     # tip deflection per volt, small displacements: w = -M L^2/(2 E I_p),

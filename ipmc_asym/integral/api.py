@@ -40,7 +40,8 @@ from ipmc_asym.kernels.jit import interpreted, jit, jit_parallel, prange
 from ipmc_asym.kernels.closed import closed_b1, closed_finish, layer_closed, moment_closed
 from ipmc_asym.kernels.exact import moment_exact
 from ipmc_asym.kernels.quadrature import moment_quadrature
-from ipmc_asym.model.params import NAFION_LI, Material, Strip, debye_length
+from ipmc_asym.model import groups
+from ipmc_asym.model.params import NAFION_LI, Material, Strip
 from ipmc_asym.model.permittivity import MODELS, Permittivity, get_model
 from ipmc_asym.base.progress import progress as _progress_bar
 from ipmc_asym.base.registry import FIDELITIES as _FIDELITY_SPECS
@@ -128,14 +129,10 @@ def groups_arrays(thickness, voltage, perm: Permittivity, material: Material):
     if not np.all(np.isfinite(v)):
         raise ValueError("voltage must be finite (volts)")
     th, v = np.broadcast_arrays(th, v)
-    m = material
-    cm = m.C_moy
     eps_core = perm.eps0 + perm.deps
-    lam = debye_length(th, eps_core, m)
-    A2 = m.F * np.abs(v) / (m.R * m.T)
-    A3 = -m.rho2 * m.Z3 / (cm * m.F)
+    lam = groups.debye_length(th, eps_core, material)
     rho = perm.eps0 / eps_core
-    return lam, A2, A3, rho, np.sign(v)
+    return lam, groups.A2(v, material), groups.A3(material), rho, np.sign(v)
 
 
 def check_min_thickness(thickness) -> None:
@@ -271,7 +268,7 @@ def _sweep(lam, A2, A3, rho, model_id, order, sign, I, err, B1, core):
 
 @jit
 def _groups_point(t, vv, lamc, a2c):
-    """``(lam, A2)`` of one point: ``lam = lamc / thickness`` (``params.debye_length``:
+    """``(lam, A2)`` of one point: ``lam = lamc / thickness`` (``groups.debye_length``:
     ``lam ~ 1/e``), ``A2 = a2c |phi0|`` (one division, no square root, per point)."""
     return lamc / t, a2c * abs(vv)
 
@@ -429,9 +426,8 @@ def _scalar_point(t, vv, lamc, a2c, A3, rho, model_id, order, any_thickness, lim
 def _driver_constants(perm: Permittivity, mat: Material, fidelity: str) -> tuple:
     """Scalar arguments of the fused drivers after ``(th, v)``."""
     eps_core = perm.eps0 + perm.deps
-    lamc = float(debye_length(1.0, eps_core, mat))  # lam * thickness (lam ~ 1/e)
-    return (lamc, mat.F / (mat.R * mat.T),
-            -mat.rho2 * mat.Z3 / (mat.C_moy * mat.F), perm.eps0 / eps_core,
+    lamc = float(groups.debye_length(1.0, eps_core, mat))  # lam * thickness (lam ~ 1/e)
+    return (lamc, groups.inverse_thermal_voltage(mat), float(groups.A3(mat)), perm.eps0 / eps_core,
             closed_model_id(perm, fidelity), _ORDER[fidelity], fidelity in ANY_THICKNESS,
             validity_limit(fidelity))
 
@@ -523,8 +519,8 @@ def moment(thickness, voltage, model="constant", fidelity="quadrature", *, mater
                          f"constant, linear, affine); got fidelity {fidelity!r}")
     gperm = perm
     if perm.is_custom:  # groups of the secant through C = 0 and C_moy (bookkeeping only)
-        e0 = max(float(perm.func(0.0)), 0.0)
-        gperm = Permittivity("secant", eps0=e0, deps=max(float(perm.func(mat.C_moy)) - e0, 0.0))
+        e0, de = perm.secant(mat.C_moy)
+        gperm = Permittivity("secant", eps0=e0, deps=de)
     if fidelity != "bvp":
         I, valid, (err, B1, core, lam, A2), (bad_th, bad_v, _) = _fused(thickness, voltage, gperm, mat, fidelity,
                                                                        full=True)
