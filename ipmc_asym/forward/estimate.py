@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ipmc_asym.integral.api import ANY_THICKNESS, check_fidelity, check_min_thickness, moment
+from ipmc_asym.integral.api import check_fidelity, check_min_thickness, moment
 from ipmc_asym.model.params import NAFION_LI, Material, Strip, debye_length
 from ipmc_asym.model.permittivity import MODELS, get_model
 from ipmc_asym.base.registry import FIDELITIES as _FIDELITY_SPECS
@@ -130,17 +130,17 @@ def moment_escalating(thickness, voltage, model="constant", fidelity="quadrature
         idx = np.flatnonzero(todo)
         if idx.size == 0:
             break
-        if perm.is_custom and _FIDELITY_SPECS[f].order >= 0:
+        if perm.is_custom and _FIDELITY_SPECS[f].compiled:
             why.append(f"{f}: not available for a custom eps(C)")
             continue
         try:
             r = moment(th[idx], v[idx], perm, f, material=material,
-                       progress=(progress if not _FIDELITY_SPECS[f].order >= 0 else False))
+                       progress=(progress if not _FIDELITY_SPECS[f].compiled else False))
         except ValueError as exc:  # e.g. closed forms for a non-paper Permittivity
             why.append(f"{f}: {exc}")
             continue
         e_ok = np.isfinite(r.I) & (r.error <= limit)
-        l_ok = (r.core > 0) | (f in ANY_THICKNESS)
+        l_ok = (r.core > 0) | _FIDELITY_SPECS[f].any_thickness
         # r.valid adds the rung's own ceiling (registry) to the checks here
         ok = e_ok & l_ok & np.asarray(r.success) & np.asarray(r.valid)
         sel = idx[ok]

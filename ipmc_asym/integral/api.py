@@ -26,6 +26,12 @@ Fidelity ladder (docs/design.md; the registry :mod:`ipmc_asym.base.registry`), n
 
 ``I`` is computed on ``|phi0|`` and carries the sign of the voltage (mirror symmetry);
 ``I = 0`` at zero volts.  Thickness is the TOTAL thickness ``2e`` (SI).
+
+Names exported for scripts: ``FIDELITIES`` is the tuple of the rung names, cheapest first
+(``registry.fidelity_names()``; the specs are the dict ``ipmc_asym.base.registry.FIDELITIES``);
+``MODELS`` is ``ipmc_asym.model.permittivity.MODELS``, ``{name: Permittivity}`` (the specs are
+the dict ``ipmc_asym.base.registry.MODELS``); ``ANY_THICKNESS`` is the tuple of the rungs
+whose spec has ``any_thickness`` set.
 """
 
 from __future__ import annotations
@@ -46,7 +52,7 @@ from ipmc_asym.model.permittivity import MODELS, Permittivity, get_model
 from ipmc_asym.base.progress import progress as _progress_bar
 from ipmc_asym.base.registry import FIDELITIES as _FIDELITY_SPECS
 from ipmc_asym.base.registry import MODELS as _MODEL_SPECS
-from ipmc_asym.base.registry import check_choice, fidelity_names
+from ipmc_asym.base.registry import any_thickness_fidelities, check_choice, fidelity_names, is_compiled
 from ipmc_asym.base.settings import (
     BVP_STATED_ERROR,
     EXACT_STATED_ERROR,
@@ -59,12 +65,14 @@ from ipmc_asym.base.settings import (
 __all__ = ["FIDELITIES", "MomentResult", "moment_integral", "moment", "groups_arrays", "check_fidelity",
            "check_min_thickness", "invalid_message", "validity_limit", "interpret_small"]
 
+#: the rung names, cheapest first (tuple; the specs: ``registry.FIDELITIES``)
 FIDELITIES = fidelity_names()
-#: order argument of the sweep driver: 1 leading, 2 corrected, 0 quadrature, 3 exact
-_ORDER = {k: f.order for k, f in _FIDELITY_SPECS.items() if f.order >= 0}
-#: fidelities valid at every thickness (no neutral core assumed): ``core`` is informative only
-#: rungs that hold whatever the thickness (overlapping layers, non-neutral core)
-ANY_THICKNESS = ("exact", "bvp")
+#: rungs that hold whatever the thickness (overlapping layers, non-neutral core): their
+#: ``core`` output is informative only (the registry's ``any_thickness`` flag)
+ANY_THICKNESS = any_thickness_fidelities()
+#: ``{name: kernel_code}`` of the compiled rungs (the registry's flags; read by ``bench.suite``
+#: and the tests of the bare driver)
+_ORDER = {k: f.kernel_code for k, f in _FIDELITY_SPECS.items() if f.compiled}
 
 
 def check_fidelity(fidelity: str) -> str:
@@ -428,7 +436,8 @@ def _driver_constants(perm: Permittivity, mat: Material, fidelity: str) -> tuple
     eps_core = perm.eps0 + perm.deps
     lamc = float(groups.debye_length(1.0, eps_core, mat))  # lam * thickness (lam ~ 1/e)
     return (lamc, groups.inverse_thermal_voltage(mat), float(groups.A3(mat)), perm.eps0 / eps_core,
-            closed_model_id(perm, fidelity), _ORDER[fidelity], fidelity in ANY_THICKNESS,
+            closed_model_id(perm, fidelity), _FIDELITY_SPECS[fidelity].kernel_code,
+            _FIDELITY_SPECS[fidelity].any_thickness,
             validity_limit(fidelity))
 
 
@@ -537,7 +546,7 @@ def moment(thickness, voltage, model="constant", fidelity="quadrature", *, mater
     B1 = np.empty(shape)
     core = np.empty(shape)
     success, message = _bvp_loop(thickness, voltage, perm, mat, I, err, B1, core, progress)
-    valid = (err < validity_limit(fidelity)) & ((core > 0) | (fidelity in ANY_THICKNESS)) & success
+    valid = (err < validity_limit(fidelity)) & ((core > 0) | _FIDELITY_SPECS[fidelity].any_thickness) & success
     return MomentResult(I=I, error=err, B1=B1, core=core, lam=lam, A2=A2, valid=valid,
                         fidelity=fidelity, model=perm.name, success=success, message=message)
 
@@ -629,7 +638,7 @@ def moment_integral(thickness, voltage, model="constant", fidelity="quadrature",
     if (type(thickness) in _SCALAR_TYPES and type(voltage) in _SCALAR_TYPES and material is None
             and not material_kw and type(model) is str):
         consts = _SCALAR_CACHE.get((model, fidelity))
-        if consts is None and model in _MODEL_SPECS and fidelity in _ORDER:
+        if consts is None and model in _MODEL_SPECS and is_compiled(fidelity):
             consts = _SCALAR_CACHE[(model, fidelity)] = _driver_constants(get_model(model), NAFION_LI, fidelity)
         t, vv = float(thickness), float(voltage)
         if consts is not None and t >= MIN_THICKNESS and math.isfinite(t) and math.isfinite(vv):
@@ -668,7 +677,7 @@ def _lean_integral(thickness, voltage, model, fidelity, material, material_kw):
     """``(I, valid, n_invalid)`` from the fused driver with no bookkeeping outputs (9 bytes a
     point; NaN in ``I`` where invalid), or None where :func:`moment` is needed (BVP, custom
     eps(C), bad input: its messages)."""
-    if fidelity not in _ORDER or not (isinstance(model, str) or isinstance(model, Permittivity)):
+    if not is_compiled(fidelity) or not (isinstance(model, str) or isinstance(model, Permittivity)):
         return None
     perm = get_model(model)
     if perm.is_custom:

@@ -8,40 +8,38 @@ Every function is vectorised (numpy broadcasting over its array arguments) and t
 array (per-sample values in uncertainty studies).  ``thickness`` and ``width`` are TOTAL
 (``2e``, ``2l``); the groups are built on ``|phi0|`` (see :mod:`ipmc_asym.model.params`).
 
-Layer rule: model layer, numpy only (``params`` imports this module, not the reverse).
+Layer rule: model layer, numpy only (``params`` imports this module, not the reverse, so
+``Material`` and ``Strip`` appear in annotations only; ``from __future__ import annotations``
+keeps them unevaluated).
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
 
 import numpy as np
-
-if TYPE_CHECKING:
-    from ipmc_asym.model.params import Material, Strip
 
 __all__ = ["Groups", "make_groups", "A0", "A1", "A2", "A3", "A5", "inverse_thermal_voltage",
            "thermal_voltage", "debye_length", "debye_length_m", "kappa", "geometric_capacitance",
            "b1_neutral", "moment_scale"]
 
 
-def _cm(material: "Material", C_moy):
+def _cm(material: Material, C_moy):
     return material.C_moy if C_moy is None else np.asarray(C_moy, dtype=float)
 
 
-def inverse_thermal_voltage(material: "Material") -> float:
+def inverse_thermal_voltage(material: Material) -> float:
     """``F / (R T)`` (1/V): ``A2 = |phi0| F / (R T)``."""
     return material.F / (material.R * material.T)
 
 
-def thermal_voltage(material: "Material") -> float:
+def thermal_voltage(material: Material) -> float:
     """``R T / F`` (V), the potential scale of the core (``phi = (R T / F) psi``)."""
     return 1.0 / inverse_thermal_voltage(material)
 
 
-def A0(thickness, voltage, deps, material: "Material", C_moy=None):
+def A0(thickness, voltage, deps, material: Material, C_moy=None):
     """``A0 = |phi0| deps / (e^2 phi4 F C_moy)`` (dimensionless; paper eq. (22)).
 
     Parameters
@@ -57,7 +55,7 @@ def A0(thickness, voltage, deps, material: "Material", C_moy=None):
                                                                 * _cm(material, C_moy))
 
 
-def A1(thickness, voltage, eps0, material: "Material", C_moy=None):
+def A1(thickness, voltage, eps0, material: Material, C_moy=None):
     """``A1 = |phi0| eps0 / (e^2 phi4 F C_moy)`` (dimensionless; paper eq. (22)).
 
     Same arguments as :func:`A0` with ``eps0`` (F/m, permittivity at ``C = 0``).
@@ -65,7 +63,7 @@ def A1(thickness, voltage, eps0, material: "Material", C_moy=None):
     return A0(thickness, voltage, eps0, material, C_moy)
 
 
-def A2(voltage, material: "Material"):
+def A2(voltage, material: Material):
     """``A2 = F |phi0| / (R T)`` (dimensionless; paper eq. (22)); even in ``phi0``.
 
     Parameters
@@ -76,7 +74,7 @@ def A2(voltage, material: "Material"):
     return np.abs(np.asarray(voltage, dtype=float)) * inverse_thermal_voltage(material)
 
 
-def A3(material: "Material", C_moy=None):
+def A3(material: Material, C_moy=None):
     """``A3 = -rho2 Z3 / (C_moy F)`` (dimensionless; paper eq. (22)): the solvent pressure
     coupling; voltage-independent.
 
@@ -103,12 +101,12 @@ def moment_scale(width, thickness, voltage, F, C_moy):
     return 6.0 * l * e * e * F * np.abs(np.asarray(voltage, dtype=float)) * C_moy
 
 
-def A5(width, thickness, voltage, material: "Material", C_moy=None):
+def A5(width, thickness, voltage, material: Material, C_moy=None):
     """``A5 = 6 l e^2 F |phi0| C_moy`` (N m; paper eq. (23)), :func:`moment_scale` of a material."""
     return moment_scale(width, thickness, voltage, material.F, _cm(material, C_moy))
 
 
-def debye_length_m(eps_core, material: "Material", C_moy=None):
+def debye_length_m(eps_core, material: Material, C_moy=None):
     """Core Debye length ``lambda_D = sqrt(eps_core R T / (phi4 F^2 C_moy))`` (m).
 
     Parameters
@@ -121,7 +119,7 @@ def debye_length_m(eps_core, material: "Material", C_moy=None):
     return np.sqrt(eps_core * m.R * m.T / (m.phi4 * m.F * m.F * _cm(m, C_moy)))
 
 
-def debye_length(thickness, eps_core, material: "Material", C_moy=None):
+def debye_length(thickness, eps_core, material: Material, C_moy=None):
     """Core Debye length over ``e``: ``lambda = lambda_D / e`` (dimensionless).
 
     Equal to ``sqrt((A0 + A1)/A2)`` but defined at zero volts too (all three groups scale
@@ -130,7 +128,7 @@ def debye_length(thickness, eps_core, material: "Material", C_moy=None):
     return debye_length_m(eps_core, material, C_moy) / (0.5 * np.asarray(thickness, dtype=float))
 
 
-def kappa(material: "Material", C_moy=None):
+def kappa(material: Material, C_moy=None):
     """Core ionic conductivity ``kappa = phi4 F^2 D C_moy / (R T)`` (S/m, Nernst-Einstein)."""
     m = material
     return m.phi4 * m.F * m.D * _cm(m, C_moy) * inverse_thermal_voltage(m)
@@ -207,7 +205,7 @@ class Groups:
         return self.extra["debye"]
 
 
-def make_groups(strip: "Strip", material: "Material", eps0: float, deps: float) -> Groups:
+def make_groups(strip: Strip, material: Material, eps0: float, deps: float) -> Groups:
     """Dimensionless groups for a strip, a material and ``eps = eps0 + deps * C / C_moy``.
 
     Parameters

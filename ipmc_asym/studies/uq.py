@@ -50,7 +50,7 @@ from ipmc_asym.io.datasets import VARIABLES
 from ipmc_asym.integral.api import ANY_THICKNESS, closed_model_id, validity_limit
 from ipmc_asym.integral.samples import moment_samples
 from ipmc_asym.model.params import moment_scale, second_moment
-from ipmc_asym.base.registry import FIDELITIES, fidelity_names
+from ipmc_asym.base.registry import FIDELITIES, compiled_fidelities
 from ipmc_asym.base.settings import CHUNK_ROWS
 
 __all__ = ["UNCERTAIN", "DISTRIBUTIONS", "OUTPUT_UNITS", "UQResult", "parse_uncertain", "run_uq",
@@ -73,7 +73,7 @@ OUTPUT_UNITS = {
     "blocking_force": ("N", "blocking force F"),
 }
 #: the compiled rungs (a kernel order in the registry), cheapest first: the sampling ladder
-SAMPLING_FIDELITIES = tuple(f for f in fidelity_names() if FIDELITIES[f].order >= 0)
+SAMPLING_FIDELITIES = compiled_fidelities()
 
 
 # ---- scene ----------------------------------------------------------------------------------
