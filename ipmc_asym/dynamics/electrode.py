@@ -145,10 +145,7 @@ def charge_hat_point(A2, rho, model_id, quad, X, Wt):
     """
     if A2 == 0.0:  # no field: sigma = 0, two layers of chat(0) = 1 in series
         return 0.0, 0.5, 0.0
-    if quad == 1:
-        B1 = G.b1_exact(A2, rho)
-    else:
-        B1 = b1_model(A2, rho, model_id)
+    B1 = b1_model(A2, rho, -1 if quad == 1 else model_id)
     Yc = math.log(B1)
     Ya = Yc - A2
     mid = -1 if quad == 1 else model_id

@@ -100,7 +100,8 @@ def closed_b1(A2, model_id):
 
 @jit
 def b1_model(A2, rho, model_id):
-    """``B1`` from electroneutrality (paper eq. (21)) for a model id of the compiled kernels.
+    """``B1`` from electroneutrality of a neutral core (paper section 4) for a model id of
+    the compiled kernels.
 
     ``model_id`` 0..2: the closed forms' specialisations (:func:`closed_b1`); ``< 0``: the
     root for any ``rho = eps0/eps_core`` in [0, 1].  The same root in numpy:

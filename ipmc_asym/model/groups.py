@@ -40,7 +40,7 @@ def thermal_voltage(material: Material) -> float:
 
 
 def A0(thickness, voltage, deps, material: Material, C_moy=None):
-    """``A0 = |phi0| deps / (e^2 phi4 F C_moy)`` (dimensionless; paper eq. (22)).
+    """``A0 = |phi0| deps / (e^2 phi4 F C_moy)`` (dimensionless; paper eqs (22)-(23)).
 
     Parameters
     ----------
@@ -56,7 +56,7 @@ def A0(thickness, voltage, deps, material: Material, C_moy=None):
 
 
 def A1(thickness, voltage, eps0, material: Material, C_moy=None):
-    """``A1 = |phi0| eps0 / (e^2 phi4 F C_moy)`` (dimensionless; paper eq. (22)).
+    """``A1 = |phi0| eps0 / (e^2 phi4 F C_moy)`` (dimensionless; paper eqs (22)-(23)).
 
     Same arguments as :func:`A0` with ``eps0`` (F/m, permittivity at ``C = 0``).
     """
@@ -64,7 +64,7 @@ def A1(thickness, voltage, eps0, material: Material, C_moy=None):
 
 
 def A2(voltage, material: Material):
-    """``A2 = F |phi0| / (R T)`` (dimensionless; paper eq. (22)); even in ``phi0``.
+    """``A2 = F |phi0| / (R T)`` (dimensionless; paper eqs (22)-(23)); even in ``phi0``.
 
     Parameters
     ----------
@@ -75,7 +75,7 @@ def A2(voltage, material: Material):
 
 
 def A3(material: Material, C_moy=None):
-    """``A3 = -rho2 Z3 / (C_moy F)`` (dimensionless; paper eq. (22)): the solvent pressure
+    """``A3 = -rho2 Z3 / (C_moy F)`` (dimensionless; paper eqs (22)-(23)): the solvent pressure
     coupling; voltage-independent.
 
     Parameters
@@ -87,7 +87,7 @@ def A3(material: Material, C_moy=None):
 
 
 def moment_scale(width, thickness, voltage, F, C_moy):
-    """``A5 = 6 l e^2 F |phi0| C_moy`` (N m): ``M_A = A5 I`` (paper eq. (23)); even in ``phi0``.
+    """``A5 = 6 l e^2 F |phi0| C_moy`` (N m): ``M_A = A5 I`` (paper eqs (23), (27)); even in ``phi0``.
 
     Parameters
     ----------
@@ -102,7 +102,7 @@ def moment_scale(width, thickness, voltage, F, C_moy):
 
 
 def A5(width, thickness, voltage, material: Material, C_moy=None):
-    """``A5 = 6 l e^2 F |phi0| C_moy`` (N m; paper eq. (23)), :func:`moment_scale` of a material."""
+    """``A5 = 6 l e^2 F |phi0| C_moy`` (N m; paper eqs (23), (27)), :func:`moment_scale` of a material."""
     return moment_scale(width, thickness, voltage, material.F, _cm(material, C_moy))
 
 
@@ -144,7 +144,7 @@ def geometric_capacitance(thickness, eps_core):
 
 
 def b1_neutral(A2, rho):
-    """``B1 = C(+e)/C_moy`` from electroneutrality of a neutral core (paper eq. (21)).
+    """``B1 = C(+e)/C_moy`` from electroneutrality of a neutral core (paper section 4).
 
     The positive root of ``(1 - rho)/2 (1 - e^{-2 A2}) B^2 + (2 rho - 1)(1 - e^{-A2}) B -
     rho A2 = 0`` (the first integral ``G(B1) = G(B1 e^{-A2})``, ``G(C) = (1 - rho) C^2/2 +
