@@ -418,8 +418,8 @@ def frequency_response(f, *, strip: Strip | None = None, model="constant", mater
     omega = 2.0 * math.pi * f
     tau = float(time_constant(s.thickness, perm, m))
     # tip deflection per volt, small displacements: w = -M L^2/(2 E I_p),
-    # M per volt = 6 l e^2 C_moy F (1 + A3) * (moment transfer)
-    k_w = -s.length**2 / (2.0 * m.E * s.I_p) * 6.0 * s.l * e * e * m.C_moy * m.F * (1.0 + A3)
+    # M per volt = A5(1 V) (1 + A3) * (moment transfer), A5(1 V) = 6 l e^2 C_moy F (N m/V)
+    k_w = -s.length**2 / (2.0 * m.E * s.I_p) * float(groups.A5(s.width, s.thickness, 1.0, m)) * (1.0 + A3)
     R = float(core_resistance(s.thickness, m))
     # DC transfer: the static moment slope at 0 V, I(0+) = (1 + A3)(lam coth(1/lam) - lam^2)
     h0 = k_w * float(GC.moment_transfer_hat(np.array([1e-12]), lam)[0].real)

@@ -318,7 +318,7 @@ def solve_transient(t, phi0_fun, strip: Strip, model="constant", material: Mater
     from ipmc_asym.dynamics.electrode import layer_voltage
 
     u = layer_voltage(sigma, perm, m) if moment else np.full(nt, np.nan)
-    Mscale = 6.0 * strip.l * e * e * m.C_moy * m.R * m.T
+    Mscale = float(groups.A5(strip.width, strip.thickness, VT, m))  # A5 at |phi0| = R T/F, N m
     extra = {"cells": P.N, "h_min_over_debye": float(P.h.min() / lam), "nfev": int(sol.nfev),
              "njev": int(sol.njev), "seconds": secs, "rtol": rtol, "method": method}
     if energy:
