@@ -118,7 +118,7 @@ def bare_driver(fidelity, model, th, v):
     lam, A2, A3, rho, sign = groups_arrays(th, v, perm, NAFION_LI)
     lam, A2, sign = (np.ascontiguousarray(a, dtype=float) for a in (lam, A2, sign))
     outs = [np.empty(lam.size) for _ in range(4)]
-    mid, order = closed_model_id(perm, fidelity), FIDELITIES[fidelity].order
+    mid, order = closed_model_id(perm, fidelity), FIDELITIES[fidelity].kernel_code
 
     def call():
         ladder_driver(lam, A2, float(A3), float(rho), mid, order, sign, *outs)

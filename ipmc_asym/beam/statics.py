@@ -73,6 +73,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ipmc_asym.kernels.jit import CACHE_DIR
+from ipmc_asym.kernels.quadrature_nodes import leggauss01
 
 __all__ = [
     "KL_BLOCK_MAX",
@@ -336,10 +337,8 @@ def _fresnel_sc(a, b):
 _GL_N = 120
 
 
-@functools.lru_cache(maxsize=1)
 def _gl01():
-    x, w = np.polynomial.legendre.leggauss(_GL_N)
-    return 0.5 * (x + 1.0), 0.5 * w
+    return leggauss01(_GL_N)
 
 
 #: below this many points :func:`_G_and_dG` integrates by Gauss-Legendre (no SciPy import:

@@ -19,6 +19,8 @@ from typing import Callable
 
 import numpy as np
 
+from ipmc_asym.kernels.quadrature_nodes import leggauss
+from ipmc_asym.model import groups
 from ipmc_asym.model.params import Groups, Material
 
 __all__ = ["AffineProblem", "CustomProblem", "b1_guess", "eps_bar_custom", "moment_y_linear",
@@ -33,21 +35,11 @@ TINY = np.finfo(float).tiny
 def b1_guess(A0: float, A1: float, A2: float) -> float:
     """``B1`` from electroneutrality with a neutral core (exponentially accurate).
 
-    Solves ``A0/2 (1 - e^{-2 A2}) B^2 + (A1 - A0)(1 - e^{-A2}) B - A1 A2 = 0`` (the first
-    integral ``G(B1) = G(B1 e^{-A2})``, ``G(C) = A0 C^2/2 + (A1 - A0) C - A1 ln C``).
-    Constant model: ``A2 / (1 - e^{-A2})``; linear: ``2 / (1 + e^{-A2})``.
+    :func:`ipmc_asym.model.groups.b1_neutral` at ``rho = A1/(A0 + A1)`` (the secant's ratio
+    for a custom ``eps(C)``).
     """
-    em1 = -math.expm1(-A2)  # 1 - e^{-A2}
-    if A0 == 0.0:
-        return A2 / em1 if A2 > 0 else 1.0
-    if A1 == 0.0:
-        return 2.0 / (1.0 + math.exp(-A2))
-    a = 0.5 * A0 * em1 * (2.0 - em1)  # A0/2 (1 - e^{-2A2})
-    bq = (A1 - A0) * em1
-    c = -A1 * A2
-    disc = math.sqrt(bq * bq - 4.0 * a * c)
-    # positive root, cancellation-free
-    return (-bq + disc) / (2.0 * a) if bq <= 0 else (-2.0 * c) / (bq + disc)
+    rho = A1 / (A0 + A1) if A0 + A1 > 0 else 1.0
+    return float(groups.b1_neutral(A2, rho))
 
 
 def expc(y):
@@ -256,7 +248,7 @@ def cumtrapz(f, x):
 # ---------------------------------------------------------------------------------------
 # post-processing of the linear-model moment (log singularity at the anode)
 # ---------------------------------------------------------------------------------------
-_GL_X, _GL_W = np.polynomial.legendre.leggauss(10)
+_GL_X, _GL_W = leggauss(10)
 
 
 def moment_y_linear(sol, z, g: Groups, b: float, D_anode: float) -> float:
@@ -306,7 +298,7 @@ def moment_y_linear(sol, z, g: Groups, b: float, D_anode: float) -> float:
 
 
 def eps_bar_custom(func: Callable, g: Groups, material: Material) -> Callable:
-    scale = abs(g.phi0) / (g.e * g.e * material.phi4 * material.F * g.C_moy)
+    scale = float(groups.A0(2.0 * g.e, g.phi0, 1.0, material, g.C_moy))  # A0 per F/m of eps
     cm = g.C_moy
 
     def eps_bar(Cb):

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import sys
 
-from ipmc_asym.base.registry import FIDELITIES, fidelity_names
+from ipmc_asym.base.registry import compiled_fidelities
 from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import count_type
 from ipmc_asym.io.datasets import uq_dataset, write_netcdf
@@ -20,7 +20,7 @@ def register(sub):
     p.add_argument("scene", metavar="SCENE.toml", help="scene with an [uncertain] table (examples/uq_nominal.toml)")
     p.add_argument("--samples", type=count_type("--samples"), default=10**5,
                    help="model runs wanted (rounded up to N(D+2), N a power of two; default 1e5)")
-    p.add_argument("--fidelity", default=None, choices=[f for f in fidelity_names() if FIDELITIES[f].order >= 0],
+    p.add_argument("--fidelity", default=None, choices=list(compiled_fidelities()),
                    help="force a fidelity (default: per sample, cheapest meeting the scene's tolerance)")
     p.add_argument("--seed", type=int, default=0, help="seed of the scrambled Sobol' sequence")
     p.add_argument("--scheduler", default=None, metavar="local|tcp://HOST:PORT",

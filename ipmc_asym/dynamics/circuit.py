@@ -54,6 +54,7 @@ from ipmc_asym.dynamics.electrode import (
 from ipmc_asym.forward.model import forward
 from ipmc_asym.kernels import _generated_charge as GC
 from ipmc_asym.kernels.jit import jit
+from ipmc_asym.model import groups
 from ipmc_asym.model.params import (
     D_CATION_SOURCE,
     NAFION_LI,
@@ -61,7 +62,6 @@ from ipmc_asym.model.params import (
     Strip,
     check_finite,
     check_positive,
-    debye_length,
 )
 from ipmc_asym.model.permittivity import Permittivity, get_model
 
@@ -251,7 +251,7 @@ def _time_grid(duration, t, points):
 def circuit_response(t, phi0_fun, strip: Strip, perm: Permittivity, material: Material, substeps: int = 2):
     """Integrate the reduced model on the time grid ``t`` (s); returns ``(sigma, u, J)``."""
     m = material
-    VT = m.R * m.T / m.F
+    VT = groups.thermal_voltage(m)
     tau = float(time_constant(strip.thickness, perm, m))
     # substeps between output times (BDF2 accuracy): at least `substeps`, and h <= tau/200;
     # times in units of tau
@@ -273,7 +273,7 @@ def circuit_response(t, phi0_fun, strip: Strip, perm: Permittivity, material: Ma
     # the bulk is a leaky dielectric: besides the layers' charge the electrodes carry the
     # displacement charge C_g (phi0 - u) of the core, C_g = eps_core/(2e) (its relaxation time
     # R C_g = lambda^2 e^2/D is instantaneous on the scale tau); C_g/C_d(0) = lambda
-    Cg = perm.eps_moy / strip.thickness
+    Cg = groups.geometric_capacitance(strip.thickness, perm.eps_moy)
     ub = phi0_fun(t) - u
     sigma = charge_scale(perm, m) * s + Cg * ub
     J = ub / float(core_resistance(strip.thickness, m))
@@ -414,14 +414,14 @@ def frequency_response(f, *, strip: Strip | None = None, model="constant", mater
     if not np.all(np.isfinite(f)) or np.any(f <= 0):
         raise ValueError("frequencies must be finite and > 0 Hz")
     e = s.e
-    lam = float(debye_length(s.thickness, perm.eps_moy, m))
-    kappa = m.phi4 * m.F**2 * m.D * m.C_moy / (m.R * m.T)
-    A3 = -m.rho2 * m.Z3 / (m.C_moy * m.F)
+    lam = float(groups.debye_length(s.thickness, perm.eps_moy, m))
+    kappa = float(groups.kappa(m))
+    A3 = float(groups.A3(m))
     omega = 2.0 * math.pi * f
     tau = float(time_constant(s.thickness, perm, m))
     # tip deflection per volt, small displacements: w = -M L^2/(2 E I_p),
-    # M per volt = 6 l e^2 C_moy F (1 + A3) * (moment transfer)
-    k_w = -s.length**2 / (2.0 * m.E * s.I_p) * 6.0 * s.l * e * e * m.C_moy * m.F * (1.0 + A3)
+    # M per volt = A5(1 V) (1 + A3) * (moment transfer), A5(1 V) = 6 l e^2 C_moy F (N m/V)
+    k_w = -s.length**2 / (2.0 * m.E * s.I_p) * float(groups.A5(s.width, s.thickness, 1.0, m)) * (1.0 + A3)
     R = float(core_resistance(s.thickness, m))
     # DC transfer: the static moment slope at 0 V, I(0+) = (1 + A3)(lam coth(1/lam) - lam^2)
     h0 = k_w * float(GC.moment_transfer_hat(np.array([1e-12]), lam)[0].real)

@@ -32,8 +32,10 @@ from ipmc_asym.base.registry import check_choice, fidelity_names
 from ipmc_asym.base.settings import BVP_STATED_ERROR, VALIDITY_LIMIT
 from ipmc_asym.kernels import _generated as G
 from ipmc_asym.kernels import _generated_charge as GC
+from ipmc_asym.kernels.closed import b1_model
 from ipmc_asym.kernels.jit import jit, jit_parallel, prange
 from ipmc_asym.kernels.special import gauss_legendre
+from ipmc_asym.model import groups
 from ipmc_asym.model.params import NAFION_LI, Material, Strip, check_positive
 from ipmc_asym.model.permittivity import MODELS, Permittivity, get_model
 
@@ -85,19 +87,7 @@ def charge_scale(perm: Permittivity, material: Material) -> float:
 
 def capacitance_scale(perm: Permittivity, material: Material) -> float:
     """``S F/(R T) = eps_core/lambda_D`` (F/m^2): ``C_d = that * Cdhat``."""
-    return charge_scale(perm, material) * material.F / (material.R * material.T)
-
-
-@jit
-def _b1(A2, rho, model_id):
-    if model_id < 0:
-        return G.b1_exact(A2, rho)
-    em1 = math.expm1(-A2)
-    if model_id == 0:
-        return G.b1_constant(A2, em1)
-    if model_id == 1:
-        return G.b1_linear(A2, em1)
-    return G.b1_affine(A2, em1)
+    return charge_scale(perm, material) * groups.inverse_thermal_voltage(material)
 
 
 @jit
@@ -156,10 +146,7 @@ def charge_hat_point(A2, rho, model_id, quad, X, Wt):
     """
     if A2 == 0.0:  # no field: sigma = 0, two layers of chat(0) = 1 in series
         return 0.0, 0.5, 0.0
-    if quad == 1:
-        B1 = G.b1_exact(A2, rho)
-    else:
-        B1 = _b1(A2, rho, model_id)
+    B1 = b1_model(A2, rho, -1 if quad == 1 else model_id)
     Yc = math.log(B1)
     Ya = Yc - A2
     mid = -1 if quad == 1 else model_id
@@ -244,10 +231,8 @@ def charge(thickness, voltage, model="constant", fidelity="corrected", *, width=
     if fidelity == "bvp":
         sig, cdv, err, errc, core = _bvp(th, v, perm, mat)
     else:
-        from ipmc_asym.model.params import debye_length
-
-        A2 = (mat.F * np.abs(v) / (mat.R * mat.T)).reshape(-1)
-        lam = np.asarray(debye_length(th, perm.eps_moy, mat), dtype=float).reshape(-1)
+        A2 = np.asarray(groups.A2(v, mat), dtype=float).reshape(-1)
+        lam = np.asarray(groups.debye_length(th, perm.eps_moy, mat), dtype=float).reshape(-1)
         rho = perm.eps0 / perm.eps_moy
         outs = [np.empty(A2.size) for _ in range(4)]
         _sweep(np.ascontiguousarray(A2), np.ascontiguousarray(lam), rho, _model_id(perm, fidelity),
@@ -279,7 +264,7 @@ def _bvp(th, v, perm, mat):
     err = np.full(th.shape, BVP_STATED_ERROR)
     errc = np.empty(th.shape)
     core = np.full(th.shape, 2.0)
-    VT = mat.R * mat.T / mat.F
+    VT = groups.thermal_voltage(mat)
     for idx in np.ndindex(th.shape):
         t, u = float(th[idx]), float(v[idx])
         sig[idx] = _bvp_sigma(t, u, perm, mat)
@@ -320,9 +305,7 @@ def layer_voltage(sigma, model="constant", material: Material | None = None):
 
 def core_resistance(thickness, material: Material = NAFION_LI):
     """``R = 2e/kappa`` (Ohm m^2), ``kappa = phi4 F^2 D C_moy/(R T)`` (S/m); thickness TOTAL 2e."""
-    m = material
-    kappa = m.phi4 * m.F**2 * m.D * m.C_moy / (m.R * m.T)
-    return np.asarray(thickness, dtype=float) / kappa
+    return np.asarray(thickness, dtype=float) / groups.kappa(material)
 
 
 def time_constant(thickness, model="constant", material: Material = NAFION_LI):

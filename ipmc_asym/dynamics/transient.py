@@ -41,7 +41,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ipmc_asym.model.params import NAFION_LI, Material, Strip, check_positive, debye_length
+from ipmc_asym.model import groups
+from ipmc_asym.model.params import NAFION_LI, Material, Strip, check_positive
 from ipmc_asym.model.permittivity import Permittivity, get_model
 
 __all__ = ["TransientResult", "make_fv_mesh", "solve_transient", "bernoulli"]
@@ -241,16 +242,16 @@ def solve_transient(t, phi0_fun, strip: Strip, model="constant", material: Mater
         raise ValueError(f"method must be BDF or Radau; got {method!r}")
     check_positive("cells_per_debye", cells_per_debye)
     tt = np.asarray(t, dtype=float).reshape(-1)
-    VT = m.R * m.T / m.F
+    VT = groups.thermal_voltage(m)
     e = strip.e
     tscale = e * e / m.D
-    lam = float(debye_length(strip.thickness, perm.eps_moy, m))
+    lam = float(groups.debye_length(strip.thickness, perm.eps_moy, m))
     rho = perm.eps0 / perm.eps_moy
     A2max = float(np.max(np.abs(phi0_fun(np.linspace(tt[0], tt[-1], 2001))))) / VT
     check_positive("refine", refine)
     X = make_fv_mesh(lam, A2max, rho, cells_per_debye=cells_per_debye * refine, ratio=1.0 + (ratio - 1.0) / refine,
                      h_core=h_core / refine)
-    A3 = -m.rho2 * m.Z3 / (m.C_moy * m.F)
+    A3 = float(groups.A3(m))
 
     def psi0(th):
         return float(phi0_fun(np.array([th * tscale]))[0]) / VT
@@ -317,7 +318,7 @@ def solve_transient(t, phi0_fun, strip: Strip, model="constant", material: Mater
     from ipmc_asym.dynamics.electrode import layer_voltage
 
     u = layer_voltage(sigma, perm, m) if moment else np.full(nt, np.nan)
-    Mscale = 6.0 * strip.l * e * e * m.C_moy * m.R * m.T
+    Mscale = float(groups.A5(strip.width, strip.thickness, VT, m))  # A5 at |phi0| = R T/F, N m
     extra = {"cells": P.N, "h_min_over_debye": float(P.h.min() / lam), "nfev": int(sol.nfev),
              "njev": int(sol.njev), "seconds": secs, "rtol": rtol, "method": method}
     if energy:

@@ -123,12 +123,12 @@ def moment_escalating(thickness, voltage, model="constant", fidelity="quadrature
         idx = np.flatnonzero(todo)
         if idx.size == 0:
             break
-        if perm.is_custom and _FIDELITY_SPECS[f].order >= 0:
+        if perm.is_custom and _FIDELITY_SPECS[f].compiled:
             why.append(f"{f}: not available for a custom eps(C)")
             continue
         try:
             r = moment(th[idx], v[idx], perm, f, material=material,
-                       progress=(progress if not _FIDELITY_SPECS[f].order >= 0 else False))
+                       progress=(False if _FIDELITY_SPECS[f].compiled else progress))
         except ValueError as exc:  # e.g. closed forms for a non-paper Permittivity
             why.append(f"{f}: {exc}")
             continue

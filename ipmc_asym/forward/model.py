@@ -23,12 +23,13 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ipmc_asym.base.registry import FIDELITIES as _FIDELITY_SPECS
-from ipmc_asym.base.registry import fidelity_names
+from ipmc_asym.base.registry import compiled_fidelities, fidelity_names
 from ipmc_asym.base.settings import OUTSIDE_REGIMES, STRAIN_LIMIT, VALIDITY_LIMIT
 from ipmc_asym.beam.statics import REGIMES, solve_beam
 from ipmc_asym.forward.escalation import Escalated, check_tol, moment_escalating, rung_checks
 from ipmc_asym.integral.api import check_fidelity, check_min_thickness, closed_model_id, validity_limit
 from ipmc_asym.integral.samples import moment_samples
+from ipmc_asym.model import groups
 from ipmc_asym.model.params import NAFION_LI, Material, moment_scale, second_moment
 from ipmc_asym.model.permittivity import get_model
 
@@ -50,7 +51,7 @@ MECHANICAL_KEYS = FREE_STRIP_KEYS + ("F_block", "F_block_small")
 WITHHOLD = (("moment", MOMENT_KEYS + MECHANICAL_KEYS), ("strain", MECHANICAL_KEYS),
             ("beam_regime", FREE_STRIP_KEYS))
 #: rungs with a compiled point kernel (those :func:`forward` climbs with per-point ``c_moy``)
-SAMPLING_FIDELITIES = tuple(f for f in fidelity_names() if _FIDELITY_SPECS[f].order >= 0)
+SAMPLING_FIDELITIES = compiled_fidelities()
 _OUTSIDE_CODES = [REGIMES.index(o) for o in OUTSIDE_REGIMES]
 
 
@@ -193,13 +194,10 @@ def _moment_per_point_material(th, v, perm, fidelity, material, c_moy, tol, esca
                          f"{', '.join(SAMPLING_FIDELITIES)}")
     check_min_thickness(th)
     limit = VALIDITY_LIMIT if tol is None else min(tol, VALIDITY_LIMIT)
-    m = material
-    C = c_moy
-    e = 0.5 * th
     eps_core = perm.eps0 + perm.deps
-    lam = np.sqrt(eps_core * m.R * m.T / (e * e * m.phi4 * m.F * m.F * C))  # core Debye length / e
-    A2 = m.F * np.abs(v) / (m.R * m.T)
-    A3 = -m.rho2 * m.Z3 / (C * m.F)
+    lam = groups.debye_length(th, eps_core, material, c_moy)  # core Debye length / e
+    A2 = groups.A2(v, material)
+    A3 = groups.A3(material, c_moy)
     rho = perm.eps0 / eps_core
     sign = np.sign(v)
     n = th.size
@@ -218,7 +216,7 @@ def _moment_per_point_material(th, v, perm, fidelity, material, c_moy, tol, esca
             break
         mid = closed_model_id(perm, f)
         Ii, ei, ci = np.empty(todo.size), np.empty(todo.size), np.empty(todo.size)
-        moment_samples(lam[todo], A2[todo], A3[todo], rho, mid, _FIDELITY_SPECS[f].order, sign[todo], Ii, ei, ci)
+        moment_samples(lam[todo], A2[todo], A3[todo], rho, mid, _FIDELITY_SPECS[f].kernel_code, sign[todo], Ii, ei, ci)
         e_ok, l_ok = rung_checks(Ii, ei, ci, f, limit)
         e_ok &= ei < validity_limit(f)  # the rung's own ceiling (integral.api.validity_limit)
         ok = e_ok & l_ok

@@ -26,6 +26,12 @@ Fidelity ladder (docs/design.md; the registry :mod:`ipmc_asym.base.registry`), n
 
 ``I`` is computed on ``|phi0|`` and carries the sign of the voltage (mirror symmetry);
 ``I = 0`` at zero volts.  Thickness is the TOTAL thickness ``2e`` (SI).
+
+Names exported for scripts: ``FIDELITIES`` is the tuple of the rung names, cheapest first
+(``registry.fidelity_names()``; the specs are the dict ``ipmc_asym.base.registry.FIDELITIES``);
+``MODELS`` is ``ipmc_asym.model.permittivity.MODELS``, ``{name: Permittivity}`` (the specs are
+the dict ``ipmc_asym.base.registry.MODELS``); ``ANY_THICKNESS`` is the tuple of the rungs
+whose spec has ``any_thickness`` set.
 """
 
 from __future__ import annotations
@@ -39,7 +45,7 @@ import numpy as np
 from ipmc_asym.base.progress import progress as _progress_bar
 from ipmc_asym.base.registry import FIDELITIES as _FIDELITY_SPECS
 from ipmc_asym.base.registry import MODELS as _MODEL_SPECS
-from ipmc_asym.base.registry import check_choice, fidelity_names
+from ipmc_asym.base.registry import any_thickness_fidelities, check_choice, fidelity_names, is_compiled
 from ipmc_asym.base.settings import (
     BVP_STATED_ERROR,
     EXACT_STATED_ERROR,
@@ -52,18 +58,21 @@ from ipmc_asym.kernels.closed import closed_b1, closed_finish, layer_closed, mom
 from ipmc_asym.kernels.exact import moment_exact
 from ipmc_asym.kernels.jit import interpreted, jit, jit_parallel, prange
 from ipmc_asym.kernels.quadrature import moment_quadrature
-from ipmc_asym.model.params import NAFION_LI, Material, Strip, debye_length
+from ipmc_asym.model import groups
+from ipmc_asym.model.params import NAFION_LI, Material, Strip
 from ipmc_asym.model.permittivity import MODELS, Permittivity, get_model
 
 __all__ = ["FIDELITIES", "MomentResult", "moment_integral", "moment", "groups_arrays", "check_fidelity",
            "check_min_thickness", "invalid_message", "validity_limit", "interpret_small"]
 
+#: the rung names, cheapest first (tuple; the specs: ``registry.FIDELITIES``)
 FIDELITIES = fidelity_names()
-#: order argument of the sweep driver: 1 leading, 2 corrected, 0 quadrature, 3 exact
-_ORDER = {k: f.order for k, f in _FIDELITY_SPECS.items() if f.order >= 0}
-#: fidelities valid at every thickness (no neutral core assumed): ``core`` is informative only
-#: rungs that hold whatever the thickness (overlapping layers, non-neutral core)
-ANY_THICKNESS = ("exact", "bvp")
+#: rungs that hold whatever the thickness (overlapping layers, non-neutral core): their
+#: ``core`` output is informative only (the registry's ``any_thickness`` flag)
+ANY_THICKNESS = any_thickness_fidelities()
+#: ``{name: kernel_code}`` of the compiled rungs (the registry's flags; read by ``bench.suite``
+#: and the tests of the bare driver)
+_ORDER = {k: f.kernel_code for k, f in _FIDELITY_SPECS.items() if f.compiled}
 
 
 def check_fidelity(fidelity: str) -> str:
@@ -128,14 +137,10 @@ def groups_arrays(thickness, voltage, perm: Permittivity, material: Material):
     if not np.all(np.isfinite(v)):
         raise ValueError("voltage must be finite (volts)")
     th, v = np.broadcast_arrays(th, v)
-    m = material
-    cm = m.C_moy
     eps_core = perm.eps0 + perm.deps
-    lam = debye_length(th, eps_core, m)
-    A2 = m.F * np.abs(v) / (m.R * m.T)
-    A3 = -m.rho2 * m.Z3 / (cm * m.F)
+    lam = groups.debye_length(th, eps_core, material)
     rho = perm.eps0 / eps_core
-    return lam, A2, A3, rho, np.sign(v)
+    return lam, groups.A2(v, material), groups.A3(material), rho, np.sign(v)
 
 
 def check_min_thickness(thickness) -> None:
@@ -271,7 +276,7 @@ def _sweep(lam, A2, A3, rho, model_id, order, sign, I, err, B1, core):
 
 @jit
 def _groups_point(t, vv, lamc, a2c):
-    """``(lam, A2)`` of one point: ``lam = lamc / thickness`` (``params.debye_length``:
+    """``(lam, A2)`` of one point: ``lam = lamc / thickness`` (``groups.debye_length``:
     ``lam ~ 1/e``), ``A2 = a2c |phi0|`` (one division, no square root, per point)."""
     return lamc / t, a2c * abs(vv)
 
@@ -429,10 +434,10 @@ def _scalar_point(t, vv, lamc, a2c, A3, rho, model_id, order, any_thickness, lim
 def _driver_constants(perm: Permittivity, mat: Material, fidelity: str) -> tuple:
     """Scalar arguments of the fused drivers after ``(th, v)``."""
     eps_core = perm.eps0 + perm.deps
-    lamc = float(debye_length(1.0, eps_core, mat))  # lam * thickness (lam ~ 1/e)
-    return (lamc, mat.F / (mat.R * mat.T),
-            -mat.rho2 * mat.Z3 / (mat.C_moy * mat.F), perm.eps0 / eps_core,
-            closed_model_id(perm, fidelity), _ORDER[fidelity], fidelity in ANY_THICKNESS,
+    lamc = float(groups.debye_length(1.0, eps_core, mat))  # lam * thickness (lam ~ 1/e)
+    return (lamc, groups.inverse_thermal_voltage(mat), float(groups.A3(mat)), perm.eps0 / eps_core,
+            closed_model_id(perm, fidelity), _FIDELITY_SPECS[fidelity].kernel_code,
+            _FIDELITY_SPECS[fidelity].any_thickness,
             validity_limit(fidelity))
 
 
@@ -523,8 +528,8 @@ def moment(thickness, voltage, model="constant", fidelity="quadrature", *, mater
                          f"constant, linear, affine); got fidelity {fidelity!r}")
     gperm = perm
     if perm.is_custom:  # groups of the secant through C = 0 and C_moy (bookkeeping only)
-        e0 = max(float(perm.func(0.0)), 0.0)
-        gperm = Permittivity("secant", eps0=e0, deps=max(float(perm.func(mat.C_moy)) - e0, 0.0))
+        e0, de = perm.secant(mat.C_moy)
+        gperm = Permittivity("secant", eps0=e0, deps=de)
     if fidelity != "bvp":
         I, valid, (err, B1, core, lam, A2), (bad_th, bad_v, _) = _fused(thickness, voltage, gperm, mat, fidelity,
                                                                        full=True)
@@ -541,7 +546,7 @@ def moment(thickness, voltage, model="constant", fidelity="quadrature", *, mater
     B1 = np.empty(shape)
     core = np.empty(shape)
     success, message = _bvp_loop(thickness, voltage, perm, mat, I, err, B1, core, progress)
-    valid = (err < validity_limit(fidelity)) & ((core > 0) | (fidelity in ANY_THICKNESS)) & success
+    valid = (err < validity_limit(fidelity)) & ((core > 0) | _FIDELITY_SPECS[fidelity].any_thickness) & success
     return MomentResult(I=I, error=err, B1=B1, core=core, lam=lam, A2=A2, valid=valid,
                         fidelity=fidelity, model=perm.name, success=success, message=message)
 
@@ -633,7 +638,7 @@ def moment_integral(thickness, voltage, model="constant", fidelity="quadrature",
     if (type(thickness) in _SCALAR_TYPES and type(voltage) in _SCALAR_TYPES and material is None
             and not material_kw and type(model) is str):
         consts = _SCALAR_CACHE.get((model, fidelity))
-        if consts is None and model in _MODEL_SPECS and fidelity in _ORDER:
+        if consts is None and model in _MODEL_SPECS and is_compiled(fidelity):
             consts = _SCALAR_CACHE[(model, fidelity)] = _driver_constants(get_model(model), NAFION_LI, fidelity)
         t, vv = float(thickness), float(voltage)
         if consts is not None and t >= MIN_THICKNESS and math.isfinite(t) and math.isfinite(vv):
@@ -672,7 +677,7 @@ def _lean_integral(thickness, voltage, model, fidelity, material, material_kw):
     """``(I, valid, n_invalid)`` from the fused driver with no bookkeeping outputs (9 bytes a
     point; NaN in ``I`` where invalid), or None where :func:`moment` is needed (BVP, custom
     eps(C), bad input: its messages)."""
-    if fidelity not in _ORDER or not (isinstance(model, str) or isinstance(model, Permittivity)):
+    if not is_compiled(fidelity) or not (isinstance(model, str) or isinstance(model, Permittivity)):
         return None
     perm = get_model(model)
     if perm.is_custom:

@@ -12,7 +12,7 @@ import math
 from ipmc_asym.kernels import _generated as G
 from ipmc_asym.kernels.jit import jit
 
-__all__ = ["layer_closed", "moment_closed", "closed_b1", "closed_finish", "TRUNCATION"]
+__all__ = ["layer_closed", "moment_closed", "closed_b1", "b1_model", "closed_finish", "TRUNCATION"]
 
 
 #: truncation of the patches (10 coefficients at ratio <= 1/24 of the radius: <= 2e-14) and of
@@ -96,6 +96,20 @@ def closed_b1(A2, model_id):
     else:
         B1 = G.b1_affine(A2, em1)
     return em, B1, math.log(B1)
+
+
+@jit
+def b1_model(A2, rho, model_id):
+    """``B1`` from electroneutrality of a neutral core (paper section 4) for a model id of
+    the compiled kernels.
+
+    ``model_id`` 0..2: the closed forms' specialisations (:func:`closed_b1`); ``< 0``: the
+    root for any ``rho = eps0/eps_core`` in [0, 1].  The same root in numpy:
+    :func:`ipmc_asym.model.groups.b1_neutral`.
+    """
+    if model_id < 0:
+        return G.b1_exact(A2, rho)
+    return closed_b1(A2, model_id)[1]
 
 
 @jit

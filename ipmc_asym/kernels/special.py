@@ -17,6 +17,7 @@ import math
 import numpy as np
 
 from ipmc_asym.kernels.jit import jit
+from ipmc_asym.kernels.quadrature_nodes import leggauss
 
 __all__ = ["exprel", "e2rel", "li2", "li3", "gauss_legendre", "ZETA2", "ZETA3"]
 
@@ -148,7 +149,7 @@ def gauss_legendre(n: int):
     ``S[i, j] = integral_{-1}^{x_i} l_j(x) dx`` where ``l_j`` is the Lagrange basis on the
     nodes, so ``S @ f(x)`` integrates the interpolant of ``f`` from -1 to each node.
     """
-    x, w = np.polynomial.legendre.leggauss(n)
+    x, w = (a.copy() for a in leggauss(n))
     # Lagrange basis l_j in the Legendre basis: V c = I  with V[i, k] = P_k(x_i)
     V = np.polynomial.legendre.legvander(x, n - 1)
     C = np.linalg.solve(V, np.eye(n))  # column j: Legendre coefficients of l_j

@@ -2,6 +2,9 @@
 
 Layer rule: this module is the bottom of the stack (parameters -> permittivity ->
 kernels -> layers/BVP -> beam -> sweeps/scenes -> plots/CLI).  It imports numpy only.
+The derived quantities (``A0..A5``, Debye length, conductivity, ``B1``) are written once in
+:mod:`ipmc_asym.model.groups`; ``Groups``, ``make_groups``, ``moment_scale`` and
+``debye_length`` are re-exported here.
 
 Conventions
 -----------
@@ -22,9 +25,10 @@ Sources of the ``nafion-li`` preset (seed paper section 4): ``Z3 = -9e4 C/kg`` (
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 
 from ipmc_asym.base.units import parse_pressure
+from ipmc_asym.model.groups import Groups, debye_length, make_groups, moment_scale
 
 __all__ = [
     "C_MOY_PAPER",
@@ -274,31 +278,6 @@ class Strip:
 NOMINAL_STRIP = Strip()
 
 
-def moment_scale(width, thickness, voltage, F, C_moy):
-    """``A5 = 6 l e^2 F |phi0| C_moy`` (N m): ``M_A = A5 I`` (paper sections 3-4).
-
-    Vectorised; ``width``, ``thickness`` are TOTAL (2l, 2e).
-    """
-    import numpy as np
-
-    l = 0.5 * np.asarray(width, dtype=float)  # noqa: E741
-    e = 0.5 * np.asarray(thickness, dtype=float)
-    return 6.0 * l * e * e * F * np.abs(np.asarray(voltage, dtype=float)) * C_moy
-
-
-def debye_length(thickness, eps_core, material: "Material"):
-    """Core Debye length over ``e``: ``lambda = sqrt(eps_core R T / (e^2 phi4 F^2 C_moy))``.
-
-    Equal to ``sqrt((A0 + A1)/A2)`` but defined at zero volts too (all three groups scale
-    with ``|phi0|``).  Vectorised; ``thickness`` is TOTAL (2e).
-    """
-    import numpy as np
-
-    m = material
-    e = 0.5 * np.asarray(thickness, dtype=float)
-    return np.sqrt(eps_core * m.R * m.T / (e * e * m.phi4 * m.F * m.F * m.C_moy))
-
-
 def second_moment(width, thickness):
     """``I_p = 4 l e^3 / 3`` (m^4) from TOTAL width and thickness (vectorised)."""
     import numpy as np
@@ -306,73 +285,3 @@ def second_moment(width, thickness):
     l = 0.5 * np.asarray(width, dtype=float)  # noqa: E741
     e = 0.5 * np.asarray(thickness, dtype=float)
     return 4.0 * l * e**3 / 3.0
-
-
-@dataclass(frozen=True)
-class Groups:
-    """Dimensionless groups of the system (paper eq. for ``A0..A5``), built on ``|phi0|``.
-
-    ``sign`` is the sign of the voltage (+1, -1, or 0): the solution for a negative voltage
-    is the mirror image of the one for ``|phi0|``, so ``I`` carries ``sign``.
-    """
-
-    C_moy: float
-    A0: float
-    A1: float
-    A2: float
-    A3: float
-    A5: float
-    sign: float
-    e: float
-    l: float  # noqa: E741
-    phi0: float
-    extra: dict = field(default_factory=dict, compare=False, repr=False)
-
-    @property
-    def debye(self) -> float:
-        """Core Debye length relative to ``e``: ``lambda = sqrt((A0 + A1) / A2)``.
-
-        Independent of the voltage (all three groups scale with ``|phi0|``); stored from the
-        dimensional data so that it is defined at zero volts too.
-        """
-        return self.extra["debye"]
-
-
-def make_groups(strip: Strip, material: Material, eps0: float, deps: float) -> Groups:
-    """Dimensionless groups for a strip, a material and ``eps = eps0 + deps * C / C_moy``.
-
-    Parameters
-    ----------
-    strip : Strip
-    material : Material
-    eps0 : float
-        Permittivity at zero concentration, F/m (``>= 0``).
-    deps : float
-        ``eps_moy - eps0``, F/m (``>= 0``; not both zero).
-
-    Returns
-    -------
-    Groups
-        ``A0 = |phi0| deps / (e^2 phi4 F C_moy)``, ``A1 = |phi0| eps0 / (e^2 phi4 F C_moy)``,
-        ``A2 = F |phi0| / (R T)``, ``A3 = -rho2 Z3 / (C_moy F)``,
-        ``A5 = 6 l e^2 F |phi0| C_moy`` (N m).
-    """
-    m = material
-    cm = m.C_moy
-    e, l = strip.e, strip.l
-    phi = abs(float(strip.voltage))
-    sign = math.copysign(1.0, strip.voltage) if strip.voltage != 0.0 else 0.0
-    den = e * e * m.phi4 * m.F * cm
-    return Groups(
-        C_moy=cm,
-        A0=phi * deps / den,
-        A1=phi * eps0 / den,
-        A2=m.F * phi / (m.R * m.T),
-        A3=-m.rho2 * m.Z3 / (cm * m.F),
-        A5=float(moment_scale(strip.width, strip.thickness, phi, m.F, cm)),
-        sign=sign,
-        e=e,
-        l=l,
-        phi0=float(strip.voltage),
-        extra={"debye": float(debye_length(strip.thickness, eps0 + deps, m))},
-    )

@@ -65,10 +65,18 @@ class Permittivity:
         """
         if self.func is None:
             return make_groups(strip, material, self.eps0, self.deps)
-        cm = material.C_moy
-        e0 = float(self.func(0.0))
-        em = float(self.func(cm))
-        return make_groups(strip, material, max(e0, 0.0), max(em - max(e0, 0.0), 0.0))
+        return make_groups(strip, material, *self.secant(material.C_moy))
+
+    def secant(self, C_moy: float) -> tuple:
+        """``(eps0, deps)`` (F/m) of the affine law through ``eps(0)`` and ``eps(C_moy)``.
+
+        For an affine model these are its own ``eps0, deps``; for a custom ``eps(C)`` the
+        secant through ``C = 0`` and ``C = C_moy`` (``C_moy`` in mol/m^3), each clipped at 0.
+        """
+        if self.func is None:
+            return self.eps0, self.deps
+        e0 = max(float(self.func(0.0)), 0.0)
+        return e0, max(float(self.func(C_moy)) - e0, 0.0)
 
 
 #: The paper's three models (section 4 table), SI (F/m), from the registry.

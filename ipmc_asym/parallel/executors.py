@@ -43,7 +43,7 @@ from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 
-from ipmc_asym.base.registry import FIDELITIES, fidelity_names, model_names
+from ipmc_asym.base.registry import FIDELITIES, compiled_fidelities, model_names
 from ipmc_asym.integral.api import moment
 from ipmc_asym.integral.samples import moment_samples
 
@@ -69,8 +69,8 @@ def check_scheduler(scheduler):
     raise ValueError(f"--scheduler must be local or tcp://HOST:PORT; got {scheduler!r}")
 
 
-#: the compiled rungs (kernel order >= 0 in the registry): what workers may call
-COMPILED = tuple(f for f in fidelity_names() if FIDELITIES[f].order >= 0)
+#: the compiled rungs (``compiled`` in the registry): what workers may call
+COMPILED = compiled_fidelities()
 
 
 def warm_kernels(fidelities=COMPILED) -> float:
@@ -89,7 +89,7 @@ def warm_kernels(fidelities=COMPILED) -> float:
             moment(np.array([200e-6]), np.array([1.0]), m, f)
         # the per-sample driver of ipmc_asym.studies.uq (same signature for every model)
         mid = 0 if FIDELITIES[f].closed_form else -1
-        moment_samples(0.01 * one, 40.0 * one, 0.3 * one, 1.0, mid, FIDELITIES[f].order, one,
+        moment_samples(0.01 * one, 40.0 * one, 0.3 * one, 1.0, mid, FIDELITIES[f].kernel_code, one,
                        np.empty(1), np.empty(1), np.empty(1))
     return time.perf_counter() - t0
 
