@@ -28,6 +28,7 @@ from ipmc_asym.io.jsonio import dumps
 from ipmc_asym.parallel.executors import check_scheduler
 from ipmc_asym.studies.fits import sweep_fits
 from ipmc_asym.studies.sweep_chunks import sweep_chunked
+from ipmc_asym.studies.sweeps import iter_sweep, prefetched, sweep, warm_writer, withhold, write_csv, write_json
 
 #: points per axis used for the fits (a subsample of a longer axis fits the same law)
 FIT_POINTS = 2000
@@ -68,7 +69,6 @@ FORMAT_WORKERS = 2
 
 def _fits(vary, args, base, mat):
     """Power-law fits along each swept axis (through the middle of the other axes)."""
-    from ipmc_asym.studies.sweeps import sweep, withhold
     fits, notes = [], []
     for var, vals in vary.items():
         if vals.size < 2:
@@ -124,17 +124,7 @@ def run(args) -> int:
     if args.out:
         check_output_path(args.out, "file")
     if args.scheduler is not None:
-
         check_scheduler(args.scheduler)
-    # deferred: the compiled kernels load only once the sweep is known to be accepted
-    from ipmc_asym.studies.sweeps import (
-        iter_sweep,
-        prefetched,
-        warm_writer,
-        withhold,
-        write_csv,
-        write_json,
-    )
 
     base = strip_from_args(args)
     mat = material_from_args(args)

@@ -11,6 +11,7 @@ from ipmc_asym.io.datasets import uq_dataset, write_netcdf
 from ipmc_asym.io.fileio import check_output_path
 from ipmc_asym.io.jsonio import dumps
 from ipmc_asym.parallel.executors import check_scheduler
+from ipmc_asym.studies.uq import run_uq
 
 
 def register(sub):
@@ -31,7 +32,6 @@ def register(sub):
 
 
 def run(args) -> int:
-    from ipmc_asym.studies.uq import run_uq
 
     for opt in ("out", "plot"):
         if getattr(args, opt):

@@ -51,6 +51,7 @@ from ipmc_asym.dynamics.electrode import (
     core_resistance,
     time_constant,
 )
+from ipmc_asym.dynamics.transient import solve_transient
 from ipmc_asym.forward.model import forward
 from ipmc_asym.kernels import _generated_charge as GC
 from ipmc_asym.kernels.jit import jit
@@ -332,7 +333,6 @@ def step_response(voltage=1.0, duration=None, *, strip: Strip | None = None, mod
         sigma, u, J = circuit_response(tgrid, fun, s, perm, m)
         success, message = True, "reduced model integrated (variable-step BDF2, 2 substeps per output interval)"
     else:
-        from ipmc_asym.dynamics.transient import solve_transient
 
         r = solve_transient(tgrid, fun, s, perm, m, **(pnp_options or {}))
         if not r.success:

@@ -41,6 +41,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ipmc_asym.dynamics.electrode import layer_voltage
+from ipmc_asym.kernels._generated import b1_exact
 from ipmc_asym.model import groups
 from ipmc_asym.model.params import NAFION_LI, Material, Strip, check_positive
 from ipmc_asym.model.permittivity import Permittivity, get_model
@@ -79,7 +81,6 @@ def make_fv_mesh(lam: float, A2max: float, rho: float, *, cells_per_debye: float
     (``lambda sqrt(2 rho (A2 - 1))``) plus 12 Debye lengths, then growing by ``ratio`` up to
     ``h_core`` in the neutral core.  Symmetric (either face may be the cathode).
     """
-    from ipmc_asym.kernels._generated import b1_exact
 
     b1 = float(b1_exact(A2max, rho)) if A2max > 0 else 1.0
     h1 = lam / cells_per_debye
@@ -315,7 +316,6 @@ def solve_transient(t, phi0_fun, strip: Strip, model="constant", material: Mater
             cs[k] = c
     sigma = sig_scale * d0
     Jsi = sig_scale * J / tscale
-    from ipmc_asym.dynamics.electrode import layer_voltage
 
     u = layer_voltage(sigma, perm, m) if moment else np.full(nt, np.nan)
     Mscale = float(groups.A5(strip.width, strip.thickness, VT, m))  # A5 at |phi0| = R T/F, N m

@@ -27,6 +27,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 
+import numpy as np
+
 from ipmc_asym.base.units import parse_pressure
 from ipmc_asym.model.groups import Groups, debye_length, make_groups, moment_scale
 
@@ -280,7 +282,6 @@ NOMINAL_STRIP = Strip()
 
 def second_moment(width, thickness):
     """``I_p = 4 l e^3 / 3`` (m^4) from TOTAL width and thickness (vectorised)."""
-    import numpy as np
 
     l = 0.5 * np.asarray(width, dtype=float)  # noqa: E741
     e = 0.5 * np.asarray(thickness, dtype=float)

@@ -55,6 +55,8 @@ from ipmc_asym.base.registry import closed_form_fidelities, fidelity_names
 from ipmc_asym.base.units import parse_length, parse_pressure, parse_quantity, parse_voltage
 from ipmc_asym.beam.statics import blocking_force_ratio
 from ipmc_asym.model.params import NAFION_LI, Material, Strip
+from ipmc_asym.model.permittivity import Permittivity, get_model
+from ipmc_asym.parallel.executors import run_chunks
 
 __all__ = [
     "FREE_PARAMETERS",
@@ -264,7 +266,6 @@ def _bound(k, x):
 
 # ---- forward model ---------------------------------------------------------------------------
 def _perm(model, values):
-    from ipmc_asym.model.permittivity import Permittivity, get_model
 
     p = get_model(model)
     if "eps0" in values or "deps" in values:
@@ -411,7 +412,6 @@ def _multistart_task(args):
 
 
 def _start_values(names, model, material):
-    from ipmc_asym.model.permittivity import get_model
 
     p = get_model(model)
     out = []
@@ -504,7 +504,6 @@ def fit(data: CalibrationData, free, model="constant", material: Material = NAFI
     for k, fid in enumerate(ladder):
         prob = _Problem(data, names, model, material, fid)
         if k == 0 and len(starts) > 1:
-            from ipmc_asym.parallel.executors import run_chunks
 
             outs = run_chunks(_multistart_task, [(prob, s, lo, hi) for s in starts], scheduler=scheduler)
             best = min(range(len(outs)), key=lambda i: outs[i][0])
@@ -576,7 +575,6 @@ def fit(data: CalibrationData, free, model="constant", material: Material = NAFI
            f"shift < 0.1 standard error on every estimate)")
     if notes:
         msg += "; " + "; ".join(notes)
-    from ipmc_asym.model.permittivity import get_model
 
     return CalibrationResult(parameters=params, correlation=corr, chi2_red=chi2_red, n_points=n,
                              fidelity=chosen, model=get_model(model).name, success=bool(res.success),

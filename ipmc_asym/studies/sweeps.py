@@ -20,9 +20,15 @@ Layer rule: stdlib + numpy at import.
 
 from __future__ import annotations
 
+import contextvars
 import io
+import queue
 import sys
+import threading
+from collections import deque
+from concurrent.futures import ThreadPoolExecutor
 
+import numba
 import numpy as np
 
 from ipmc_asym.base.progress import progress as progress_bar
@@ -34,6 +40,7 @@ from ipmc_asym.forward.escalation import check_tol
 from ipmc_asym.forward.model import CHECKS, FREE_STRIP_KEYS, MECHANICAL_KEYS, WITHHOLD, forward
 from ipmc_asym.integral.api import check_fidelity
 from ipmc_asym.io.fileio import atomic_write
+from ipmc_asym.io.jsonio import dumps
 from ipmc_asym.io.textfmt import format_table
 from ipmc_asym.model.params import NAFION_LI, Material, Strip
 from ipmc_asym.model.permittivity import get_model
@@ -156,9 +163,6 @@ def prefetched(chunks, depth: int = 1, threads: int | None = None):
     ``threads``: Numba threads of the producer's kernels (e.g. 1: one core computes while the
     consumer uses the other).
     """
-    import contextvars
-    import queue
-    import threading
 
     q: queue.Queue = queue.Queue(maxsize=max(1, int(depth)))
     done = object()
@@ -167,7 +171,6 @@ def prefetched(chunks, depth: int = 1, threads: int | None = None):
     def produce():
         try:
             if threads is not None:  # Numba's thread count is per calling thread
-                import numba
 
                 numba.set_num_threads(max(1, min(int(threads), numba.config.NUMBA_NUM_THREADS)))
             for c in chunks:
@@ -416,8 +419,6 @@ def _texts(chunks, kind: str, workers: int):
             for piece in _pieces(c):
                 yield _format_chunk_bytes(piece, kind), piece.size
         return
-    from collections import deque
-    from concurrent.futures import ThreadPoolExecutor
 
     pending: deque = deque()
     with ThreadPoolExecutor(max_workers=workers, thread_name_prefix="ipmc-format") as pool:
@@ -476,7 +477,6 @@ def write_json(chunks, fh, extra_before: dict | None = None, extra_after=None, w
     """Stream ``{"rows": [...], ...}`` chunk by chunk; ``extra_after`` is a callable giving
     the keys written after the rows (e.g. fits, timing); ``workers`` as in :func:`write_csv`.
     Returns the number of rows."""
-    from ipmc_asym.io.jsonio import dumps
 
     put = _byte_writer(fh)
 

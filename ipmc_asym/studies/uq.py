@@ -43,14 +43,19 @@ deferred.
 from __future__ import annotations
 
 import math
+import os
 import time
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from ipmc_asym.base.settings import CHUNK_ROWS
+from ipmc_asym.base.units import parse_length, parse_pressure, parse_voltage
 from ipmc_asym.forward.model import SAMPLING_FIDELITIES, forward
 from ipmc_asym.io.datasets import VARIABLES
+from ipmc_asym.model.permittivity import get_model
+from ipmc_asym.parallel.executors import chunk_slices, run_chunks
+from ipmc_asym.studies.scene_schema import load_scene, parse_scene
 
 __all__ = ["UNCERTAIN", "DISTRIBUTIONS", "OUTPUT_UNITS", "UQResult", "parse_uncertain", "run_uq",
            "evaluate_samples", "uq_chunk"]
@@ -75,7 +80,6 @@ OUTPUT_UNITS = {
 
 # ---- scene ----------------------------------------------------------------------------------
 def _quantity(name, key, v):
-    from ipmc_asym.base.units import parse_length, parse_pressure, parse_voltage
 
     where = f"uncertain.{name}.{key}"
     if isinstance(v, bool) or not isinstance(v, (int, float, str)):
@@ -260,7 +264,6 @@ class UQResult:
 
 
 def _scene_parts(scene):
-    from ipmc_asym.studies.scene_schema import load_scene, parse_scene
 
     if not isinstance(scene, dict):
         scene = load_scene(scene)
@@ -417,14 +420,12 @@ def run_uq(scene, samples: int = 10**6, *, seed: int = 0, fidelity: str | None =
     for k in ("length", "width", "thickness", "modulus", "c_moy"):
         if np.any(cols[k] <= 0):
             raise ValueError(f"uq: sampled {k} <= 0 ({int(np.sum(cols[k] <= 0))} samples); narrow its distribution")
-    from ipmc_asym.parallel.executors import chunk_slices, run_chunks
 
     if chunk_rows is not None:
         slices = [slice(a, min(a + int(chunk_rows), n)) for a in range(0, n, int(chunk_rows))]
     elif scheduler is None:
         slices = [slice(a, min(a + CHUNK_ROWS, n)) for a in range(0, n, CHUNK_ROWS)]
     else:
-        import os
 
         slices = chunk_slices(n, _SECONDS_PER_SAMPLE.get(fidelity, 1e-6), os.cpu_count() or 1, max_items=2**20)
     tasks = [({k: cols[k][sl] for k in cols}, tuple(outputs), model, material, tol, fidelity) for sl in slices]
@@ -447,7 +448,6 @@ def run_uq(scene, samples: int = 10**6, *, seed: int = 0, fidelity: str | None =
             sob[o] = None
             continue
         sob[o] = _sobol_indices(y, names, base_n)
-    from ipmc_asym.model.permittivity import get_model
 
     return UQResult(summary=summary, sobol=sob, inputs=unc, samples={k: cols[k] for k in names}, outputs=outs,
                     n_samples=n, base_n=base_n, fidelity=counts, model=get_model(model).name, tolerance=tol,
