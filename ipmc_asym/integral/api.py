@@ -36,6 +36,7 @@ whose spec has ``any_thickness`` set.
 
 from __future__ import annotations
 
+import contextvars
 import math
 import warnings
 from dataclasses import dataclass
@@ -452,13 +453,31 @@ def validity_limit(fidelity: str) -> float:
     return min(VALIDITY_LIMIT, _FIDELITY_SPECS[fidelity].ceiling)
 
 
-#: interpret small inputs (see :func:`interpret_small`); off: always the compiled drivers
-_INTERPRET = [False]
+#: interpret small inputs (see :func:`interpret_small`); off: always the compiled drivers.
+#: A context variable: the switch holds in the context (thread, task) that set it.
+_INTERPRET = contextvars.ContextVar("ipmc_asym_interpret_small", default=False)
 
 
-def interpret_small(enabled: bool = True) -> None:
-    """Evaluate small inputs with the interpreted twins of the drivers (``_jit.interpreted``)
+class _Switch:
+    """What :func:`interpret_small` returns: ``with`` restores the previous setting on exit."""
+
+    def __init__(self, token):
+        self._token = token
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        _INTERPRET.reset(self._token)
+        return False
+
+
+def interpret_small(enabled: bool = True) -> _Switch:
+    """Evaluate small inputs with the interpreted twins of the drivers (``kernels.jit.interpreted``)
     as long as the compiled driver is not loaded in this process.
+
+    ``interpret_small()`` switches it on for the rest of the context (what the one-shot
+    ``ipmc-asym estimate`` does); ``with interpret_small(): ...`` only inside the block.
 
     For one-shot processes (``ipmc-asym estimate``): a few points cost ~30 us each
     interpreted, against ~0.5 s to load the compiled driver from the cache.  Same source,
@@ -466,13 +485,13 @@ def interpret_small(enabled: bool = True) -> None:
     where the interpreter would raise (an inf or NaN on the way), the compiled driver runs.
     "Small" is ``points x registry interpreted_s <= settings.INTERPRET_BUDGET_S``.
     """
-    _INTERPRET[0] = bool(enabled)
+    return _Switch(_INTERPRET.set(bool(enabled)))
 
 
 def _run_driver(driver, n: int, fidelity: str, args):
     """``driver(*args)``, or its interpreted twin where :func:`interpret_small` says so."""
     cost = _FIDELITY_SPECS[fidelity].interpreted_s
-    if _INTERPRET[0] and not driver.signatures and 0.0 < n * cost <= INTERPRET_BUDGET_S:
+    if _INTERPRET.get() and not driver.signatures and 0.0 < n * cost <= INTERPRET_BUDGET_S:
         try:
             with np.errstate(all="raise", under="ignore"):  # underflow: the same 0 compiled
                 return interpreted(driver)(*args)

@@ -113,7 +113,7 @@ def test_interpret_small_respects_the_budget(monkeypatch):
     compiled driver is not loaded yet; never for a rung without an interpreted cost."""
     used = []
     monkeypatch.setattr(integral, "interpreted", lambda f: (lambda *a: used.append("twin")))
-    monkeypatch.setattr(integral, "_INTERPRET", [True])
+    switch = integral.interpret_small()
 
     class Driver:
         def __init__(self, signatures):
@@ -128,3 +128,9 @@ def test_interpret_small_respects_the_budget(monkeypatch):
     integral._run_driver(Driver(["loaded"]), 1, "leading", ())
     integral._run_driver(Driver([]), 1, "bvp", ())
     assert used == ["twin", "compiled", "compiled", "compiled"]
+    switch.__exit__(None, None, None)
+    integral._run_driver(Driver([]), 1, "leading", ())  # switched off again: compiled
+    with integral.interpret_small():
+        integral._run_driver(Driver([]), 1, "leading", ())
+    integral._run_driver(Driver([]), 1, "leading", ())
+    assert used[4:] == ["compiled", "twin", "compiled"]
