@@ -10,7 +10,8 @@ import re
 
 import numpy as np
 
-__all__ = ["parse_length", "parse_voltage", "parse_pressure", "parse_quantity", "fmt_length", "SWEEP_VARIABLES",
+__all__ = ["parse_length", "parse_voltage", "parse_pressure", "parse_force", "parse_time", "parse_diffusion",
+           "parse_quantity", "fmt_length", "SWEEP_VARIABLES",
            "parse_vary_spec", "parse_vary", "vary_values"]
 
 _LENGTH = {
@@ -19,6 +20,10 @@ _LENGTH = {
 }
 _VOLT = {"v": 1.0, "mv": 1e-3, "kv": 1e3, "uv": 1e-6, "µv": 1e-6}
 _PRESSURE = {"pa": 1.0, "kpa": 1e3, "mpa": 1e6, "gpa": 1e9}
+_FORCE = {"N": 1.0, "mN": 1e-3, "uN": 1e-6, "µN": 1e-6, "μN": 1e-6, "kN": 1e3}
+_TIME = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6, "μs": 1e-6, "min": 60.0, "h": 3600.0}
+_DIFFUSION = {"m2/s": 1.0, "m^2/s": 1.0, "cm2/s": 1e-4, "cm^2/s": 1e-4, "mm2/s": 1e-6, "mm^2/s": 1e-6,
+              "um2/s": 1e-12, "µm2/s": 1e-12, "um^2/s": 1e-12, "µm^2/s": 1e-12}
 
 _NUM = re.compile(r"^\s*([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)\s*([^\s\d].*?)?\s*$")
 
@@ -62,6 +67,21 @@ def parse_voltage(name: str, text) -> float:
 def parse_pressure(name: str, text) -> float:
     """``'130MPa'``, ``'1.3e8'`` -> pascals."""
     return parse_quantity(name, text, _PRESSURE, "pressure", case_sensitive=False)
+
+
+def parse_force(name: str, text) -> float:
+    """``'1.2mN'``, ``'5uN'``, ``'0.001'`` -> newtons."""
+    return parse_quantity(name, text, _FORCE, "force")
+
+
+def parse_time(name: str, text) -> float:
+    """``'20ms'``, ``'0.5s'``, ``'2min'``, ``'0.1'`` -> seconds."""
+    return parse_quantity(name, text, _TIME, "time")
+
+
+def parse_diffusion(name: str, text) -> float:
+    """``'1e-10m2/s'``, ``'1e-6 cm2/s'``, ``'1e-10'`` -> m^2/s."""
+    return parse_quantity(name, text, _DIFFUSION, "diffusion coefficient")
 
 
 def fmt_length(x: float) -> str:

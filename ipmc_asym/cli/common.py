@@ -11,12 +11,12 @@ import os
 import re
 import sys
 
-from ipmc_asym.base.units import parse_length, parse_pressure, parse_voltage
+from ipmc_asym.base.units import parse_diffusion, parse_length, parse_pressure, parse_voltage
 from ipmc_asym.model.params import Strip, material_from_spec
 
 __all__ = ["UsageError", "Parser", "add_strip_options", "material_from_args", "strip_from_args",
            "arg_type", "count_type", "join_negative_values", "fmt_num", "c_moy_label", "length_type", "pressure_type",
-           "voltage_type", "tol_type", "first_run_notice"]
+           "voltage_type", "tol_type", "first_run_notice", "diffusion_type"]
 
 
 class UsageError(Exception):
@@ -60,6 +60,10 @@ def length_type(name):
 
 def pressure_type(name):
     return _positive(name, parse_pressure, "130MPa")
+
+
+def diffusion_type(name="--diffusion"):
+    return _positive(name, parse_diffusion, "1e-10m2/s")
 
 
 def voltage_type(name="voltage"):

@@ -7,7 +7,7 @@ import numpy as np
 from ipmc_asym.base.registry import model_names
 from ipmc_asym.base.units import parse_quantity
 from ipmc_asym.cli import SUMMARIES
-from ipmc_asym.cli.common import add_strip_options, arg_type, count_type, material_from_args, strip_from_args
+from ipmc_asym.cli.common import add_strip_options, arg_type, count_type, diffusion_type, material_from_args, strip_from_args
 from ipmc_asym.dynamics.circuit import FREQ_METHODS, frequency_response
 from ipmc_asym.io.jsonio import dumps
 
@@ -31,7 +31,8 @@ def register(sub):
     p.add_argument("--model", default="constant", choices=list(model_names()), help="permittivity model")
     p.add_argument("--method", default="pnp-linear", choices=FREQ_METHODS,
                    help="pnp-linear (exact linearised PNP, closed form) or circuit (R + 1/(i w C_d))")
-    p.add_argument("--diffusion", type=float, default=None, help="cation diffusion coefficient D (m^2/s)")
+    p.add_argument("--diffusion", type=diffusion_type(), default=None,
+                   help="cation diffusion coefficient D (1e-10m2/s, 1e-6cm2/s; a bare number is m^2/s)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
 
 

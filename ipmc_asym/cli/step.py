@@ -8,12 +8,13 @@ import sys
 import numpy as np
 
 from ipmc_asym.base.registry import model_names
-from ipmc_asym.base.units import fmt_length, parse_quantity
+from ipmc_asym.base.units import fmt_length, parse_time
 from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import (
     add_strip_options,
     arg_type,
     count_type,
+    diffusion_type,
     first_run_notice,
     material_from_args,
     strip_from_args,
@@ -26,7 +27,7 @@ COLUMNS = ("t", "phi0", "sigma", "current_density", "M_A", "theta", "w")
 
 
 def _duration(text):
-    v = parse_quantity("--duration", text, {"s": 1.0, "ms": 1e-3, "us": 1e-6, "min": 60.0}, "time")
+    v = parse_time("--duration", text)
     if v <= 0:
         raise ValueError(f"--duration must be > 0 (e.g. 0.5s, 200ms); got {text!r}")
     return v
@@ -40,7 +41,8 @@ def register(sub):
     p.add_argument("--fidelity", default="circuit", choices=STEP_FIDELITIES,
                    help="circuit (reduced nonlinear capacitor) or pnp (transient Nernst-Planck/Gauss)")
     p.add_argument("--model", default="constant", choices=list(model_names()), help="permittivity model")
-    p.add_argument("--diffusion", type=float, default=None, help="cation diffusion coefficient D (m^2/s)")
+    p.add_argument("--diffusion", type=diffusion_type(), default=None,
+                   help="cation diffusion coefficient D (1e-10m2/s, 1e-6cm2/s; a bare number is m^2/s)")
     p.add_argument("--points", type=count_type("--points", 2), default=1000, help="output times (default 1000)")
     p.add_argument("--out", default=None, help="CSV file (columns t, phi0, sigma, current_density, M_A, theta, w)")
     p.add_argument("--json", action="store_true", help="print one JSON object")

@@ -52,7 +52,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ipmc_asym.base.registry import closed_form_fidelities, fidelity_names
-from ipmc_asym.base.units import parse_length, parse_pressure, parse_quantity, parse_voltage
+from ipmc_asym.base.units import parse_force, parse_length, parse_pressure, parse_voltage
 from ipmc_asym.beam.statics import blocking_force_ratio
 from ipmc_asym.model.params import NAFION_LI, Material, Strip
 from ipmc_asym.model.permittivity import Permittivity, get_model
@@ -79,7 +79,6 @@ FREE_PARAMETERS = {
 #: measured columns -> unit (magnitudes)
 MEASURED = {"deflection": "m", "blocking_force": "N"}
 GEOMETRY = ("length", "width", "thickness", "voltage")
-_FORCE = {"N": 1.0, "mN": 1e-3, "uN": 1e-6, "µN": 1e-6, "μN": 1e-6, "kN": 1e3}
 #: the fidelity ladder, cheapest first (the registry is the one list)
 LADDER = fidelity_names()
 #: starting value of a permittivity parameter whose nominal value is 0 (log parameters)
@@ -127,7 +126,7 @@ def _parse_cell(col, text):
     if col == "voltage":
         return parse_voltage(col, text)
     if col in ("blocking_force", "sigma_blocking_force"):
-        return parse_quantity(col, text, _FORCE, "force")
+        return parse_force(col, text)
     raise ValueError(f"column {col!r} not readable")  # pragma: no cover - filtered earlier
 
 

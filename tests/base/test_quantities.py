@@ -41,3 +41,21 @@ def test_unknown_name_lists_the_known_ones():
     with pytest.raises(ValueError, match="known: length"):
         quantity("deflection_of_the_moon")
     assert axis_label("tip_deflection", "mm") == "tip deflection w (large displacement) [mm]"
+
+
+@pytest.mark.parametrize("parse, text, si", [
+    ("parse_force", "1.2mN", 1.2e-3), ("parse_force", "5uN", 5e-6), ("parse_time", "20ms", 0.02),
+    ("parse_time", "2min", 120.0), ("parse_diffusion", "1e-10m2/s", 1e-10), ("parse_diffusion", "1e-6cm2/s", 1e-10),
+    ("parse_diffusion", "1e-10", 1e-10), ("parse_length", "200um", 2e-4), ("parse_voltage", "-500mV", -0.5),
+])
+def test_one_quantity_parser_for_every_unit(parse, text, si):
+    import ipmc_asym.base.units as units
+
+    assert getattr(units, parse)("x", text) == pytest.approx(si, rel=1e-15)
+
+
+def test_unknown_unit_names_the_parameter_and_the_allowed_units():
+    import ipmc_asym.base.units as units
+
+    with pytest.raises(ValueError, match=r"--diffusion: unknown unit 'parsec'.*allowed: m2/s"):
+        units.parse_diffusion("--diffusion", "5parsec")
