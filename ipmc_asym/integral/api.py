@@ -204,9 +204,9 @@ def _closed_post(lam, Ii, e_i, b1, c):
     """The closed forms' ``(I, error, B1, core)`` as :func:`_point` returns them."""
     # The kernel keeps ~20 lam of exponential tails in its core; the layer width the
     # quadrature measures (to |y| = 1) is the depletion width +- 0.5 lam (measured on
-    # 1 um - 10 mm x 0.1 mV - 20 V), so 2 - dep - lam is a conservative core and the
-    # core interaction 4 exp(-core/lam) below is no longer overstated by ~e^19
-    # (``corrected`` was flagged invalid at 10 um while accurate to ~1e-9).
+    # 1 um - 10 mm x 0.1 mV - 20 V), so 2 - dep - lam is a conservative core; the ~20 lam
+    # of tails would overstate the core interaction 4 exp(-core/lam) below by ~e^19
+    # (and flag ``corrected`` invalid at 10 um, where it is accurate to ~1e-9).
     c = c + 19.0 * lam
     e_i = max(e_i, ROUNDING_ERROR)
     # neglected core interaction: exponentially small in core/lambda
@@ -640,8 +640,7 @@ def moment_integral(thickness, voltage, model="constant", fidelity="quadrature",
     on_invalid : {"raise", "nan", "warn"}
         Where the fidelity is outside its validity (error estimate above ``VALIDITY_LIMIT``,
         overlapping layers, or a BVP that did not converge): a one-line ``ValueError``
-        (default), or NaN at those points (``"warn"``: NaN plus a ``RuntimeWarning``;
-        ``"ignore"``, kept from earlier versions, is the same as ``"nan"``).  A
+        (default), or NaN at those points (``"warn"``: NaN plus a ``RuntimeWarning``).  A
         number whose validity check failed is never returned; :func:`moment` gives the
         flags and estimates, and :func:`ipmc_asym.evaluate` escalates.
 
@@ -651,7 +650,7 @@ def moment_integral(thickness, voltage, model="constant", fidelity="quadrature",
         ``I`` with the broadcast shape of the inputs (a float for scalar inputs).
         ``M_A = A5 I`` with ``A5 = 6 l e^2 F |phi0| C_moy``.
     """
-    check_choice("on_invalid", on_invalid, ("raise", "nan", "warn", "ignore"))
+    check_choice("on_invalid", on_invalid, ("raise", "nan", "warn"))
     # scalar fast path: one compiled call, no arrays (falls through on anything unusual,
     # including an invalid point, which then gets the full treatment below)
     if (type(thickness) in _SCALAR_TYPES and type(voltage) in _SCALAR_TYPES and material is None

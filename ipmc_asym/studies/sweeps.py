@@ -33,7 +33,7 @@ import numpy as np
 
 from ipmc_asym.base.progress import progress as progress_bar
 from ipmc_asym.base.registry import model_names
-from ipmc_asym.base.settings import CHUNK_ROWS, MAX_ROWS, OUTSIDE_REGIMES
+from ipmc_asym.base.settings import CHUNK_ROWS, MAX_ROWS
 from ipmc_asym.base.units import SWEEP_VARIABLES as VARIABLES
 from ipmc_asym.base.units import parse_vary, parse_vary_spec, vary_values
 from ipmc_asym.forward.escalation import check_tol
@@ -47,7 +47,7 @@ from ipmc_asym.model.permittivity import get_model
 
 __all__ = ["VARIABLES", "DTYPE", "LABELS", "CHECK_COLS", "parse_vary", "parse_vary_spec", "vary_values", "sweep", "iter_sweep",
            "prefetched", "count_rows",
-           "withhold", "format_chunk", "warm_writer", "csv_header", "write_csv", "write_json", "rows_as_dicts"]
+           "withhold", "format_chunk", "warm_writer", "csv_header", "write_csv", "write_json"]
 
 
 _FLOAT_COLS = ("length", "width", "thickness", "voltage", "modulus", "I", "M_A", "theta", "w", "w_small",
@@ -61,7 +61,6 @@ DTYPE = np.dtype([(c, "f8") for c in _FLOAT_COLS[:5]] + [("model", "U8"), ("fide
 #: column labels of the output files (CSV header, JSON keys) where the field name alone is
 #: ambiguous: width and thickness are TOTAL (2l, 2e).  All columns are SI (m, V, Pa, N m, N, rad).
 LABELS = {"width": "width_total_2l", "thickness": "thickness_total_2e"}
-OUTSIDE = OUTSIDE_REGIMES
 #: the free-strip and mechanical outputs (forward.model) that are columns here (no tip position)
 _FREE = tuple(c for c in FREE_STRIP_KEYS if c in DTYPE.names)
 _MECH = tuple(c for c in MECHANICAL_KEYS if c in DTYPE.names)
@@ -298,25 +297,6 @@ def withhold(arr: np.ndarray, copy: bool = True) -> np.ndarray:
             for c in keys:
                 if c in out.dtype.names:
                     out[c][idx] = np.nan
-    return out
-
-
-def rows_as_dicts(arr: np.ndarray) -> list[dict]:
-    """JSON-ready rows (NaN -> None)."""
-    out = []
-    names = arr.dtype.names
-    for rec in arr:
-        d = {}
-        for k in names:
-            v = rec[k]
-            if isinstance(v, (np.floating, float)):
-                v = float(v)
-                d[k] = v if np.isfinite(v) else None
-            elif isinstance(v, (np.bool_, bool)):
-                d[k] = bool(v)
-            else:
-                d[k] = str(v)
-        out.append(d)
     return out
 
 

@@ -110,10 +110,10 @@ def test_estimate_interprets_a_few_points_and_loads_nothing_compiled():
 
 def test_interpret_small_respects_the_budget(monkeypatch):
     """Twins only while points x interpreted cost <= ``settings.INTERPRET_BUDGET_S`` and the
-    compiled driver is not loaded yet; never for a rung without an interpreted cost."""
+    compiled driver is not loaded yet; never for a rung without an interpreted cost; the
+    switch holds inside its ``with`` block only."""
     used = []
     monkeypatch.setattr(integral, "interpreted", lambda f: (lambda *a: used.append("twin")))
-    switch = integral.interpret_small()
 
     class Driver:
         def __init__(self, signatures):
@@ -123,14 +123,11 @@ def test_interpret_small_respects_the_budget(monkeypatch):
             used.append("compiled")
 
     n_ok = int(integral.INTERPRET_BUDGET_S / integral._FIDELITY_SPECS["leading"].interpreted_s)
-    integral._run_driver(Driver([]), n_ok, "leading", ())
-    integral._run_driver(Driver([]), n_ok + 1, "leading", ())
-    integral._run_driver(Driver(["loaded"]), 1, "leading", ())
-    integral._run_driver(Driver([]), 1, "bvp", ())
-    assert used == ["twin", "compiled", "compiled", "compiled"]
-    switch.__exit__(None, None, None)
-    integral._run_driver(Driver([]), 1, "leading", ())  # switched off again: compiled
-    with integral.interpret_small():
-        integral._run_driver(Driver([]), 1, "leading", ())
-    integral._run_driver(Driver([]), 1, "leading", ())
-    assert used[4:] == ["compiled", "twin", "compiled"]
+    with integral.interpret_small(False):  # whatever an earlier in-process command switched on
+        with integral.interpret_small():
+            integral._run_driver(Driver([]), n_ok, "leading", ())
+            integral._run_driver(Driver([]), n_ok + 1, "leading", ())
+            integral._run_driver(Driver(["loaded"]), 1, "leading", ())
+            integral._run_driver(Driver([]), 1, "bvp", ())
+        integral._run_driver(Driver([]), 1, "leading", ())  # outside the block: compiled
+    assert used == ["twin", "compiled", "compiled", "compiled", "compiled"]
