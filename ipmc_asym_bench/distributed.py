@@ -4,35 +4,19 @@ from __future__ import annotations
 
 import contextlib
 import math
-import os
 import time
 
 import numpy as np
 
-from ipmc_asym.parallel.executors import BLAS_ENV, warm_kernels, worker_setup
+from ipmc_asym.parallel.executors import warm_kernels, worker_env, worker_setup
 from ipmc_asym.studies.sweep_chunks import sweep_chunked
 from ipmc_asym.studies.sweeps import sweep
 
 __all__ = ["section", "WORKER_ENV"]
 
-#: environment of the worker processes: one BLAS and one Numba thread each
-WORKER_ENV = {**BLAS_ENV, "NUMBA_NUM_THREADS": "1"}
-
-
-@contextlib.contextmanager
-def environment(values):
-    """``values`` set in ``os.environ`` while the clusters run (their worker processes inherit
-    them: the thread counts must be set before a worker imports NumPy); restored after."""
-    old = {k: os.environ.get(k) for k in values}
-    os.environ.update(values)
-    try:
-        yield
-    finally:
-        for k, v in old.items():
-            if v is None:
-                os.environ.pop(k, None)
-            else:
-                os.environ[k] = v
+#: environment of the worker processes: one BLAS and one Numba thread each (the nannies
+#: start each worker with it)
+WORKER_ENV = worker_env(1)
 
 
 def section(quick: bool = False, shape: tuple | None = None, repeats: int | None = None) -> dict:
@@ -58,7 +42,6 @@ def section(quick: bool = False, shape: tuple | None = None, repeats: int | None
     env = dict(WORKER_ENV)
     warm_vary = {"thickness": vary["thickness"][:1], "voltage": vary["voltage"][:1]}
     with contextlib.ExitStack() as stack:
-        stack.enter_context(environment(env))
         clients = {}
         for nw in (1, 2):
             cl = stack.enter_context(distributed.LocalCluster(n_workers=nw, threads_per_worker=1, processes=True,

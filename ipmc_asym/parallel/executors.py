@@ -48,7 +48,7 @@ from ipmc_asym.integral.api import moment
 from ipmc_asym.integral.samples import moment_samples
 
 __all__ = ["run_chunks", "chunk_slices", "warm_kernels", "worker_setup", "BLAS_ENV", "MIN_CHUNK_SECONDS",
-           "check_scheduler"]
+           "check_scheduler", "worker_env"]
 
 #: environment of every worker process: one BLAS/OpenMP thread (the parallelism is the workers)
 BLAS_ENV = {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1",
@@ -178,7 +178,7 @@ def run_chunks(func, tasks, scheduler=None, workers: int | None = None, threads:
             return _on_pool(func, tasks, nw, threads, fidelities)
         # the nannies start each worker with this environment (the parent's is untouched)
         with distributed.LocalCluster(n_workers=nw, threads_per_worker=1, processes=True,
-                                      dashboard_address=":0", env=_worker_env(threads)) as cluster, \
+                                      dashboard_address=":0", env=worker_env(threads)) as cluster, \
                 distributed.Client(cluster) as client:
             return _on_client(client, func, tasks, threads, fidelities)
     try:
@@ -204,14 +204,15 @@ def _on_client(client, func, tasks, threads, fidelities):
 
 def _on_pool(func, tasks, nw, threads, fidelities):
 
-    with _env(_worker_env(threads)):  # spawned workers inherit this environment
+    with _env(worker_env(threads)):  # spawned workers inherit this environment
         ctx = mp.get_context("spawn")
         with ProcessPoolExecutor(max_workers=nw, mp_context=ctx, initializer=worker_setup,
                                  initargs=(threads, fidelities)) as ex:
             return list(ex.map(func, tasks))
 
 
-def _worker_env(threads):
+def worker_env(threads: int = 1) -> dict:
+    """Environment of a worker process: one BLAS thread, ``threads`` Numba threads."""
     return {**BLAS_ENV, "NUMBA_NUM_THREADS": str(max(1, int(threads)))}
 
 
