@@ -27,10 +27,12 @@ Only the public API of ``ipmc_asym`` is used.
 from __future__ import annotations
 
 import importlib
+import time
 
 import numba
 import numpy as np
 
+from ipmc_asym import moment_integral
 from ipmc_asym.base.registry import model_names
 from ipmc_asym.integral.api import moment
 from ipmc_asym_bench.kernels import bvp_sample, startup_time, time_driver
@@ -51,6 +53,8 @@ TARGETS = {
 }
 
 ERR_FLOOR = 1e-16  # relative errors below this are reported as this (log plots)
+#: the ``exact`` rung (~15 us a point) is timed through the API on this many points of the grid
+EXACT_POINTS = 20_000
 
 
 def sample_points(n: int, seed: int = 0, layout: str = "random"):
@@ -197,6 +201,7 @@ def run_bench(points: int = 10**6, bvp_points: int = 5, repeats: int = 3, seed: 
                 "pass_time": bool(s1 <= tgt["seconds_per_point"]),
                 "pass_speedup": None if speed is None else bool(speed >= tgt["speedup_vs_bvp"]),
             })
+        rows.append(_exact_row(model, th, v, sub_th, sub_v, bI, t_bvp, repeats))
     checks = [r[k] for r in rows for k in ("pass_time", "pass_speedup") if r[k] is not None]
     extra = run_sections(sections, quick_sections)
     checks += [f["pass"] for sec in extra.values() for f in sec.get("figures", []) if f.get("pass") is not None]
@@ -207,6 +212,37 @@ def run_bench(points: int = 10**6, bvp_points: int = 5, repeats: int = 3, seed: 
         "targets": TARGETS, "compile": comp, "startup": startup, "results": rows, "sections": extra,
         "all_pass": bool(all(checks) and (startup is None or startup["pass"])),
     }
+
+
+def _exact_row(model, th, v, sub_th, sub_v, bI, t_bvp, repeats) -> dict:
+    """The ``exact`` rung's row: the public API on :data:`EXACT_POINTS` points of the same grid
+    (single-threaded, best of ``repeats``), its error against the BVP sample."""
+    step = max(1, th.size // EXACT_POINTS)
+    te, ve = th[::step], v[::step]
+    old = numba.get_num_threads()
+    numba.set_num_threads(1)
+    try:
+        moment_integral(te[:2], ve[:2], model, "exact")  # warm-up (compile or load from cache)
+        best = np.inf
+        for _ in range(max(1, repeats)):
+            t0 = time.perf_counter()
+            out = moment_integral(te, ve, model, "exact", on_invalid="nan")
+            best = min(best, time.perf_counter() - t0)
+    finally:
+        numba.set_num_threads(old)
+    s1 = best / te.size
+    if bI.size:
+        r = moment(sub_th, sub_v, model, "exact")
+        rel = np.maximum(np.abs(r.I - bI) / np.abs(bI), ERR_FLOOR)
+        emax, emed, est = float(rel.max()), float(np.median(rel)), float(np.max(r.error))
+    else:
+        emax = emed = est = None
+    return {"model": model, "fidelity": "exact", "seconds_per_point_serial": s1,
+            "seconds_per_point_parallel": None, "nonfinite": int(np.count_nonzero(~np.isfinite(out))),
+            "bvp_sample": int(bI.size), "rel_error_max": emax, "rel_error_median": emed,
+            "error_estimate_max": est, "speedup_vs_bvp": (t_bvp / s1) if t_bvp else None,
+            "target_seconds_per_point": None, "target_speedup": None, "pass_time": None,
+            "pass_speedup": None, "note": f"timed through moment_integral on {te.size} points"}
 
 
 def quick_bench(points: int = 10**5, bvp_points: int = 3) -> dict:

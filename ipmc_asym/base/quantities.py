@@ -41,6 +41,8 @@ QUANTITIES = (
     Quantity("voltage", "V", "voltage phi0 (sign = bending direction)"),
     Quantity("modulus", "Pa", "Young's modulus E"),
     Quantity("c_moy", "mol/m^3", "mean cation concentration C_moy"),
+    Quantity("eps0", "F/m", "permittivity eps0 of the cation-free polymer (eq. 16)"),
+    Quantity("deps", "F/m", "permittivity increase eps_moy - eps0 (eq. 16)"),
     # outputs (paper eqs (6), (12)-(15), (27))
     Quantity("I", "1", "moment integral I (dimensionless)", scene_name="I"),
     Quantity("M_A", "N m", "bending moment M_A", scene_name="moment"),

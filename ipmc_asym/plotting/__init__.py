@@ -12,10 +12,26 @@ import os
 
 from ipmc_asym.io.fileio import atomic_path
 
-__all__ = ["pyplot", "savefig", "MODEL_COLOURS"]
+__all__ = ["pyplot", "savefig", "MODEL_COLOURS", "MODEL_LINES", "MODEL_MARKERS", "model_style"]
 
 #: one colour per permittivity model, in every figure
 MODEL_COLOURS = {"constant": "C0", "linear": "C1", "affine": "C2"}
+#: ... and one line style and one marker, so that the models stay apart in black-and-white print
+MODEL_LINES = {"constant": "-", "linear": "--", "affine": "-."}
+MODEL_MARKERS = {"constant": "o", "linear": "s", "affine": "^"}
+
+
+def model_style(model: str, *, line: bool = True, marker: bool = False, markevery=None) -> dict:
+    """Matplotlib keywords of ``model``'s curves: its colour, and its line style and/or marker.
+
+    ``line=False`` keeps a solid line (where the line style carries another meaning, e.g.
+    small vs large displacement); ``marker=True`` adds the model's hollow marker every
+    ``markevery`` points.
+    """
+    kw = {"color": MODEL_COLOURS.get(model, "k"), "ls": MODEL_LINES.get(model, "-") if line else "-"}
+    if marker:
+        kw.update(marker=MODEL_MARKERS.get(model, "o"), markevery=markevery, ms=4.5, mfc="white", mew=1.0)
+    return kw
 
 
 class _Figures:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ipmc_asym.base.quantities import unit_and_long_name
 from ipmc_asym.plotting import pyplot, savefig
 
 __all__ = ["plot_fit"]
@@ -11,7 +12,19 @@ __all__ = ["plot_fit"]
 #: geometry column -> (display scale, unit, label)
 _AXIS = {"voltage": (1.0, "V", "voltage φ0"), "thickness": (1e6, "µm", "total thickness 2e"),
          "length": (1e3, "mm", "length L"), "width": (1e3, "mm", "total width 2l")}
+#: SI unit -> (display scale, display unit) of the fitted parameters in the title
+_DISPLAY = {"Pa": (1e-6, "MPa"), "mol/m^3": (1.0, "mol/m³"), "F/m": (1.0, "F/m")}
 _LABEL = {"deflection": ("tip deflection |w| [mm]", 1e3), "blocking_force": ("blocking force |F| [mN]", 1e3)}
+
+
+def _parameter_text(name, p) -> str:
+    """``modulus = 130 MPa ± 2.1 MPa``: the value with its unit from the output vocabulary."""
+    unit = unit_and_long_name(name)[0]
+    scale, shown = _DISPLAY.get(unit, (1.0, unit))
+    txt = f"{name} = {p['value'] * scale:.4g} {shown}".rstrip()
+    if p.get("stderr") is not None and p.get("identifiable"):
+        return txt + f" ± {p['stderr'] * scale:.2g} {shown}".rstrip()
+    return txt + ("" if p.get("identifiable") else " (not identifiable)")
 
 
 def plot_fit(result, path) -> str:
@@ -60,9 +73,7 @@ def plot_fit(result, path) -> str:
         axr.axhline(0, color="k", lw=0.8)
         axr.set_ylabel("(data − fit)/σ" if sig is not None else "(data − fit)/data")
         axr.set_xlabel(f"{xl} [{xu}]")
-    pars = ", ".join(
-        f"{n} = {p['value']:.4g}" + (f" ± {p['stderr']:.2g}" if p["identifiable"] else " (not identifiable)")
-        for n, p in result.parameters.items())
+    pars = ", ".join(_parameter_text(n, p) for n, p in result.parameters.items())
     fig.suptitle(f"fit [{result.model}, {result.fidelity}]: {pars}; χ²_red = {result.chi2_red:.3g}", fontsize=10)
     fig.tight_layout()
     return savefig(fig, path, dpi=120)

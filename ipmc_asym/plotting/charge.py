@@ -7,7 +7,7 @@ import numpy as np
 from ipmc_asym.dynamics.circuit import frequency_response, step_response, time_constant
 from ipmc_asym.dynamics.electrode import charge
 from ipmc_asym.model.params import NAFION_LI, Strip
-from ipmc_asym.plotting import MODEL_COLOURS, pyplot, savefig
+from ipmc_asym.plotting import MODEL_COLOURS, MODEL_MARKERS, model_style, pyplot, savefig
 
 __all__ = ["plot_charge_capacitance", "plot_step", "plot_bode"]
 
@@ -24,17 +24,17 @@ def plot_charge_capacitance(path, strip: Strip | None = None, material=NAFION_LI
     for m in MODELS3:
         r = charge(s.thickness, v, m, "corrected", material=material)
         c = MODEL_COLOURS[m]
-        a1.plot(v, r.sigma, color=c, label=m)
-        a2.semilogy(v, r.C_diff, color=c, label=m)
+        a1.plot(v, r.sigma, label=m, **model_style(m))
+        a2.semilogy(v, r.C_diff, label=m, **model_style(m))
         rb = charge(s.thickness, vb, m, "bvp", material=material)
-        a1.plot(vb, rb.sigma, "o", color=c, mfc="none")
+        a1.plot(vb, rb.sigma, MODEL_MARKERS[m], color=c, mfc="none")
         ok = rb.valid
-        a2.semilogy(vb[ok], rb.C_diff[ok], "o", color=c, mfc="none")
-    a1.set_xlabel("phi0 [V]")
-    a1.set_ylabel("sigma [C/m^2] (face z = -e)")
-    a1.set_title(f"electrode charge (2e = {s.thickness * 1e6:.0f} um); o = BVP")
-    a2.set_xlabel("phi0 [V]")
-    a2.set_ylabel("C_d = dsigma/dphi0 [F/m^2]")
+        a2.semilogy(vb[ok], rb.C_diff[ok], MODEL_MARKERS[m], color=c, mfc="none")
+    a1.set_xlabel("φ0 [V]")
+    a1.set_ylabel("σ [C/m²] (face z = −e)")
+    a1.set_title(f"electrode charge (total 2e = {s.thickness * 1e6:.0f} µm); o = BVP")
+    a2.set_xlabel("φ0 [V]")
+    a2.set_ylabel("C_d = dσ/dφ0 [F/m²]")
     a2.set_title("differential capacitance (analytic); o = BVP difference")
     a2.set_ylim(1e-3, 3e3)
     for a in (a1, a2):
@@ -54,14 +54,14 @@ def plot_step(path, voltage=1.0, strip: Strip | None = None, material=NAFION_LI)
         tm = float(time_constant(s.thickness, m, material))
         rc = step_response(voltage, 6 * tm, strip=s, model=m, material=material, points=600)
         rp = step_response(voltage, 6 * tm, strip=s, model=m, material=material, fidelity="pnp", points=31)
-        a1.plot(rc.t / tm, rc.sigma, color=c, label=f"{m}: circuit (tau = {tm:.3g} s)")
-        a1.plot(rp.t / tm, rp.sigma, "o", color=c, mfc="none", label=f"{m}: PNP")
-        a2.plot(rc.t / tm, rc.w * 1e3, color=c, label=f"{m}: circuit")
-        a2.plot(rp.t / tm, rp.w * 1e3, "o", color=c, mfc="none", label=f"{m}: PNP")
-    a1.set_xlabel("t / tau")
-    a1.set_ylabel("sigma [C/m^2]")
-    a1.set_title(f"{voltage:g} V step, 2e = {s.thickness * 1e6:.0f} um, D = {material.D:.2g} m^2/s")
-    a2.set_xlabel("t / tau")
+        a1.plot(rc.t / tm, rc.sigma, label=f"{m}: circuit (τ = {tm:.3g} s)", **model_style(m))
+        a1.plot(rp.t / tm, rp.sigma, MODEL_MARKERS[m], color=c, mfc="none", label=f"{m}: PNP")
+        a2.plot(rc.t / tm, rc.w * 1e3, label=f"{m}: circuit", **model_style(m))
+        a2.plot(rp.t / tm, rp.w * 1e3, MODEL_MARKERS[m], color=c, mfc="none", label=f"{m}: PNP")
+    a1.set_xlabel("t / τ")
+    a1.set_ylabel("σ [C/m²]")
+    a1.set_title(f"{voltage:g} V step, total 2e = {s.thickness * 1e6:.0f} µm, D = {material.D:.2g} m²/s")
+    a2.set_xlabel("t / τ")
     a2.set_ylabel("tip deflection w [mm] (quasi-static, no inertia)")
     a2.set_title("w from the layers' charge; no water transport")
     for a in (a1, a2):
@@ -84,10 +84,12 @@ def plot_bode(path, strip: Strip | None = None, material=NAFION_LI) -> str:
         for meth, ls in (("pnp-linear", "-"), ("circuit", "--")):
             r = frequency_response(f, strip=s, model=m, material=material, method=meth)
             lab = f"{m}, {meth}"
-            ax[0, 0].loglog(f, np.abs(r.Z), ls, color=c, label=lab)
-            ax[1, 0].semilogx(f, np.degrees(np.angle(r.Z)), ls, color=c, label=lab)
-            ax[0, 1].loglog(f, r.w_amp * 1e3, ls, color=c, label=lab)
-            ax[1, 1].semilogx(f, np.degrees(r.w_phase), ls, color=c, label=lab)
+            # line style = method, marker = model (black-and-white print)
+            mk = {"color": c, "marker": MODEL_MARKERS[m], "markevery": 30, "ms": 4, "mfc": "white"}
+            ax[0, 0].loglog(f, np.abs(r.Z), ls, label=lab, **mk)
+            ax[1, 0].semilogx(f, np.degrees(np.angle(r.Z)), ls, label=lab, **mk)
+            ax[0, 1].loglog(f, r.w_amp * 1e3, ls, label=lab, **mk)
+            ax[1, 1].semilogx(f, np.degrees(r.w_phase), ls, label=lab, **mk)
     ax[0, 0].set_ylabel("|Z| [Ohm] (electrode area 2l L)")
     ax[1, 0].set_ylabel("arg Z [deg]")
     ax[0, 1].set_ylabel("|w| / V [mm/V]")

@@ -20,7 +20,7 @@ import numpy as np
 from ipmc_asym.base.registry import model_names
 from ipmc_asym.base.settings import OUTSIDE_REGIMES
 from ipmc_asym.model.params import NAFION_LI, Material, Strip
-from ipmc_asym.plotting import MODEL_COLOURS, pyplot, savefig
+from ipmc_asym.plotting import MODEL_COLOURS, model_style, pyplot, savefig
 from ipmc_asym.plotting.profiles import write_all
 from ipmc_asym.plotting.speed import plot_speed_accuracy
 from ipmc_asym.studies.profiles import compute_all
@@ -29,84 +29,112 @@ from ipmc_asym.studies.sweeps import sweep
 __all__ = ["influence_figure", "make_all", "INFLUENCE"]
 
 MODELS3 = model_names()
-_COL = MODEL_COLOURS
 
 #: variable -> (values SI, axis scale to display, axis label, file stem, paper fig)
 INFLUENCE = {
     "length": (np.linspace(0.005, 0.04, 36), 1e2, "length L (cm)", "influence_length", 8),
     "thickness": (np.linspace(50e-6, 400e-6, 36), 1e6, "TOTAL thickness 2e (µm)", "influence_thickness", 9),
-    # log-spaced: I(phi0) changes regime around 0.1 V (Debye-Hueckel -> layers); a linear
-    # 0.05 V step drew kinks there
-    "voltage": (np.geomspace(0.01, 3.0, 90), 1.0, r"voltage $\varphi_0$ (V)", "influence_voltage", 10),
+    # dense at small voltage as well: I(phi0) changes regime around 0.1 V (Debye-Hueckel ->
+    # layers); drawn on a linear axis as the paper (whose "approximately linear" is read
+    # there) and on a log axis below it
+    "voltage": (np.unique(np.concatenate([np.geomspace(0.01, 3.0, 60), np.linspace(0.05, 3.0, 60)])), 1.0,
+                r"voltage $\varphi_0$ (V)", "influence_voltage", 10),
     "width": (np.linspace(1e-3, 10e-3, 19), 1e3, "TOTAL width 2l (mm)", "influence_width", None),
 }
+
+#: the three panels: (row key, small-displacement key, display factor, axis label, title)
+_PANELS = (("w", "w_small", 1e3, "tip deflection |w| (mm)", "(a) deflection"),
+           ("F_block", None, 1e3, r"blocking force $|F^p|$ (mN)", "(b) blocking force"),
+           ("theta", None, 1.0, r"rotation $|\theta|$ (rad)", "(c) rotation"))
+
+
+def _si(value: float, unit: str) -> str:
+    """``130 MPa`` rather than ``1.3e+08 Pa`` in a title."""
+    for f, p in ((1e9, "G"), (1e6, "M"), (1e3, "k"), (1.0, "")):
+        if abs(value) >= f:
+            return f"{value / f:.4g} {p}{unit}"
+    return f"{value:.4g} {unit}"
 
 
 def influence_figure(var, path, base: Strip | None = None, material: Material = NAFION_LI, dpi=110,
                      values=None):
-    """Three panels (|w|, F^p, |theta|) vs ``var`` for the three models (quadrature fidelity)."""
+    """|w|, |F^p|, |theta| against ``var`` for the three models (quadrature fidelity, escalated).
+
+    Each model has its colour and marker.  Solid: every check of the forward model holds;
+    dotted: the number is kept but a model assumption fails (the free strip past a quarter
+    turn for ``w`` and ``theta``, the face strain above the material's limit for all three);
+    dashed (panel a): the small-displacement deflection, eq. (13).  A thin vertical dotted
+    line marks where a model's free strip reaches a quarter turn.  The voltage figure has a
+    second row with a log voltage axis.
+    """
     plt = pyplot()
+    from matplotlib.lines import Line2D  # deferred: matplotlib is heavy and only figures need it
+
     vals, sc, xlabel, _stem, fig_no = INFLUENCE[var]
     vals = vals if values is None else np.asarray(values, float)
     base = Strip() if base is None else base
     arr = sweep({var: vals}, list(MODELS3), "quadrature", base, material)
-    fig, axs = plt.subplots(1, 3, figsize=(13, 4.0), dpi=dpi)
-    handles = []
+    rows = 2 if var == "voltage" else 1
+    fig, axs = plt.subplots(rows, 3, figsize=(13, 3.6 * rows + 0.6), dpi=dpi, squeeze=False)
     ymax = [0.0, 0.0, 0.0]
+    every = max(1, len(vals) // 8)
     for m in MODELS3:
         a = arr[arr["model"] == m]
+        order = np.argsort(a[var])
+        a = a[order]
         x = a[var] * sc
-        # outside the beam model: past a quarter turn, or strain above settings.STRAIN_LIMIT
-        out = ~(a["check_beam_regime"] & a["check_strain"]) | np.isin(a["regime"], OUTSIDE_REGIMES)
-        inside = ~out
-        for k, (ax, q, qs, fac) in enumerate(((axs[0], "w", "w_small", 1e3),
-                                              (axs[1], "F_block", "F_block_small", 1e3),
-                                              (axs[2], "theta", None, 1.0))):
+        strain_ok = a["check_strain"].astype(bool)
+        free_ok = a["check_beam_regime"].astype(bool) & ~np.isin(a["regime"], OUTSIDE_REGIMES)
+        for k, (q, qs, fac, _lab, _t) in enumerate(_PANELS):
             y = np.abs(a[q]) * fac
-            yi = np.where(inside, y, np.nan)
-            (h,) = ax.plot(x, yi, "-", color=_COL[m], label=f"{m}")
-            if k == 0:
-                handles.append(h)
-            if np.any(np.isfinite(yi)):
-                ymax[k] = max(ymax[k], float(np.nanmax(yi)))
-            if out.any():
-                # beyond the quarter turn: marked dotted, up to the first point past it only
-                edge = out & (np.roll(inside, 1) | np.roll(inside, -1))
-                yo = np.where(edge | (inside & np.roll(out, -1)) | (inside & np.roll(out, 1)), y, np.nan)
-                ax.plot(x, yo, ":", color=_COL[m], alpha=0.8)
-                if k == 0 and inside.any() and out.any():
-                    xq = x[np.flatnonzero(out)[0]] if out[-1] else x[np.flatnonzero(out)[-1]]
-                    ax.axvline(xq, color=_COL[m], lw=0.6, ls=":", alpha=0.6)
-            if qs is not None and q == "w":
-                # small-displacement formula: only where the strip is inside the model
-                ax.plot(x, np.where(inside, np.abs(a[qs]) * fac, np.nan), "--", color=_COL[m], lw=0.8, alpha=0.6)
-    for k, ax in enumerate(axs):
-        if ymax[k] > 0:
-            ax.set_ylim(0.0, 1.15 * ymax[k] if k < 2 else max(1.15 * ymax[k], 1.7))
-    axs[0].set_ylabel("tip deflection |w| (mm)")
-    axs[0].set_title("(a) deflection (dashed: small displ.; dotted: outside the model)", fontsize=9)
-    axs[1].set_ylabel(r"blocking force $F^p$ (mN)")
-    axs[1].set_title("(b) blocking force (large displacements)", fontsize=9)
-    axs[2].set_ylabel(r"rotation $|\theta|$ (rad)")
-    axs[2].axhline(np.pi / 2, color="k", lw=0.6, ls="--")
-    axs[2].set_title(r"(c) rotation ($\pi/2$ dashed: quarter turn)", fontsize=9)
-    for ax in axs:
-        ax.set_xlabel(xlabel)
-        ax.grid(True, alpha=0.3)
+            ok = strain_ok & (free_ok if q != "F_block" else True)
+            # the dotted part joins the solid one: it starts at the last point inside
+            edge = ok & (np.roll(~ok, 1) | np.roll(~ok, -1))
+            for ax in axs[:, k]:
+                ax.plot(x, np.where(ok, y, np.nan), **model_style(m, line=False, marker=True, markevery=every))
+                if (~ok).any():
+                    ax.plot(x, np.where(~ok | edge, y, np.nan), ":", color=MODEL_COLOURS[m], lw=1.3)
+                if qs is not None:
+                    ax.plot(x, np.where(ok, np.abs(a[qs]) * fac, np.nan), "--", color=MODEL_COLOURS[m],
+                            lw=0.8, alpha=0.7)
+                if k == 0 and free_ok.any() and (~free_ok).any():
+                    cross = np.flatnonzero(np.diff(free_ok.astype(int)))
+                    for c in cross:
+                        ax.axvline(x[c + 1], color=MODEL_COLOURS[m], lw=0.7, ls=":", alpha=0.8)
+            if np.any(ok & np.isfinite(y)):
+                ymax[k] = max(ymax[k], float(np.nanmax(np.where(ok, y, np.nan))))
+    for r in range(rows):
+        for k, (_q, _qs, _f, lab, title) in enumerate(_PANELS):
+            ax = axs[r, k]
+            ax.set_ylabel(lab)
+            ax.set_xlabel(xlabel + (", log axis" if r == 1 else ""))
+            ax.grid(True, alpha=0.3)
+            if r == 0:
+                ax.set_title(title, fontsize=9)
+            if ymax[k] > 0:
+                ax.set_ylim(0.0, 1.15 * ymax[k] if k < 2 else max(1.15 * ymax[k], 1.7))
+        axs[r, 2].axhline(np.pi / 2, color="k", lw=0.6, ls="--")
     if var == "voltage":
-        for ax in axs:
+        for ax in axs[0]:
+            ax.set_xlim(0.0, None)
+        for ax in axs[1]:
             ax.set_xscale("log")
-    # one legend for the figure, below the panels: never on a curve or the pi/2 line
-    fig.legend(handles, [h.get_label() for h in handles], loc="lower center", ncol=3, fontsize=8,
-               frameon=False)
-    fixed = {k: v for k, v in (("L", f"{base.length * 100:g} cm"), ("2l", f"{base.width * 1e3:g} mm"),
-                                ("2e", f"{base.thickness * 1e6:g} µm"), ("phi0", f"{base.voltage:g} V"))}
-    var_key = {"length": "L", "width": "2l", "thickness": "2e", "voltage": "phi0"}[var]
-    fixed.pop(var_key)
+    handles = [Line2D([], [], label=m, **model_style(m, line=False, marker=True)) for m in MODELS3]
+    handles += [Line2D([], [], color="0.35", ls="--", lw=0.8, label="small displacement, eq. (13)"),
+                Line2D([], [], color="0.35", ls=":", lw=1.3,
+                       label="outside the model: past a quarter turn (w, θ) or strain above the limit"),
+                Line2D([], [], color="0.35", ls=":", lw=0.7, marker="|", ms=10,
+                       label="free strip reaches a quarter turn"),
+                Line2D([], [], color="k", ls="--", lw=0.6, label="θ = π/2")]
+    # one legend for the figure, below the panels: never on a curve
+    fig.legend(handles=handles, loc="lower center", ncol=4, fontsize=8, frameon=False)
+    fixed = {"L": f"{base.length * 100:g} cm", "2l": f"{base.width * 1e3:g} mm",
+             "2e": f"{base.thickness * 1e6:g} µm", "φ0": f"{base.voltage:g} V"}
+    fixed.pop({"length": "L", "width": "2l", "thickness": "2e", "voltage": "φ0"}[var])
     t = f"Influence of {var}" + (f" (paper Fig. {fig_no})" if fig_no else "") + "; fixed " + \
-        ", ".join(f"{k}={v}" for k, v in fixed.items()) + f", E={material.E:.3g} Pa"
+        ", ".join(f"{k} = {v}" for k, v in fixed.items()) + f", E = {_si(material.E, 'Pa')}"
     fig.suptitle(t, fontsize=10)
-    fig.tight_layout(rect=(0, 0.06, 1, 1))
+    fig.tight_layout(rect=(0, 0.1 / rows, 1, 1))
     return savefig(fig, path)
 
 

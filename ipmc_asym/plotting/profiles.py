@@ -8,51 +8,95 @@ import numpy as np
 
 from ipmc_asym.base.registry import model_names
 from ipmc_asym.model.params import NAFION_LI, Material, Strip
-from ipmc_asym.plotting import MODEL_COLOURS, pyplot, savefig
+from ipmc_asym.plotting import model_style, pyplot, savefig
 from ipmc_asym.studies.profiles import QUANTITIES, compute_all, profile_summary, write_csv
 
 __all__ = ["plot_profiles", "write_all"]
 
-def plot_profiles(results: dict, quantity: str, path, e: float, dpi: int = 110, title: str | None = None):
-    """Full-width panel + zooms at the anode and the cathode (log distance from the face, µm).
+#: the full-thickness panel's stretch: distances from a face below this (in units of e) get
+#: about as much room as each decade above it (asinh scale), so the layers at the faces, some
+#: 1e-4 e thick or less, are seen next to the neutral core instead of as spikes at z = +-1
+STRETCH_D0 = 1e-4
+#: left edge of the zoom panels (distance from the face, µm)
+ZOOM_MIN_UM = 1e-4
 
-    ``results``: model name -> BVPResult; ``e`` HALF thickness (m).
+
+def _stretch(z):
+    z = np.asarray(z, float)
+    d = np.clip(1.0 - np.abs(z), 0.0, 1.0)
+    return np.sign(z) * (1.0 - np.arcsinh(d / STRETCH_D0) / np.arcsinh(1.0 / STRETCH_D0))
+
+
+def _unstretch(x):
+    x = np.asarray(x, float)
+    s = np.clip(1.0 - np.abs(x), 0.0, 1.0)
+    return np.sign(x) * (1.0 - STRETCH_D0 * np.sinh(s * np.arcsinh(1.0 / STRETCH_D0)))
+
+
+def _zoom_curve(dist, f, grid):
+    """The profile against the distance from a face, on the zoom's log axis.
+
+    The BVP meshes differ per model: where a model's first node off the face lies beyond the
+    axis' left edge, the curve is continued to that edge by linear interpolation in the
+    distance between the face value and that node (the profile is smooth there), so every
+    model's curve starts at the same offset.
+    """
+    o = np.argsort(dist)
+    dist, f = dist[o], f[o]
+    pos = dist > 0
+    first = dist[pos][0] if pos.any() else np.inf
+    extra = grid[grid < first]
+    x = np.concatenate([extra, dist[pos]])
+    return x, np.interp(x, dist, f)
+
+
+def plot_profiles(results: dict, quantity: str, path, e: float, dpi: int = 110, title: str | None = None):
+    """Full thickness (stretched near the faces) + zooms at the anode and the cathode.
+
+    ``results``: model name -> BVPResult; ``e`` HALF thickness (m).  The zooms plot against
+    the distance from the face in µm on a log axis, each with its own y-range.
     """
     plt = pyplot()
     attr, label = QUANTITIES[quantity]
-    fig, axs = plt.subplots(1, 3, figsize=(13, 4.0), dpi=dpi)
-    fmax = 0.0
+    fig, axs = plt.subplots(1, 3, figsize=(13, 4.2), dpi=dpi)
+    log_y = quantity == "E"
+    grid = np.geomspace(ZOOM_MIN_UM, e * 1e6, 400)
+    panel_max = [0.0, 0.0, 0.0]
     for name, res in results.items():
         z = np.asarray(res.z)
         f = np.asarray(getattr(res, attr))
-        if quantity == "E":
+        if log_y:
             # the linear model's field spikes to ~1e17 at the anode (eps -> 0 there): on a
             # linear axis it flattens every other curve, so |E| is drawn on a log axis
             f = np.where(np.abs(f) > 0, np.abs(f), np.nan)
-            fmax = max(fmax, float(np.nanmax(f)))
-        c = MODEL_COLOURS.get(name, None)
-        axs[0].plot(z, f, color=c, label=name)
-        da = (z + 1.0) * e * 1e6
-        m = (da > 0) & (z < 0)
-        axs[1].plot(da[m], f[m], color=c, label=name)
-        dc = (1.0 - z) * e * 1e6
-        m = (dc > 0) & (z > 0)
-        axs[2].plot(dc[m], f[m], color=c, label=name)
+        st = model_style(name)
+        axs[0].plot(z, f, label=name, **st)
+        panel_max[0] = max(panel_max[0], float(np.nanmax(f)))
+        for k, (side, dist) in enumerate((((z < 0), (z + 1.0) * e * 1e6), ((z > 0), (1.0 - z) * e * 1e6)), 1):
+            x, y = _zoom_curve(dist[side], f[side], grid)   # the face itself is at distance 0
+            keep = x >= ZOOM_MIN_UM
+            axs[k].plot(x[keep], y[keep], label=name, **st)
+            if np.any(np.isfinite(y[keep])):
+                panel_max[k] = max(panel_max[k], float(np.nanmax(y[keep])))
+    axs[0].set_xscale("function", functions=(_stretch, _unstretch))
+    ticks = [-1.0, -0.999, -0.99, -0.9, 0.0, 0.9, 0.99, 0.999, 1.0]
+    axs[0].set_xticks(ticks, [f"{t:g}" for t in ticks], fontsize=7)
+    axs[0].set_xlim(-1.0, 1.0)
     axs[0].set_xlabel(r"$\bar z = z/e$ ($e$ = HALF thickness = %.4g µm)" % (e * 1e6))
-    axs[0].set_title("full thickness (anode $\\bar z=-1$, cathode $+1$)", fontsize=9)
+    axs[0].set_title("full thickness, stretched near the faces (asinh scale)", fontsize=9)
     for ax, side in ((axs[1], "anode ($\\bar z=-1$)"), (axs[2], "cathode ($\\bar z=+1$)")):
         ax.set_xscale("log")
-        ax.set_xlim(1e-4, e * 1e6)
+        ax.set_xlim(ZOOM_MIN_UM, e * 1e6)
         ax.set_xlabel(f"distance from the {side.split(' ')[0]} face (µm, log)")
         ax.set_title(f"zoom at the {side}", fontsize=9)
     if quantity == "C":
         axs[2].set_yscale("log")
-    if quantity == "E":
-        for ax in axs:
+    if log_y:
+        for ax, top in zip(axs, panel_max):
             ax.set_yscale("log")
-            # the neutral core's field is exponentially small (down to 1e-300): show 12 decades
-            # below the smallest face value, where the layers are
-            ax.set_ylim(1e-6, 10.0 * fmax)
+            # the neutral core's field is exponentially small (down to 1e-300): each panel
+            # shows its own largest value down to 1e-6 (where the layers end)
+            ax.set_ylim(1e-6, 10.0 * top)
         label = f"|{label}| (log)"
     for ax in axs:
         ax.set_ylabel(label)

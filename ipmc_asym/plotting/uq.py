@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from ipmc_asym.base.quantities import axis_label
 from ipmc_asym.plotting import pyplot, savefig
 
 __all__ = ["plot_uq"]
@@ -20,6 +21,8 @@ def plot_uq(result, path) -> str:
     path : str   PNG path (written atomically)
     """
     plt = pyplot()
+    from matplotlib.ticker import MaxNLocator  # deferred: matplotlib is heavy and only figures need it
+
     outs = list(result.outputs)
     n = len(outs)
     cols = min(n, 3)
@@ -32,7 +35,9 @@ def plot_uq(result, path) -> str:
         ax.hist(y, bins=80, density=True, color="C0", alpha=0.75)
         for q in ("q2.5", "q50", "q97.5"):
             ax.axvline(s[q] * f, color="k", ls="--" if q != "q50" else "-", lw=0.9)
-        ax.set_xlabel(f"{o}" + (f" [{u}]" if u else " [-]"))
+        ax.set_xlabel(axis_label(o, u or "1"))
+        # at most four ticks: values such as 0.002345 overlap at matplotlib's default count
+        ax.xaxis.set_major_locator(MaxNLocator(4))
         ax.set_ylabel("density")
         sob = result.sobol.get(o)
         if sob:

@@ -25,10 +25,12 @@ def test_structure(res):
         assert k in res
     assert set(res["sections"]) == {"exact_api", "uq", "charge"}
     rows = {(r["model"], r["fidelity"]): r for r in res["results"]}
-    assert set(rows) == {(m, f) for m in MODELS for f in ("leading", "corrected", "quadrature", "bvp")}
+    assert set(rows) == {(m, f) for m in MODELS for f in ("leading", "corrected", "quadrature", "exact", "bvp")}
     for (m, f), r in rows.items():
         assert r["seconds_per_point_serial"] > 0
-        if f != "bvp":
+        if f == "exact":
+            assert r["nonfinite"] == 0 and r["bvp_sample"] >= 1
+        elif f != "bvp":
             assert r["seconds_per_point_parallel"] > 0
             assert r["nonfinite"] == 0
             assert isinstance(r["pass_time"], bool)
@@ -43,6 +45,8 @@ def test_error_ordering(res):
         assert quad < 1e-8 and corr < 1e-8
         assert lead < 0.1
         # the estimates bound the measured errors (x10 slack)
+        # exact: within its stated error of the BVP (both ~1e-12 here)
+        assert rows[(m, "exact")]["rel_error_max"] <= 10 * max(rows[(m, "exact")]["error_estimate_max"], 1e-12)
         for f in ("leading", "corrected", "quadrature"):
             assert rows[(m, f)]["rel_error_max"] <= 10 * max(rows[(m, f)]["error_estimate_max"], 1e-12)
 
