@@ -21,7 +21,21 @@ extensions = [
     "numpydoc",
     "sphinx.ext.mathjax",
     "sphinx_gallery.gen_gallery",
+    "myst_parser",
 ]
+# docs/design.md is a page of its own (Markdown read by MyST), not a source listing
+source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
+myst_heading_anchors = 3
+
+
+def setup(app):
+    # design.md's machine-readable blocks (```layers, ```studies: read by tests/test_layers.py)
+    # are plain text to the highlighter
+    from pygments.lexers.special import TextLexer
+    from sphinx.highlighting import lexers
+
+    for name in ("layers", "studies"):
+        lexers[name] = TextLexer()
 
 exclude_patterns = ["_build", "**.ipynb_checkpoints", "auto_examples/*.ipynb", "auto_examples/*.py",
                     "auto_examples/*.zip", "auto_examples/*.json", "sg_execution_times.rst"]

@@ -49,6 +49,7 @@ __all__ = [
     "validate",
     "laws",
     "scene",
+    "figures",
 ]
 
 _LAZY = {
@@ -76,6 +77,7 @@ _LAZY = {
     "validate": ("ipmc_asym.validation.validate", "claims"),
     "laws": ("ipmc_asym.studies.laws", "law_table"),
     "scene": ("ipmc_asym.studies.scenes", "run_scene"),
+    "figures": ("ipmc_asym.plotting.figures", "make_all"),
 }
 
 

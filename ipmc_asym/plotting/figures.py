@@ -58,7 +58,7 @@ def _si(value: float, unit: str) -> str:
 
 def influence_figure(var, path, base: Strip | None = None, material: Material = NAFION_LI, dpi=110,
                      values=None):
-    """|w|, |F^p|, |theta| against ``var`` for the three models (quadrature fidelity, escalated).
+    """``|w|``, ``|F^p|``, ``|theta|`` against ``var`` for the three models (quadrature fidelity, escalated).
 
     Each model has its colour and marker.  Solid: every check of the forward model holds;
     dotted: the number is kept but a model assumption fails (the free strip past a quarter
@@ -140,18 +140,38 @@ def influence_figure(var, path, base: Strip | None = None, material: Material = 
 
 def make_all(out_dir="figures", dpi=110, base: Strip | None = None, material: Material = NAFION_LI,
              quick=False, bench=None, log=None) -> dict:
-    """Write every figure; returns {"files": [...], "notes": [...], "layers": [...]}.
+    """Write the paper's figures (Figs 4-10) and the speed/accuracy plot: ``ipmc-asym figures``.
 
     Parameters
     ----------
+    out_dir : str or path
+        Directory of the PNG and CSV files (created if missing).
+    dpi : int
+        Resolution of the PNGs.
+    base : Strip, optional
+        The strip the curves vary about (default: the nominal strip; lengths TOTAL).
+    material : Material
     quick : bool
-        Fewer points, no speed/accuracy figure (tests).
+        Every third point of the influence curves, no speed/accuracy figure.
     bench : dict or callable, optional
         The bench result the speed/accuracy figure is drawn from (the dict of ``ipmc-asym
         bench --json``), or a function of no arguments returning one (a measurement, run at
         that step); without it the figure is skipped with a note.
     log : callable, optional
         Called with one progress line per figure (the CLI prints them on stderr).
+
+    Returns
+    -------
+    dict
+        ``{"files": [PNG paths], "notes": [str], "layers": [layer widths per model]}``.
+
+    Examples
+    --------
+    >>> import pathlib, tempfile
+    >>> import ipmc_asym as ia
+    >>> out = ia.figures(pathlib.Path(tempfile.mkdtemp()) / "figs", quick=True)
+    >>> sorted(pathlib.Path(f).name for f in out["files"])[:3]
+    ['influence_length.png', 'influence_thickness.png', 'influence_voltage.png']
     """
     log = log or (lambda msg: None)
     n_total = 2 + len(INFLUENCE) + (0 if quick or bench is None else 1)
