@@ -221,3 +221,15 @@ def test_verdicts_match_the_golden_file(rows, request):
     pinned = json.loads(GOLDEN.read_text(encoding="utf-8"))
     changed = {k: (pinned.get(k), now.get(k)) for k in set(pinned) | set(now) if pinned.get(k) != now.get(k)}
     assert not changed, f"verdicts changed (pinned, now): {changed}; rerun with --update-golden if intended"
+
+
+def test_design_states_the_accumulation_lengths_measured(rows):
+    # docs/design.md quotes both definitions' lengths: they must be what validate measures
+    text = " ".join((Path(__file__).resolve().parents[2] / "docs" / "design.md").read_text(encoding="utf-8").split())
+    m = re.search(r"devoid zone \((\d\.\d+) / (\d\.\d+) / (\d\.\d+) µm .*?decay length, (\d\.\d+) / (\d\.\d+) / (\d\.\d+) µm", text)
+    assert m, "design.md no longer quotes the accumulation lengths"
+    for i, mm in enumerate(("constant", "linear", "affine")):
+        r = rows[f"layer_accumulation_{mm}"]
+        for text_v, v in ((m.group(1 + i), r["value"]), (m.group(4 + i), r["alternatives"]["1/e decay length"]["value"])):
+            dec = len(text_v.split(".")[1])
+            assert abs(v - float(text_v)) <= 0.5 * 10.0 ** -dec * (1 + 1e-9), (mm, text_v, v)
