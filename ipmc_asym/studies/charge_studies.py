@@ -38,8 +38,11 @@ EPS_CAPACITANCE_LITERATURE = 1e-3
 #: "un temps caracteristique d'une seconde environ" (introduction): within a factor 3 of 1 s
 ABOUT_ONE_SECOND = (1.0 / 3.0, 3.0)
 #: diffusion coefficients of Li+ in Nafion reported in the sources read, as (D in m^2/s, source).
-#: None found: the radiotracer study behind the default D (Goswami et al. 2001) lists Na+, K+, Cs+
-#: and Ag+, not Li+ (params.D_CATION_SOURCE).  A sourced entry here turns the ~1 s verdict on.
+#: None read: the radiotracer study behind the default D (Goswami et al. 2001) lists Na+, K+, Cs+
+#: and Ag+, not Li+ (params.D_CATION_SOURCE).  Studies that do measure Li+ in Nafion by 7Li NMR
+#: (V. I. Volkov et al., Int. J. Mol. Sci. 23 (2022) 5011, a review; "Ion mobility in Nafion-117
+#: membranes", Desalination 170 (2004) 49) were found, but only their abstracts, which give no
+#: value.  A sourced entry here turns the ~1 s verdict on.
 D_LI_NAFION_REPORTED: tuple = ()
 #: the one criterion of the ~1 s claim (used here and by ``validate``)
 TIME_CRITERION = ("~1 s is reachable for a model if, over the range of D reported for Li+ in Nafion, its tau = R C_d(0) "
