@@ -120,8 +120,8 @@ def charge_claims(material: Material = NAFION_LI, strip: Strip | None = None) ->
         where = "D reported for Li+ in Nafion: " + "; ".join(f"{d:.2g} m^2/s ({src})" for d, src in D_LI_NAFION_REPORTED)
     else:
         verdict = "not-reproducible"
-        where = ("no diffusion coefficient of Li+ in Nafion was found in the sources read (the default D is the order "
-                 "of Na+, K+, Cs+, Ag+): the ~1 s cannot be judged")
+        where = ("no diffusion coefficient of Li+ in Nafion was found in the sources read (the source of the default D "
+                 "lists Na+, K+, Cs+, Ag+): the ~1 s cannot be judged")
     rows.append({
         "claim": "characteristic time of about one second", "section": "introduction",
         "paper": "~1 s (Nemat-Nasser 2000, experiments)",

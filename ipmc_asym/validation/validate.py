@@ -642,8 +642,8 @@ _WIDTH = Criterion("factor", 2.0, "widths read off the paper's Fig. 4, and the e
                    "definition: agreement within a factor 2")
 _ACCUMULATION = Criterion(
     "factor", 2.0, "the paper gives a 'longueur caracteristique' without defining it; the 1 % level is the one "
-    "its anode width ('presque totalement depourvue', 0.2 / 0.07 um) needs, and it gives the paper's 0.2 / 2 / 2 um "
-    "to one digit where the 1/e decay length gives 0.005 / 0.5 / 0.5 um: the paper used a level, not a decay rate",
+    "its anode widths ('presque totalement depourvue') need, and with it the paper's three cathode widths hold to "
+    "one digit where the 1/e decay lengths do not (alternatives): the paper used a level, not a decay rate",
     "width = distance from the cathode face to where C_bar - 1 falls through 0.01 (the 1 % level of the anode's "
     "devoid zone); alternative reported: the 1/e decay length of C_bar - 1")
 _LINEAR_R = Criterion("at_least", None, "the paper claims the curve is roughly linear, its correlation with a "
