@@ -671,7 +671,9 @@ CLAIMS = (
           "deflection {} .. {} mm and blocking force {F_lo} .. {F_hi} mN both hold at the nominal strip",
           CLAIM_PAPER["lit_w"], _ranges_compatible,
           Criterion("overlap", None, "both ranges can hold only if the deflections the force range implies "
-                    "meet the deflection range"), " mm",
+                    "meet the deflection range",
+                    "assumes both literature ranges apply at the nominal geometry (L = 2 cm, 2l = 5 mm, 2e = 200 um, "
+                    "E = 1.3e8 Pa): the paper does not say on which strips they were measured"), " mm",
           extra=dict(zip(("F_lo", "F_hi"), CLAIM_PAPER["lit_F"]))),
     *(Claim(f"lit_w_{mm}", "§4", f"nominal deflection in {{}} .. {{}} mm ({mm})", CLAIM_PAPER["lit_w"],
             _lit(mm, "w"), _LIT, " mm") for mm in model_names()),

@@ -170,6 +170,8 @@ def test_rule_statements_match_the_api(text):
 @pytest.mark.slow
 def test_exact_against_bvp_as_stated():
     (bound,) = _find(r"≤ (\d\.\d+e-\d+) vs the BVP on 1 µm–10 mm × ±\(1e-4–20\) V", DESIGN)
+    (readme_bound,) = _find(r"`exact` \|.*?\| ≤ (\d\.\d+e-\d+) on 1 µm–10 mm × ±\(1e-4–20\) V, all models", README)
+    assert readme_bound == bound
     r = cl.exact_vs_bvp()
     for m in MODELS:
         assert r[m]["bvp_failed"] == [], m  # the design says the BVP converges everywhere there
