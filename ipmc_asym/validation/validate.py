@@ -409,6 +409,14 @@ def _accumulation(model):
     return f
 
 
+def _anode_slopes(ctx):
+    """dD_bar/dz_bar = C_bar - 1 at the anode face (eq. (20)), constant over affine."""
+    sl = {mm: ctx.summaries[mm]["C_anode"] - 1.0 for mm in ("constant", "affine")}
+    ratio = sl["constant"] / sl["affine"]
+    return Ours(ratio, "'steepness' is not defined: the slope dD/dz = C - 1 at the anode face is "
+                + ", ".join(f"{mm} {v:.4g}" for mm, v in sl.items()) + f" (ratio {ratio:.4g})")
+
+
 def _cathode_ratio(ctx):
     b = {mm: ctx.summaries[mm]["B1"] for mm in ctx.models}
     val = {f"constant/{mm}": b["constant"] / b[mm] for mm in ctx.models if mm != "constant"}
@@ -697,8 +705,9 @@ CLAIMS = (
                    "compute its size"), Criterion("none", None, "the model as solved has no pressure term"),
           " %"),
     Claim("anode_D_steepness", "§6.1", "near -1 the affine D curve is {} times less steep than the constant one",
-          5, _none("'steepness' is not defined: the slope dD/dz = C - 1 at the anode face is ~ -1 for both"),
-          Criterion("none", None, "no definition of steepness to compute")),
+          5, _anode_slopes, Criterion("none", None, "no definition of steepness to compute",
+                                      "value = the constant model's slope dD/dz = C - 1 at the anode face over the "
+                                      "affine model's (one reading of 'steepness', not judged)")),
     # §6.2 scaling laws
     Claim("I_e", "§6.2", "I ~ e^{:g} (first approximation)", -1.0, _I_e,
           Criterion("abs", LAW_HOLD_TOL, "'en premiere approximation': the local exponent within the tolerance of "
