@@ -30,10 +30,12 @@ def run(args) -> int:
         for r in rows:
             print(f"[{r['verdict']}] {r['section']}  {r['claim']}\n{pad}paper:     {r['paper']}\n"
                   f"{pad}ours:      {r['ours']}\n{pad}criterion: {r['criterion']} ({r['reason']})")
+            for k, a in r["alternatives"].items():
+                print(f"{pad}alternative ({k}): {a['verdict']}")
         n = {v: sum(r["verdict"] == v for r in rows) for v in VERDICTS}
         print("summary: " + ", ".join(f"{k} {v}" for k, v in n.items()))
     return 0
 
 
 #: the keys of a JSON claim row
-JSON_KEYS = ("claim", "section", "paper", "ours", "verdict", "key", "criterion", "reason")
+JSON_KEYS = ("claim", "section", "paper", "ours", "verdict", "key", "criterion", "reason", "value", "alternatives")

@@ -55,11 +55,11 @@ __all__ = [
 #: Default cation diffusion coefficient (m^2/s) of the ``nafion-li`` preset and its source.
 D_CATION_DEFAULT = 1.0e-10
 D_CATION_SOURCE = (
-    "D = 1e-10 m^2/s: order of the measured self-diffusion coefficients of alkali cations in "
-    "fully hydrated Nafion 117 (radiotracer: A. Goswami et al., J. Phys. Chem. B 105 (2001) "
-    "9196; Li+ taken equal to Na+ within that order) and of the values used in PNP models of "
-    "Nafion IPMCs (S. Nemat-Nasser, J. Y. Li, J. Appl. Phys. 87 (2000) 3321); uncertain by a "
-    "factor ~3 either way: every dynamic time scales as 1/D"
+    "D = 1e-10 m^2/s is an assumption for Li+, not a measurement: the radiotracer study of "
+    "self-diffusion in Nafion-117 (A. Goswami et al., J. Phys. Chem. B 105 (2001) 9196) lists Na+, "
+    "K+, Cs+ and Ag+ (and divalent ions), not Li+, and no diffusion coefficient of Li+ in Nafion was "
+    "found in the sources read; every dynamic time scales as 1/D (ipmc-asym validate reports the D "
+    "that gives the paper's ~1 s)"
 )
 
 #: The value the paper states (section 4) and uses; the formula with the quoted data gives

@@ -14,7 +14,7 @@ from ipmc_asym.base.settings import LAW_HOLD_TOL
 from ipmc_asym.integral.api import moment
 from ipmc_asym.studies.fits import local_exponent
 
-__all__ = ["local_exponents", "law_table", "law_ranges", "factor_three"]
+__all__ = ["local_exponents", "law_table", "law_ranges", "factor_three", "VOLTAGE_LAWS"]
 
 HOLD_TOL = LAW_HOLD_TOL
 
@@ -82,24 +82,49 @@ def _ranges(x, ex, target, tol=HOLD_TOL):
     return spans
 
 
+#: each regime's law: (exponent of I in phi0, where in the voltage range the regime lives).
+#: "low"/"high": a limit law, which holds at its own end of the range; "middle": an intermediate
+#: regime (A2 >> 1 but rho A2 << 1), which holds only on a plateau of the local exponent.
+VOLTAGE_LAWS = {
+    "constant": {"small voltage": (0.0, "low"), "large voltage": (0.5, "high")},
+    "linear": {"small voltage": (0.0, "low"), "large voltage": (-1.0, "high")},
+    "affine": {"small voltage": (0.0, "low"), "large voltage, rho A2 << 1": (-1.0, "middle"),
+               "very large voltage, rho A2 >> 1": (0.5, "high")},
+}
+
+
+def _is_the_law(span, x, ex, where) -> bool:
+    """A crossing is not the law: the span must reach its regime's end, or hold a plateau.
+
+    A local exponent that passes through a law's exponent on its way elsewhere (e.g. the affine
+    model's 0.5 between 4.6 and 8.3 V, overshooting to 0.56 at 10 V) is within the tolerance
+    over an interval without the law holding there.  A limit law ("low"/"high") must hold up to
+    its own end of the range; an intermediate law ("middle") must hold where the exponent turns
+    (an interior extremum of the local exponent inside the span).
+    """
+    if where == "low":
+        return span[0] == float(x[0])
+    if where == "high":
+        return span[1] == float(x[-1])
+    inside = np.nonzero((x >= span[0]) & (x <= span[1]))[0]
+    d = np.diff(ex[inside])
+    return bool(inside.size > 2 and np.any(np.sign(d[:-1]) != np.sign(d[1:])))
+
+
 def law_ranges(model):
-    """Where ``I ~ phi0^a`` (each regime's a) and ``I ~ e^-1`` hold, from local exponents."""
+    """Where ``I ~ phi0^a`` (each regime's a) and ``I ~ e^-1`` hold, from local exponents.
+
+    A law holds where the local exponent is within ``HOLD_TOL`` of its exponent AND the span is
+    the law's own (:func:`_is_the_law`, the same rule for every model and law): ``I ~ e^-1`` is
+    the thick-strip limit, so its span must reach the thickest strip.
+    """
     v, exv = local_exponents(model, "voltage")
     t, ext = local_exponents(model, "thickness")
-    targets = {"constant": {"small voltage": 0.0, "large voltage": 0.5},
-               "linear": {"small voltage": 0.0, "large voltage": -1.0},
-               "affine": {"small voltage": 0.0, "large voltage, rho A2 << 1": -1.0,
-                          "very large voltage, rho A2 >> 1": 0.5}}[model]
     out = {"voltage": {}, "thickness": {}}
-    for regime, a in targets.items():
-        spans = _ranges(v, exv, a)
-        # a limit law holds at its own end of the range; a crossing elsewhere is not the law
-        if regime == "small voltage":
-            spans = [s for s in spans if s[0] == float(v[0])]
-        elif regime.startswith("very large") or regime == "large voltage":
-            spans = [s for s in spans if s[1] == float(v[-1])] if model != "affine" else spans
+    for regime, (a, where) in VOLTAGE_LAWS[model].items():
+        spans = [s for s in _ranges(v, exv, a) if _is_the_law(s, v, exv, where)]
         out["voltage"][f"I ~ phi0^{a:g} ({regime})"] = spans
-    out["thickness"]["I ~ e^-1"] = _ranges(t, ext, -1.0)
+    out["thickness"]["I ~ e^-1"] = [s for s in _ranges(t, ext, -1.0) if _is_the_law(s, t, ext, "high")]
     out["exponent_phi0"] = {"min": float(exv.min()), "max": float(exv.max()),
                             "at_1V": float(np.interp(0.0, np.log(v), exv))}
     out["exponent_e"] = {"min": float(ext.min()), "max": float(ext.max()),

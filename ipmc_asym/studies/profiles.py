@@ -21,6 +21,11 @@ Layer widths (the toolkit's one set of definitions: :data:`LAYER_WIDTHS`, used b
     length of the accumulated charge.
 ``accumulation_half`` (cathode)
     same, with ``settings.ACCUMULATION_HALF_FRACTION`` (1/2; less sensitive to the tail).
+``accumulation_1pct`` (cathode)
+    distance from the cathode face to where ``C_bar - 1`` falls through ``settings.DEVOID_LEVEL``
+    (0.01): the cathode's counterpart of ``devoid``, the zone where the concentration differs
+    from ``C_moy`` by more than 1 %.  This is the width compared with the paper's "accumulation
+    de cations sur une longueur caracteristique" (section 6.1: 0.2 / 2 / 2 um).
 
 The anode is the face at the higher potential: ``z_bar = -1`` for a positive voltage,
 ``z_bar = +1`` for a negative one (the mirror image).
@@ -66,6 +71,7 @@ LAYER_WIDTHS = {
                                    "cathode face"),
     "accumulation_half_um": ("cathode", f"C_bar - 1 falls to {ACCUMULATION_HALF_FRACTION:g} (B1 - 1) "
                                         "from the cathode face"),
+    "accumulation_1pct_um": ("cathode", f"C_bar - 1 falls through {DEVOID_LEVEL:g} from the cathode face"),
 }
 
 #: the paper's statements (section 6.1), micrometres
@@ -112,8 +118,8 @@ def layer_widths(res, e: float) -> dict:
     Returns
     -------
     dict
-        ``depletion_um``, ``devoid_um``, ``accumulation_um``, ``accumulation_half_um``
-        (NaN where the level is never crossed).
+        ``depletion_um``, ``devoid_um``, ``accumulation_um``, ``accumulation_half_um``,
+        ``accumulation_1pct_um`` (NaN where the level is never crossed).
     """
     z, C = np.asarray(res.z, dtype=float), np.asarray(res.C, dtype=float)
     if getattr(getattr(res, "groups", None), "sign", 1.0) < 0:
@@ -125,7 +131,8 @@ def layer_widths(res, e: float) -> dict:
     return {"depletion_um": _crossing(da, C, DEPLETION_LEVEL),
             "devoid_um": _crossing(da, C, DEVOID_LEVEL),
             "accumulation_um": _crossing(dc, Cc, ACCUMULATION_FRACTION * B1m1),
-            "accumulation_half_um": _crossing(dc, Cc, ACCUMULATION_HALF_FRACTION * B1m1)}
+            "accumulation_half_um": _crossing(dc, Cc, ACCUMULATION_HALF_FRACTION * B1m1),
+            "accumulation_1pct_um": _crossing(dc, Cc, DEVOID_LEVEL)}
 
 
 def profile_summary(model="constant", strip: Strip | None = None, material: Material = NAFION_LI,
@@ -136,7 +143,7 @@ def profile_summary(model="constant", strip: Strip | None = None, material: Mate
     -------
     dict
         ``model``, ``B1`` (= C_bar at the cathode), ``C_anode``, ``depletion_um``, ``devoid_um``,
-        ``accumulation_um``, ``accumulation_half_um``, ``D_face`` (D_bar at the faces, equal by
+        ``accumulation_um``, ``accumulation_half_um``, ``accumulation_1pct_um``, ``D_face`` (D_bar at the faces, equal by
         electroneutrality), ``D_core`` (``|D_bar|`` max over the central half), ``p_anode``,
         ``p_cathode``, ``E_anode``, ``E_cathode``, ``I``, ``cathode_charge`` (F B1 C_moy, C/m^3),
         ``debye_um`` (core Debye length), ``e_um`` (HALF thickness), ``n_nodes``.

@@ -163,7 +163,7 @@ def test_charge_claims_rows_follow_their_criteria():
     rows = {r["key"]: r for r in charge_claims()}
     cap, tim = rows["capacitance_permittivity"], rows["characteristic_time"]
     for r in (cap, tim):
-        assert r["verdict"] in ("reproduced", "differs") and r["criterion"]
+        assert r["verdict"] in ("reproduced", "differs", "not-reproducible") and r["criterion"]
     e0 = cap["numbers"]["eps_app_0V"]
     # eps_app(0 V) = eps_core e / lambda_D, independently of the charge code
     from ipmc_asym.model.params import debye_length

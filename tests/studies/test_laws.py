@@ -54,3 +54,45 @@ def test_moment_exponents_follow(laws):
     e = _exp(laws, "linear", "large voltage", "M_A")
     assert e["phi0"] == 0 and e["l"] == 1 and e["e"] == 1
     assert laws["factor_sections_3_4_over_6_2"] == {"theta": "3", "w_small": "3", "F_block": "3"}
+
+
+# --- a crossing is not the law, for every model -----------------------------------------------
+def test_a_crossing_is_not_a_plateau():
+    from ipmc_asym.studies.laws import _is_the_law, _ranges
+
+    x = np.linspace(0.0, 1.0, 101)
+    crossing = 0.2 + 0.5 * x  # passes through 0.5 on its way to 0.7
+    plateau = 0.5 - 0.3 * (x - 0.5) ** 2  # turns at 0.5
+    for ex, expected in ((crossing, False), (plateau, True)):
+        spans = _ranges(x, ex, 0.5, tol=0.05)
+        assert spans and all(_is_the_law(s, x, ex, "middle") is expected for s in spans)
+    # a limit law must reach its own end of the range
+    assert not any(_is_the_law(s, x, crossing, "high") for s in _ranges(x, crossing, 0.5, tol=0.05))
+    assert all(_is_the_law(s, x, crossing, "high") for s in _ranges(x, crossing, 0.7, tol=0.05))
+
+
+@pytest.mark.parametrize("model", ["constant", "linear", "affine"])
+def test_every_reported_span_is_the_laws_own(model):
+    from ipmc_asym.studies.laws import VOLTAGE_LAWS, law_ranges
+
+    r = law_ranges(model)
+    for regime, (a, where) in VOLTAGE_LAWS[model].items():
+        for lo, hi in r["voltage"][f"I ~ phi0^{a:g} ({regime})"]:
+            if where == "low":
+                assert lo == pytest.approx(1e-3), (model, regime)
+            if where == "high":
+                assert hi == pytest.approx(10.0), (model, regime)
+    for lo, hi in r["thickness"]["I ~ e^-1"]:
+        assert hi == pytest.approx(4e-3)
+
+
+@pytest.mark.slow
+def test_affine_exponent_overshoots_one_half_so_no_span_is_reported():
+    # independent: the BVP's exponent of I near the top of the voltage range is above 1/2 + tol,
+    # so the local exponent only crosses 1/2 below it (the affine I ~ phi0^(1/2) is not reached by 10 V)
+    from ipmc_asym.base.settings import LAW_HOLD_TOL
+    from ipmc_asym.studies.laws import law_ranges
+
+    volts = (9.0, 10.0)
+    assert _fit(volts, [moment_integral_bvp(200e-6, v, "affine") for v in volts]) > 0.5 + LAW_HOLD_TOL
+    assert law_ranges("affine")["voltage"]["I ~ phi0^0.5 (very large voltage, rho A2 >> 1)"] == []
