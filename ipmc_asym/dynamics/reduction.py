@@ -6,9 +6,9 @@ frequency band and fits it by vector fitting (:func:`vector_fit`) on the samples
 ``+i omega`` and their conjugates at ``-i omega``, so that the fit is real (real poles and
 conjugate pairs), stable (an unstable pole is reflected into the left half-plane), with the
 order raised step by step until the tolerance is met; the result is a pole-residue model
-``H(s) = d + sum_k r_k/(s - p_k)`` with a real state-space realisation.  Its error is stated: the largest relative deviation from the full model on a
-check grid four times denser than the fit grid, over the band.  Outside the band nothing is
-claimed.
+``H(s) = d + sum_k r_k/(s - p_k)`` with a real state-space realisation.  Its error is
+stated: the largest relative deviation from the full model on a check grid four times denser
+than the fit grid, over the band.  Outside the band nothing is claimed.
 """
 
 from __future__ import annotations
