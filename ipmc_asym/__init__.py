@@ -50,6 +50,7 @@ __all__ = [
     "laws",
     "scene",
     "figures",
+    "transfer_function",
 ]
 
 _LAZY = {
@@ -78,6 +79,7 @@ _LAZY = {
     "laws": ("ipmc_asym.studies.laws", "law_table"),
     "scene": ("ipmc_asym.studies.scenes", "run_scene"),
     "figures": ("ipmc_asym.plotting.figures", "make_all"),
+    "transfer_function": ("ipmc_asym.dynamics.reduction", "transfer_function"),
 }
 
 

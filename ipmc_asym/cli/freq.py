@@ -9,6 +9,8 @@ from ipmc_asym.base.units import parse_quantity
 from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import add_strip_options, arg_type, count_type, diffusion_type, material_from_args, strip_from_args
 from ipmc_asym.dynamics.circuit import FREQ_METHODS, frequency_response
+from ipmc_asym.dynamics.reduction import transfer_function
+from ipmc_asym.io.fileio import atomic_write, check_output_path
 from ipmc_asym.io.jsonio import dumps
 
 
@@ -34,11 +36,30 @@ def register(sub):
     p.add_argument("--diffusion", type=diffusion_type(), default=None,
                    help="cation diffusion coefficient D (1e-10m2/s, 1e-6cm2/s; a bare number is m^2/s)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument("--export", metavar="F.json", default=None,
+                   help="write reduced-order models of V -> w and V -> charge over [--from, --to] (poles, residues, "
+                        "state space, stated error; see ipmc_asym.transfer_function)")
+    p.add_argument("--export-tol", type=_tol_type, default=1e-4,
+                   help="relative error the exported models aim at over the band, in (0, 1) (default 1e-4)")
+
+
+def _tol_type(text):
+    try:
+        v = float(text)
+    except ValueError:
+        v = float("nan")
+    if not 0.0 < v < 1.0:
+        raise ValueError(f"--export-tol must be a number in (0, 1); got {text!r}")
+    return v
 
 
 def run(args):
     if args.f2 <= args.f1:
         raise ValueError(f"--to must be above --from; got {args.f1:g} Hz .. {args.f2:g} Hz")
+    if args.export is not None:
+        if not str(args.export).endswith(".json"):
+            raise ValueError(f"--export {args.export!r}: the format is JSON; give a path ending in .json")
+        check_output_path(args.export, what="--export")
     material = material_from_args(args)
     if args.diffusion is not None:
         material = material.with_(D=args.diffusion)
@@ -50,6 +71,16 @@ def run(args):
             "electrode_area": strip.width * strip.length, "diffusion_coefficient": material.D,
             "units": {"f": "Hz", "Z": "Ohm (strip, electrode area 2l L)", "w_amp": "m/V", "w_phase": "rad"},
             "notes": r.notes + ["about phi0 = 0; w from the layers' charge, small displacements"]}
+    if args.export is not None:
+        fits = {o: transfer_function(args.f1, args.f2, strip=strip, model=args.model, material=material, output=o,
+                                     method=args.method, tol=args.export_tol) for o in ("w", "charge")}
+        doc = {"models": {o: t.to_dict() for o, t in fits.items()}, "thickness_total": strip.thickness,
+               "electrode_area": strip.width * strip.length, "diffusion_coefficient": material.D,
+               "notes": ["current = s x charge (the bulk's geometric capacitance makes V -> current improper)"]}
+        with atomic_write(args.export) as fh:
+            fh.write(dumps(doc, indent=1))
+        head["export"] = {"path": str(args.export), **{o: t.message for o, t in fits.items()}}
+        bad = [o for o, t in fits.items() if not t.success]
     if args.json:
         out = dict(head)
         out.update(cols)
@@ -62,4 +93,10 @@ def run(args):
         print(f"{f[i]:11.4g} {r.Z.real[i]:12.5g} {r.Z.imag[i]:12.5g} {r.w_amp[i] * 1e3:13.5g} {r.w_phase[i]:11.4g}")
     for n in head["notes"]:
         print(f"note: {n}")
+    if args.export is not None:
+        for o in ("w", "charge"):
+            print(f"exported V -> {o}: {head['export'][o]}")
+        print(f"wrote {args.export}")
+        if bad:
+            print(f"warning: the fit of {', '.join(bad)} misses --export-tol {args.export_tol:g} (its error is stated)")
     return 0

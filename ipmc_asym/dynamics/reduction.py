@@ -1,0 +1,260 @@
+"""Reduced-order models for control: a rational fit of a transfer function over a band.
+
+:func:`transfer_function` samples :func:`ipmc_asym.dynamics.circuit.frequency_response`
+(the full model: the exact linearised Nernst-Planck/Gauss solution by default) over a
+frequency band and fits it by vector fitting (:func:`vector_fit`) on the samples at
+``+i omega`` and their conjugates at ``-i omega``, so that the fit is real (real poles and
+conjugate pairs), stable (an unstable pole is reflected into the left half-plane), with the
+order raised step by step until the tolerance is met; the result is a pole-residue model
+``H(s) = d + sum_k r_k/(s - p_k)`` with a real state-space realisation.  Its error is
+stated: the largest relative deviation from the full model on a check grid four times denser
+than the fit grid, over the band.  Outside the band nothing is claimed.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ipmc_asym.dynamics.circuit import frequency_response
+from ipmc_asym.model.params import NAFION_LI, Material, Strip
+
+__all__ = ["RationalModel", "transfer_function", "vector_fit", "OUTPUTS", "MAX_ORDER"]
+
+#: the transfer functions :func:`transfer_function` exports: name -> (meaning, unit)
+OUTPUTS = {"w": ("tip deflection per volt (small displacements)", "m/V"),
+           "charge": ("electrode charge per volt, electrode area 2l L", "C/V"),
+           "current": ("current per volt, electrode area 2l L (admittance; improper: s x charge)", "A/V"),
+           "impedance": ("impedance, electrode area 2l L", "Ohm")}
+#: largest model order (number of poles) a fit may use, and the orders tried in turn
+MAX_ORDER = 60
+ORDERS = (2, 4, 6, 8, 12, 16, 20, 24, 32, 40, 48, 60)
+
+
+@dataclass
+class RationalModel:
+    """``H(s) = d1 s + d + sum_k residues[k]/(s - poles[k])``, ``s = 2 pi i f`` (rad/s).
+
+    Attributes
+    ----------
+    poles, residues : ndarray of complex, shape (n,)   real poles (imaginary part exactly 0) and
+        exact conjugate pairs, Re(poles) <= 0 (0: an integrator, the impedance's capacitor)
+    d : float   direct term
+    d1 : float  coefficient of ``s`` (nonzero only for the current: the bulk's geometric
+        capacitance passes ``C_g dV/dt``, an improper transfer; no state space exists for it)
+    band : (float, float)   the band of the fit (Hz); the stated error holds there only
+    max_rel_error : float   largest ``|H_fit - H| / |H|`` on the check grid in the band
+    output : str ; unit : str ; model : str ; method : str   what was fitted
+    success : bool   the fit met ``tol`` on the check grid
+    message : str
+    """
+
+    poles: np.ndarray
+    residues: np.ndarray
+    d: float
+    band: tuple
+    max_rel_error: float
+    output: str
+    unit: str
+    model: str
+    method: str
+    success: bool
+    message: str
+    notes: list = field(default_factory=list)
+    d1: float = 0.0
+
+    @property
+    def order(self) -> int:
+        return int(self.poles.size)
+
+    def __call__(self, f):
+        """The fitted response at frequencies ``f`` (Hz), complex, shape of ``f``."""
+        s = 2j * math.pi * np.asarray(f, dtype=float)
+        return self.d1 * s + self.d + np.sum(self.residues / (s[..., None] - self.poles), axis=-1)
+
+    def state_space(self):
+        """Real ``(A, B, C, D)`` with ``H(s) = C (sI - A)^{-1} B + D``: one state per real pole,
+        a 2x2 block ``[[a, b], [-b, a]]`` per conjugate pair ``a +- ib``."""
+        if self.d1 != 0.0:
+            raise ValueError(f"output {self.output!r} is improper (d1 s term): no state space; "
+                             "export output='charge' and differentiate (current = s x charge)")
+        A, B, C = [], [], []
+        for p, r in zip(self.poles, self.residues):
+            if p.imag == 0.0:
+                A.append(np.array([[p.real]]))
+                B.append(np.array([1.0]))
+                C.append(np.array([r.real]))
+            elif p.imag > 0.0:
+                # r/(s - p) + conj(r)/(s - conj p) = C (sI - A)^{-1} B with A = [[a, b], [-b, a]]
+                A.append(np.array([[p.real, p.imag], [-p.imag, p.real]]))
+                B.append(np.array([0.0, 2.0]))
+                C.append(np.array([-r.imag, r.real]))
+        n = sum(a.shape[0] for a in A)
+        Am = np.zeros((n, n))
+        i = 0
+        for a in A:
+            m = a.shape[0]
+            Am[i:i + m, i:i + m] = a
+            i += m
+        return Am, np.concatenate(B)[:, None], np.concatenate(C)[None, :], np.array([[self.d]])
+
+    def to_control(self):
+        """The model as a ``control.StateSpace`` (the optional python-control package)."""
+        try:
+            import control  # deferred: optional dependency (pip install ".[control]")
+        except ImportError:
+            raise ValueError("to_control needs the python-control package: pip install \"ipmc_asym[control]\"") from None
+        return control.ss(*self.state_space())
+
+    def to_dict(self) -> dict:
+        """JSON-ready: poles and residues as [re, im] pairs, the state space, the stated error."""
+        ss = None if self.d1 != 0.0 else dict(zip("ABCD", (x.tolist() for x in self.state_space())))
+        return {"output": self.output, "unit": self.unit, "model": self.model, "method": self.method,
+                "s": "2 pi i f (rad/s)", "form": "H(s) = d1 s + d + sum_k r_k / (s - p_k) = C (sI - A)^-1 B + D (when d1 = 0)",
+                "band_Hz": list(self.band), "order": self.order, "max_rel_error": self.max_rel_error,
+                "success": self.success, "message": self.message,
+                "poles": [[p.real, p.imag] for p in self.poles],
+                "residues": [[r.real, r.imag] for r in self.residues], "d": self.d, "d1": self.d1,
+                "state_space": ss,
+                "notes": list(self.notes)}
+
+
+def _symmetric(poles):
+    """Stable, conjugate-symmetric pole set: unstable poles reflected into the left half-plane (as
+    vector fitting does), poles near the real axis made real (coincident ones merged), each upper
+    pole paired with its conjugate."""
+    poles = np.where(poles.real > 0, -poles.conj(), poles)
+    # a pair within 1e-3 of the real axis is a real double pole (no oscillation at a quality
+    # factor < 5e-4): as a pair it fits with huge opposite residues that cancel (rounding)
+    small = np.abs(poles.imag) <= 1e-3 * np.abs(poles)
+    upper = poles[~small & (poles.imag > 0)]
+    real = np.sort(poles[small].real)
+    keep = np.concatenate([[True], np.diff(real) > 1e-6 * np.abs(real[1:])]) if real.size else np.zeros(0, bool)
+    return np.concatenate([real[keep].astype(complex), upper, upper.conj()])
+
+
+def vector_fit(s, H, order, iterations=12, proper=True):
+    """Vector fitting (Gustavsen & Semlyen, IEEE Trans. Power Delivery 14 (1999) 1052) of the
+    samples ``H`` at the points ``s`` (conjugate-symmetric: both ``s`` and ``conj(s)``), in
+    RELATIVE error (rows weighted by ``1/|H|``: a transfer function spans decades).
+
+    Starting poles: lightly damped pairs ``-b/100 +- i b``, ``b`` log-spaced over ``|s|``; each
+    iteration solves ``sigma H = p`` by linear least squares and moves the poles to the zeros of
+    ``sigma``.  Returns the poles, residues and the direct term of ``d + sum r/(s - p)``
+    (``proper=False``: strictly proper, ``d = 0``).
+    """
+    s = np.asarray(s, complex)
+    H = np.asarray(H, complex)
+    w = 1.0 / np.abs(H)
+    a = np.abs(s[np.abs(s) > 0])
+    b = np.geomspace(a.min(), a.max(), max(1, order // 2))
+    poles = np.concatenate([-b / 100 + 1j * b, -b / 100 - 1j * b])
+    if order % 2:
+        poles = np.append(poles, -np.sqrt(a.min() * a.max()) + 0j)
+    for _ in range(iterations):
+        n = poles.size
+        Phi = 1.0 / (s[:, None] - poles[None, :])
+        M = np.hstack([Phi, np.ones((s.size, 1)), -H[:, None] * Phi]) * w[:, None]
+        x, *_ = np.linalg.lstsq(M, H * w, rcond=None)
+        poles = _symmetric(np.linalg.eigvals(np.diag(poles) - np.outer(np.ones(n), x[n + 1:])))
+    Phi = 1.0 / (s[:, None] - poles[None, :])
+    M = np.hstack([Phi, np.ones((s.size, 1))]) if proper else Phi
+    # symmetric samples and poles: the least-squares solution is conjugate-symmetric, d real
+    x, *_ = np.linalg.lstsq(M * w[:, None], H * w, rcond=None)
+    return (poles, x[:-1], float(x[-1].real)) if proper else (poles, x, 0.0)
+
+
+def transfer_function(f_min, f_max, *, strip: Strip | None = None, model="constant", material: Material | None = None,
+                      output="w", method="pnp-linear", tol=1e-4, points=200) -> RationalModel:
+    """A reduced-order rational model of ``output`` over the band ``[f_min, f_max]`` (Hz).
+
+    Parameters
+    ----------
+    f_min, f_max : float
+        The band (Hz), ``0 < f_min < f_max``.
+    strip : Strip, optional ; model : str ; material : Material, optional
+    output : {"w", "charge", "current", "impedance"}
+        ``w``: tip deflection per volt (m/V); ``charge``: electrode charge per volt (C/V,
+        electrode area 2l L); ``current``: ``s`` x charge (A/V; improper, no state space);
+        ``impedance``: Z (Ohm).  See :data:`OUTPUTS`.
+    method : {"pnp-linear", "circuit"}
+        The full model sampled (:func:`ipmc_asym.dynamics.circuit.frequency_response`).
+    tol : float
+        Relative error aimed at on the band, in (0, 1).
+    points : int
+        Log-spaced fit frequencies (the check grid has four times as many), 20-5000.
+
+    Returns
+    -------
+    RationalModel
+        ``success`` is False (with a message) when the fit misses ``tol`` on the check grid;
+        ``max_rel_error`` is the error measured there either way.
+
+    Examples
+    --------
+    >>> import ipmc_asym as ia
+    >>> tf = ia.transfer_function(0.01, 1000.0, model="constant")
+    >>> tf.success and tf.max_rel_error < 1e-4
+    True
+    >>> A, B, C, D = tf.state_space()
+    """
+    if output not in OUTPUTS:
+        raise ValueError(f"output must be one of {', '.join(OUTPUTS)}; got {output!r}")
+    f_min, f_max = float(f_min), float(f_max)
+    if not (math.isfinite(f_min) and math.isfinite(f_max) and 0.0 < f_min < f_max):
+        raise ValueError(f"the band needs 0 < f_min < f_max (Hz); got {f_min:g}, {f_max:g}")
+    if not (0.0 < tol < 1.0):
+        raise ValueError(f"tol must lie in (0, 1); got {tol!r}")
+    points = int(points)
+    if not 20 <= points <= 5000:
+        raise ValueError(f"points must be an integer in 20..5000; got {points}")
+    s_ = Strip() if strip is None else strip
+    m = NAFION_LI if material is None else material
+
+    def full(f):
+        r = frequency_response(f, strip=s_, model=model, material=m, method=method)
+        if output in ("charge", "current"):
+            # fitted as the charge per volt Q = Y/s: the current I = s Q has a zero at s = 0 that
+            # a relative fit of Y itself cannot pin
+            return 1.0 / (r.Z * 2j * math.pi * f), r
+        return {"w": r.H_w, "impedance": r.Z}[output], r
+
+    f_fit = np.geomspace(f_min, f_max, points)
+    H, r0 = full(f_fit)
+    f_chk = np.geomspace(f_min, f_max, 4 * points)
+    Hc, _ = full(f_chk)
+    # s scaled by the band's geometric centre: the least-squares problems stay well conditioned
+    w0 = 2.0 * math.pi * math.sqrt(f_min * f_max)
+    s = 1j * 2.0 * math.pi * f_fit / w0
+    sc = 1j * 2.0 * math.pi * f_chk / w0
+    best = None
+    from threadpoolctl import threadpool_limits  # deferred: only the fit needs it
+
+    # small least-squares problems: BLAS threads would only compete for the cores
+    with threadpool_limits(1):
+        for order in ORDERS:
+            poles, res, d = vector_fit(np.concatenate([s, s.conj()]), np.concatenate([H, H.conj()]), order)
+            val = d + np.sum(res / (sc[:, None] - poles[None, :]), axis=1)
+            err = float(np.max(np.abs(val - Hc) / np.abs(Hc)))
+            if best is None or err < best[0]:
+                best = (err, poles, res, d)
+            if err <= tol:
+                break
+    err, poles, res, d = best
+    d1 = 0.0
+    if output == "current":
+        # I = s Q with s = w0 x (x the scaled variable): w0 x (d + r/(x - p)) = d s + w0 r + w0 r p/(x - p)
+        d1, d, res = d, float(w0 * np.sum(res).real), w0 * res * poles
+        Hc = Hc * sc * w0
+    # back to s in rad/s: r/(s/w0 - p) = (r w0)/(s - p w0)
+    fit = RationalModel(poles=poles * w0, residues=res * w0, d=d, band=(f_min, f_max), max_rel_error=math.inf,
+                        output=output, unit=OUTPUTS[output][1], model=r0.model, method=method, success=False,
+                        message="", notes=list(r0.notes), d1=d1)
+    err = float(np.max(np.abs(fit(f_chk) - Hc) / np.abs(Hc)))
+    fit.max_rel_error = err
+    fit.success = bool(err <= tol and np.all(fit.poles.real <= 0))
+    fit.message = (f"order {fit.order}: max relative error {err:.2e} on {f_chk.size} check frequencies in the band"
+                   + ("" if fit.success else f" (> tol {tol:g})"))
+    return fit

@@ -1,0 +1,102 @@
+"""Reduced-order models (dynamics/reduction.py) against exact rational functions and the full model."""
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from ipmc_asym.cli import main
+from ipmc_asym.dynamics.circuit import frequency_response
+from ipmc_asym.dynamics.reduction import transfer_function, vector_fit
+from ipmc_asym.model.params import Strip
+
+
+def _ss_eval(A, B, C, D, f):
+    s = 2j * math.pi * np.asarray(f)
+    n = A.shape[0]
+    return np.array([(C @ np.linalg.solve(si * np.eye(n) - A, B) + D)[0, 0] for si in s])
+
+
+def test_vector_fit_recovers_an_exact_rational_function():
+    # H(s) = 0.5 + 2/(s + 1) + (1 + 3i)/(s + 0.2 - 5i) + conj: poles known exactly
+    poles = np.array([-1.0, -0.2 + 5j, -0.2 - 5j])
+    res = np.array([2.0, 1 + 3j, 1 - 3j])
+    s = 1j * np.geomspace(1e-2, 1e2, 300)
+    s = np.concatenate([s, s.conj()])
+    H = 0.5 + np.sum(res / (s[:, None] - poles), axis=1)
+    p, r, d = vector_fit(s, H, 3)
+    o = np.argsort(p.imag)
+    np.testing.assert_allclose(p[o], poles[np.argsort(poles.imag)], rtol=1e-9, atol=1e-9)
+    np.testing.assert_allclose(r[o], res[np.argsort(poles.imag)], rtol=1e-8, atol=1e-8)
+    assert d == pytest.approx(0.5, rel=1e-10)
+
+
+@pytest.mark.parametrize("model", ["constant", "affine"])
+@pytest.mark.parametrize("output", ["w", "charge", "impedance"])
+def test_fit_within_its_stated_error_on_independent_frequencies(model, output):
+    tf = transfer_function(1e-2, 1e3, model=model, output=output, tol=1e-5)
+    assert tf.success and tf.max_rel_error <= 1e-5
+    assert np.all(tf.poles.real <= 0)
+    # frequencies of neither the fit grid nor the check grid
+    f = np.sort(np.exp(np.random.default_rng(1).uniform(math.log(1e-2), math.log(1e3), 97)))
+    r = frequency_response(f, model=model)
+    full = {"w": r.H_w, "charge": 1.0 / (r.Z * 2j * math.pi * f), "impedance": r.Z}[output]
+    assert np.max(np.abs(tf(f) / full - 1)) <= 2 * tf.max_rel_error
+    # the state space is the same function
+    assert np.max(np.abs(_ss_eval(*tf.state_space(), f) / tf(f) - 1)) <= 1e-6
+
+
+def test_current_is_s_times_charge_and_has_no_state_space():
+    q = transfer_function(0.1, 100.0, output="charge", tol=1e-6)
+    i = transfer_function(0.1, 100.0, output="current", tol=1e-6)
+    f = np.geomspace(0.1, 100.0, 7)
+    np.testing.assert_allclose(i(f), 2j * math.pi * f * q(f), rtol=1e-9)
+    r = frequency_response(f)
+    np.testing.assert_allclose(i(f), 1.0 / r.Z, rtol=1e-5)
+    with pytest.raises(ValueError, match="improper"):
+        i.state_space()
+
+
+def test_static_gain_is_the_full_models():
+    # far below the charging frequency the fit's gain tends to the full model's DC value
+    s = Strip(thickness=100e-6)
+    tf = transfer_function(1e-4, 10.0, strip=s, model="constant", tol=1e-6)
+    r = frequency_response(np.array([1e-4]), strip=s, model="constant")
+    assert abs(tf(np.array([1e-4]))[0] / r.H_w[0] - 1) <= 1e-6
+
+
+@pytest.mark.parametrize("kw, match", [({"output": "force"}, "output"), ({"tol": 2.0}, "tol"),
+                                       ({"points": 10**6}, "points")])
+def test_bad_input_one_line(kw, match):
+    with pytest.raises(ValueError, match=match):
+        transfer_function(1.0, 10.0, **kw)
+    with pytest.raises(ValueError, match="band"):
+        transfer_function(10.0, 1.0)
+
+
+def test_freq_export(tmp_path, capsys):
+    out = tmp_path / "tf.json"
+    assert main(["freq", "--from", "0.1Hz", "--to", "100Hz", "--points", "5", "--export", str(out)]) == 0
+    doc = json.loads(out.read_text())
+    w = doc["models"]["w"]
+    assert w["unit"] == "m/V" and w["max_rel_error"] <= 1e-4 and w["state_space"]["A"]
+    A, B, C, D = (np.array(w["state_space"][k]) for k in "ABCD")
+    f = np.array([0.3, 3.0, 30.0])
+    r = frequency_response(f)
+    assert np.max(np.abs(_ss_eval(A, B, C, D, f) / r.H_w - 1)) <= 2e-4
+    assert "wrote" in capsys.readouterr().out
+
+
+def test_freq_export_refuses_before_work(tmp_path):
+    assert main(["freq", "--from", "1Hz", "--to", "10Hz", "--export", str(tmp_path / "x.csv")]) == 2
+    assert main(["freq", "--from", "1Hz", "--to", "10Hz", "--export", str(tmp_path / "no" / "x.json")]) == 2
+
+
+def test_to_control_when_installed():
+    control = pytest.importorskip("control")
+    tf = transfer_function(0.1, 100.0, tol=1e-6)
+    sys = tf.to_control()
+    f = np.array([0.5, 5.0])
+    np.testing.assert_allclose(np.asarray(sys(2j * math.pi * f)).ravel(), tf(f), rtol=1e-6)
+    assert isinstance(sys, control.StateSpace)
