@@ -2,14 +2,15 @@
 A sweep on a Dask cluster
 =========================
 
-A sweep is cut into chunks of contiguous rows, each chunk a task; on a Dask cluster the
-chunks run on its workers and are put back in order, so the rows are those of the serial
-sweep, bit for bit.  It pays where a point is expensive and the rows are many: here, small
-enough for the documentation build, the full BVP at 8 voltages and two thicknesses, on a
-``LocalCluster`` of two single-threaded worker processes (on your own cluster pass
-``distributed.Client("tcp://SCHEDULER:8786")``, or ``--scheduler`` on the command line).  Each worker loads the compiled kernels once, from the on-disk cache.  The
-time on the cluster includes the workers' start (a few seconds), so on so few rows, or on a
-busy machine, it can exceed the serial time; the rows are the same either way.
+A sweep is cut into chunks of contiguous rows, each chunk a task; on a Dask cluster the chunks
+run on its workers and are put back in order, so the rows are those of the serial sweep, bit
+for bit. It pays where a point is expensive and the rows are many: here, small enough for the
+documentation build, the full BVP at 8 voltages and two thicknesses, on a ``LocalCluster`` of
+two single-threaded worker processes (on your own cluster pass
+``distributed.Client("tcp://SCHEDULER:8786")``, or ``--scheduler`` on the command line). Each
+worker loads the compiled kernels once, from the on-disk cache. The time on the cluster
+includes the workers' start (a few seconds), so on so few rows, or on a busy machine, it can
+exceed the serial time; the rows are the same either way.
 """
 
 import time
