@@ -49,6 +49,8 @@ __all__ = [
     "validate",
     "laws",
     "scene",
+    "materials",
+    "design",
 ]
 
 _LAZY = {
@@ -76,6 +78,8 @@ _LAZY = {
     "validate": ("ipmc_asym.validation.validate", "claims"),
     "laws": ("ipmc_asym.studies.laws", "law_table"),
     "scene": ("ipmc_asym.studies.scenes", "run_scene"),
+    "materials": ("ipmc_asym.model.materials", "MATERIAL_SETS"),
+    "design": ("ipmc_asym.studies.design", "design"),
 }
 
 

@@ -30,6 +30,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ipmc_asym.base.units import parse_pressure
+from ipmc_asym.model import material_data
 from ipmc_asym.model.groups import Groups, debye_length, make_groups, moment_scale
 
 __all__ = [
@@ -50,6 +51,8 @@ __all__ = [
     "second_moment",
     "MATERIAL_KEYS",
     "material_from_spec",
+    "named_material",
+    "FALLBACK_DEFAULTS",
 ]
 
 #: Default cation diffusion coefficient (m^2/s) of the ``nafion-li`` preset and its source.
@@ -118,6 +121,9 @@ class Material:
     D: float = D_CATION_DEFAULT
     c_moy: object = "paper"
     name: str = "nafion-li"
+    #: full citations of the sources of the values (a material set's; empty: the defaults
+    #: above, which are the built-in set ``nafion-li``)
+    sources: tuple = ()
 
     def __post_init__(self):
         z3 = check_finite("Z3", self.Z3, "a finite number < 0 C/kg")
@@ -158,6 +164,36 @@ class Material:
     def with_(self, **kw) -> "Material":
         return replace(self, **kw)
 
+    @classmethod
+    def from_file(cls, path) -> "Material":
+        """A user's material file (TOML, the schema of ``ipmc_asym/materials/*.toml``, units accepted).
+
+        A parameter the file does not give falls back visibly to :data:`FALLBACK_DEFAULTS`
+        (``ipmc-asym materials FILE.toml`` lists it as such); ``Z3`` (or ``IEC``), ``rho3``,
+        ``phi4`` and ``E`` are required.
+
+        Raises
+        ------
+        ValueError
+            One line naming the file and the key.
+        """
+        return cls(**material_data.read_set(path, FALLBACK_DEFAULTS).material_kwargs())
+
+    @classmethod
+    def named(cls, name: str) -> "Material":
+        """A built-in material set (``ipmc_asym/materials/NAME.toml``)."""
+        return cls(**material_data.load_set(name, FALLBACK_DEFAULTS).material_kwargs())
+
+
+#: what a parameter a material file does not give falls back to: (value SI, source)
+FALLBACK_DEFAULTS = {
+    "rho2": (1000.0, "library default: the density of water, as in Tixier & Pouget section 4 (set nafion-li)"),
+    "T": (300.0, "library default: the temperature chosen by Tixier & Pouget section 4 (set nafion-li)"),
+    "F": (96487.0, "library default: the Faraday constant of Tixier & Pouget section 2 (set nafion-li)"),
+    "R": (8.31, "library default: the gas constant of Tixier & Pouget section 2 (set nafion-li)"),
+    "D": (D_CATION_DEFAULT, "library default (params.D_CATION_SOURCE): " + D_CATION_SOURCE),
+}
+
 
 NAFION_LI = Material()
 MATERIALS = {"nafion-li": NAFION_LI}
@@ -172,8 +208,8 @@ def material_from_spec(spec=None, labels=None) -> Material:
     Parameters
     ----------
     spec : dict or None
-        Any of :data:`MATERIAL_KEYS`: ``preset`` (a key of :data:`MATERIALS`, default
-        ``nafion-li``); ``E`` or ``modulus`` (Pa, number or string with units such as
+        Any of :data:`MATERIAL_KEYS`: ``preset`` (a built-in set name, default ``nafion-li``,
+        or a user's material file ``FILE.toml``: :func:`named_material`); ``E`` or ``modulus`` (Pa, number or string with units such as
         ``"130MPa"``); ``c_moy`` (``"paper"``, ``"formula"``, or a number > 0 in mol/m^3,
         also as a string); ``phi4``, ``Z3``, ``rho3``, ``rho2``, ``T`` (numbers, SI).
     labels : dict, optional
@@ -201,8 +237,13 @@ def material_from_spec(spec=None, labels=None) -> Material:
         if k not in MATERIAL_KEYS:
             raise ValueError(f"unknown key {k!r} in [material]; allowed: {', '.join(sorted(MATERIAL_KEYS))}")
     preset = spec.get("preset", "nafion-li")
-    if preset not in MATERIALS:
-        raise ValueError(f"{name('preset')} must be one of {', '.join(MATERIALS)}; got {preset!r}")
+    if isinstance(preset, Material):
+        base = preset
+    else:
+        try:
+            base = named_material(preset)
+        except ValueError as exc:
+            raise ValueError(f"{name('preset')}: {exc}") from None
     if "E" in spec and "modulus" in spec:
         raise ValueError(f"{name('E')}: give E or modulus, not both")
     kw = {}
@@ -235,9 +276,21 @@ def material_from_spec(spec=None, labels=None) -> Material:
             raise ValueError(bad)
         kw["c_moy"] = v
     try:
-        return MATERIALS[preset].with_(**kw)
+        return base.with_(**kw)
     except ValueError as exc:
         raise ValueError(f"material: {exc}") from None
+
+
+def named_material(spec) -> Material:
+    """A material from a name: ``nafion-li`` (:data:`NAFION_LI`), another built-in set
+    (``ipmc_asym/materials/NAME.toml``) or a user's file ``FILE.toml``."""
+    if not isinstance(spec, str) or not spec.strip():
+        raise ValueError(f"material must be a set name or a file NAME.toml; got {spec!r}")
+    if spec in MATERIALS:
+        return MATERIALS[spec]
+    if spec.endswith(".toml"):
+        return Material.from_file(spec)
+    return Material.named(spec)
 
 
 @dataclass(frozen=True)

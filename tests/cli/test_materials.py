@@ -1,0 +1,47 @@
+"""``ipmc-asym materials``, ``--material`` and ``--cite`` as a user runs them."""
+
+import json
+from pathlib import Path
+
+import pytest
+
+from ipmc_asym.cli import main
+
+ROOT = Path(__file__).resolve().parents[2]
+USER = str(ROOT / "examples" / "materials" / "paper-values-with-units.toml")
+
+
+def test_materials_list_and_show(capsys):
+    assert main(["materials", "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert [m["name"] for m in d["materials"]] == ["nafion-li", "nafion-li-formula"]
+    assert d["not_offered"]
+    assert main(["materials", "nafion-li", "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["parameters"]["phi4"]["value"] == 0.38 and d["parameters"]["D"]["fallback"] is True
+    assert d["used"]["C_moy"] == 3082.0 and all(d["parameters"][k]["source"] for k in d["parameters"])
+    assert main(["materials", USER]) == 0
+    out = capsys.readouterr().out
+    assert "FALLBACK" in out and "[1] M. Tixier" in out
+
+
+def test_estimate_with_material_set_and_file(capsys):
+    assert main(["estimate", "--model", "constant", "--material", "nafion-li-formula", "--json"]) == 0
+    a = json.loads(capsys.readouterr().out)
+    assert a["results"][0]["C_moy"] == pytest.approx(3162.4768, rel=1e-7)
+    assert main(["estimate", "--model", "constant", "--material", USER, "--json", "--cite"]) == 0
+    cap = capsys.readouterr()
+    b = json.loads(cap.out)  # the bibliography goes to stderr with --json
+    assert b["results"][0]["I"] == a["results"][0]["I"]
+    assert "material set: paper-values-with-units" in cap.err and "[1] M. Tixier" in cap.err
+    # an explicit option still overrides the set's value
+    assert main(["estimate", "--model", "constant", "--material", "nafion-li-formula", "--c-moy", "paper",
+                 "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["results"][0]["C_moy"] == 3082.0
+
+
+@pytest.mark.parametrize("value", ["flemion-k", "missing.toml"])
+def test_bad_material_one_line(value, capsys):
+    assert main(["estimate", "--material", value]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--material" in err
