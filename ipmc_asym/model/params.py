@@ -121,8 +121,8 @@ class Material:
     D: float = D_CATION_DEFAULT
     c_moy: object = "paper"
     name: str = "nafion-li"
-    #: full citations of the sources of the values (a material set's; empty: the defaults
-    #: above, which are the built-in set ``nafion-li``)
+    #: full citations of the sources of the values (a material set's; :data:`NAFION_LI` carries
+    #: the paper's)
     sources: tuple = ()
 
     def __post_init__(self):
@@ -195,7 +195,14 @@ FALLBACK_DEFAULTS = {
 }
 
 
-NAFION_LI = Material()
+#: the sources of the paper's set (``ipmc_asym/materials/nafion-li.toml``; a test keeps them equal)
+PAPER_CITATION = ("M. Tixier, J. Pouget, Validation d'un modèle pour un polymère électroactif (in French; conference "
+                  "paper: static model of an IPMC strip, sections 3-6), Université de Versailles Saint-Quentin and "
+                  "Sorbonne Université, Institut Jean le Rond d'Alembert")
+D_CITATION = ("ipmc_asym default cation diffusion coefficient (params.D_CATION_SOURCE): order of the self-diffusion "
+              "coefficients of alkali cations in hydrated Nafion 117, A. Goswami et al., J. Phys. Chem. B 105 (2001) "
+              "9196; not a value of this set's source")
+NAFION_LI = Material(sources=(PAPER_CITATION, D_CITATION))
 MATERIALS = {"nafion-li": NAFION_LI}
 
 #: keys of a material specification (scene ``[material]`` table, CLI options)

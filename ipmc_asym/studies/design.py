@@ -596,7 +596,9 @@ def design(spec, *, pareto: bool = True) -> DesignResult:
     >>> r = ia.design({"strip": {"width": "5mm", "voltage": "1V"},
     ...                "vary": {"length": ["1cm", "4cm"], "thickness": ["100um", "400um"]},
     ...                "objective": {"maximize": "blocking_force"},
-    ...                "constraints": {"tip_deflection": {"min": "2mm"}}})   # doctest: +SKIP
+    ...                "constraints": {"tip_deflection": {"min": "2mm"}}})
+    >>> [a["name"] for a in r.active_constraints]
+    ['tip_deflection']
     """
     t0 = time.perf_counter()
     if not isinstance(spec, dict):

@@ -57,7 +57,8 @@ def test_cited_values_are_used(path):
 
 def test_nafion_li_is_the_default_material_and_the_papers_numbers():
     m = ia.materials.get("nafion-li")
-    assert m == NAFION_LI == Material()
+    assert m == NAFION_LI == Material(sources=m.sources)
+    assert NAFION_LI.sources == material_data.load_set("nafion-li").citations()
     assert m.C_moy == 3082.0  # stated in section 4
     # slip 1: eq. (17) with the paper's data, by hand: 0.62 * 2078 * 9e4 / (0.38 * 96487)
     assert ia.materials.get("nafion-li-formula").C_moy == pytest.approx(3162.4768, rel=1e-7)
