@@ -18,7 +18,8 @@ def register(sub):
                                    "Pareto front of [pareto] (examples/design_*.toml).")
     p.add_argument("spec", metavar="SPEC.toml", help="design specification (examples/design_blocking_force.toml)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
-    p.add_argument("--plot", default=None, metavar="F.png", help="the Pareto front (needs [pareto])")
+    p.add_argument("--plot", default=None, metavar="F.png",
+                   help="the Pareto front of [pareto] (default: tip_deflection vs blocking_force, 200 points)")
     add_material_options(p)
     p.set_defaults(material=None)
 
@@ -40,6 +41,8 @@ def run(args) -> int:
     spec = load_spec(args.spec)
     if args.material is not None:
         spec["material"] = args.material
+    if args.plot and "pareto" not in spec:  # the plot is the front: force vs deflection by default
+        spec["pareto"] = {"x": "tip_deflection", "y": "blocking_force", "points": 200}
     name = args.spec.rsplit("/", 1)[-1].removesuffix(".toml")
     spec.setdefault("name", name)
     res = design(spec)

@@ -82,8 +82,8 @@ STEP_MIN = 1e-11
 ACTIVE_RTOL = 1e-4
 #: caps (size-like inputs): choice combinations, Pareto points, robust samples
 MAX_COMBOS = 512
-MAX_PARETO_POINTS = 10_000
-MAX_SAMPLES = 1000
+MAX_PARETO_POINTS = 1000
+MAX_SAMPLES = 256
 #: candidates of the first grid (all combinations together) and of the Pareto sample
 GRID_POINTS = 32_768
 PARETO_SAMPLE = 131_072

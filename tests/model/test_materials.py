@@ -130,3 +130,13 @@ def test_bad_user_file_one_line(tmp_path, change, words):
 def test_unknown_set_lists_the_sets():
     with pytest.raises(ValueError, match="nafion-li-formula"):
         ia.materials.get("flemion-na")
+
+
+def test_scene_file_takes_a_material_file():
+    from ipmc_asym.studies.scene_schema import parse_scene
+
+    path = str(ROOT / "examples" / "materials" / "paper-values-with-units.toml")
+    sc = parse_scene({"model": "constant", "voltage": 1.0, "material": {"preset": path}})
+    assert sc.material.name == "paper-values-with-units"
+    assert sc.material.C_moy == pytest.approx(ia.materials.get("nafion-li-formula").C_moy, rel=1e-14)
+    assert parse_scene({"voltage": 1.0, "material": {"preset": "nafion-li-formula", "E": "100MPa"}}).material.E == 1e8

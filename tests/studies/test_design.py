@@ -114,3 +114,14 @@ def test_bad_spec_one_line(spec, words):
     with pytest.raises(ValueError, match=words) as e:
         ia.design(spec)
     assert "\n" not in str(e.value)
+
+
+def test_only_choices_is_an_exhaustive_search():
+    spec = {"strip": {"width": "5mm", "length": "2cm"},
+            "vary": {"thickness": ["100um", "200um", "300um"], "voltage": {"choices": ["0.5V", "1V"]}},
+            "objective": {"maximize": "tip_deflection"}, "constraints": {"blocking_force": {"min": "0.5mN"}}}
+    res = design(spec)
+    T, V = np.meshgrid([100e-6, 200e-6, 300e-6], [0.5, 1.0])
+    r = forward(0.02, 5e-3, T, V, fidelity="corrected").withhold()
+    ok = r.valid & (np.abs(r.F_block) >= 0.5e-3)
+    assert res.objective["value"] == pytest.approx(float(np.max(np.where(ok, np.abs(r.w), -1))), rel=1e-12)
