@@ -14,7 +14,8 @@ import sys
 from ipmc_asym.base.units import parse_diffusion, parse_length, parse_pressure, parse_voltage
 from ipmc_asym.model.params import Strip, material_from_spec
 
-__all__ = ["UsageError", "Parser", "add_strip_options", "add_material_options", "print_citations", "material_from_args", "strip_from_args",
+__all__ = ["UsageError", "Parser", "add_strip_options", "add_material_options", "print_citations", "material_comments",
+           "material_from_args", "strip_from_args",
            "arg_type", "count_type", "join_negative_values", "fmt_num", "c_moy_label", "length_type", "pressure_type",
            "voltage_type", "tol_type", "first_run_notice", "diffusion_type"]
 
@@ -181,6 +182,11 @@ def material_from_args(args):
     if getattr(args, "cite", False):
         print_citations(material, json_mode=bool(getattr(args, "json", False)))
     return material
+
+
+def material_comments(material) -> list:
+    """Header comment lines of a result file: the material set and its numbered sources."""
+    return [f"material set: {material.name}"] + [f"source [{i}]: {c}" for i, c in enumerate(material.sources, 1)]
 
 
 def print_citations(material, json_mode=False):

@@ -18,6 +18,7 @@ from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import (
     add_strip_options,
     count_type,
+    material_comments,
     material_from_args,
     strip_from_args,
     tol_type,
@@ -174,7 +175,7 @@ def run(args) -> int:
                 with atomic_write(args.out) as fh:
                     rows = write_json(chunks, fh, {"n_rows": n}, tail, workers=FORMAT_WORKERS)
             elif args.out:
-                rows = write_csv(chunks, args.out, workers=FORMAT_WORKERS)
+                rows = write_csv(chunks, args.out, workers=FORMAT_WORKERS, comments=material_comments(mat))
             elif args.json:
                 rows = write_json(chunks, sys.stdout, {"n_rows": n}, tail)
             else:

@@ -45,3 +45,13 @@ def test_bad_material_one_line(value, capsys):
     assert main(["estimate", "--material", value]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "--material" in err
+
+
+def test_sweep_csv_names_material_and_sources(tmp_path):
+    out = tmp_path / "s.csv"
+    assert main(["sweep", "--vary", "length=1cm:2cm:3", "--fidelity", "leading", "--no-progress",
+                 "--material", "nafion-li-formula", "--out", str(out)]) == 0
+    lines = out.read_text(encoding="utf-8").splitlines()
+    head = [ln for ln in lines if ln.startswith("#")]
+    assert head[0] == "# material set: nafion-li-formula" and head[1].startswith("# source [1]: M. Tixier")
+    assert lines[len(head)].startswith("length,") and len(lines) == len(head) + 4
