@@ -66,6 +66,7 @@ PARAMETERS = {
           "diffusion coefficient of the cations"),
     "C_moy": ("concentration", {"mol/m^3": 1.0, "mol/m3": 1.0, "mol/L": 1e3, "M": 1e3},
               "mean cation concentration (the value the source states)"),
+    "thickness": ("length", {"m": 1.0, "mm": 1e-3, "um": 1e-6, "µm": 1e-6}, "typical TOTAL thickness of the membrane"),
 }
 #: parameters that become fields of ``params.Material`` (the others are derived or stated)
 MATERIAL_FIELDS = ("Z3", "rho3", "phi4", "rho2", "E", "T", "F", "R", "D")
@@ -293,7 +294,7 @@ def parse_set(data: dict, origin: str = "built-in", defaults: dict | None = None
         if k not in out and k in defaults:
             v, src = defaults[k]
             out[k] = Parameter(k, v, f"{v:g} {_si_unit(k)}", src, "", "", None,
-                               "no source in this set: the library default", True)
+                               "not given by the set: the value of the paper's set nafion-li", True)
     c_moy = data.get("c_moy", "formula")
     if isinstance(c_moy, bool) or not (c_moy in ("paper", "formula") or isinstance(c_moy, (int, float))):
         raise ValueError(f"material {name}: c_moy must be 'paper', 'formula' or a number > 0 mol/m^3; got {c_moy!r}")

@@ -21,9 +21,9 @@ __all__ = ["names", "get", "info", "citations", "bibliography", "describe", "NOT
 
 #: sets the issue asks for that are not offered, and why (no source read for them here)
 NOT_OFFERED = (
-    "Nafion 117 / 115 / 212, Flemion, Aquivion with H+, Li+, Na+, K+: not offered -- no source was read "
-    "that gives Z3 (or the IEC), rho3, phi4 and E for them; write a material file (ipmc-asym materials "
-    "--help, examples/materials/*.toml) with the values and citations of your membrane",
+    "Nafion 212, Flemion, Aquivion, and Nafion 115/117 in the Li+, Na+, K+ forms: not offered -- no source "
+    "read gives their Z3 (or IEC), rho3, phi4 and hydrated E; nafion-115-h/-117-h take phi4 from the paper. "
+    "Write a material file (examples/materials/*.toml) with your membrane's values and citations",
 )
 
 
@@ -114,7 +114,7 @@ def describe(material) -> str:
         if p["range"]:
             extra.append(f"range {p['range'][0]:g}-{p['range'][1]:g}")
         if p["fallback"]:
-            extra.append("FALLBACK: no source in this set, library default")
+            extra.append("FALLBACK (not from this set's own sources)")
         if p["note"]:
             extra.append(p["note"])
         out.append(f"    {k:6s} = {p['value']:<10.6g} {p['unit']:10s} {src} {'; '.join(extra)}")

@@ -185,16 +185,6 @@ class Material:
         return cls(**material_data.load_set(name, FALLBACK_DEFAULTS).material_kwargs())
 
 
-#: what a parameter a material file does not give falls back to: (value SI, source)
-FALLBACK_DEFAULTS = {
-    "rho2": (1000.0, "library default: the density of water, as in Tixier & Pouget section 4 (set nafion-li)"),
-    "T": (300.0, "library default: the temperature chosen by Tixier & Pouget section 4 (set nafion-li)"),
-    "F": (96487.0, "library default: the Faraday constant of Tixier & Pouget section 2 (set nafion-li)"),
-    "R": (8.31, "library default: the gas constant of Tixier & Pouget section 2 (set nafion-li)"),
-    "D": (D_CATION_DEFAULT, "library default (params.D_CATION_SOURCE): " + D_CATION_SOURCE),
-}
-
-
 #: the sources of the paper's set (``ipmc_asym/materials/nafion-li.toml``; a test keeps them equal)
 PAPER_CITATION = ("M. Tixier, J. Pouget, Validation d'un modèle pour un polymère électroactif (in French; conference "
                   "paper: static model of an IPMC strip, sections 3-6), Université de Versailles Saint-Quentin and "
@@ -202,6 +192,17 @@ PAPER_CITATION = ("M. Tixier, J. Pouget, Validation d'un modèle pour un polymè
 D_CITATION = ("ipmc_asym default cation diffusion coefficient (params.D_CATION_SOURCE): order of the self-diffusion "
               "coefficients of alkali cations in hydrated Nafion 117, A. Goswami et al., J. Phys. Chem. B 105 (2001) "
               "9196; not a value of this set's source")
+#: what a parameter a material file does not give falls back to: (value SI, full citation);
+#: the values of the paper's set (``nafion-li``)
+FALLBACK_DEFAULTS = {
+    "rho2": (1000.0, PAPER_CITATION),
+    "T": (300.0, PAPER_CITATION),
+    "F": (96487.0, PAPER_CITATION),
+    "R": (8.31, PAPER_CITATION),
+    "D": (D_CATION_DEFAULT, D_CITATION),
+}
+
+
 NAFION_LI = Material(sources=(PAPER_CITATION, D_CITATION))
 MATERIALS = {"nafion-li": NAFION_LI}
 

@@ -14,13 +14,13 @@ from pathlib import Path
 import ipmc_asym as ia
 from ipmc_asym.base.registry import MODELS
 from ipmc_asym.model import material_data
-from ipmc_asym.model.params import NAFION_LI, Material, material_from_spec
+from ipmc_asym.model.params import FALLBACK_DEFAULTS, NAFION_LI, Material, material_from_spec
 
 ROOT = Path(__file__).resolve().parents[2]
 SETS = sorted((ROOT / "ipmc_asym" / "materials").glob("*.toml"))
 # units as the files write them -> SI (written out here, independently of the loader)
-UNIT = {"C/kg": 1.0, "kg/m^3": 1.0, "1": 1.0, "Pa": 1.0, "K": 1.0, "C/mol": 1.0, "J/(mol K)": 1.0,
-        "m^2/s": 1.0, "mol/m^3": 1.0}
+UNIT = {"C/kg": 1.0, "kg/m^3": 1.0, "g/cm^3": 1e3, "1": 1.0, "Pa": 1.0, "MPa": 1e6, "K": 1.0, "C/mol": 1.0,
+        "J/(mol K)": 1.0, "m^2/s": 1.0, "mol/m^3": 1.0, "meq/g": 1.0, "um": 1e-6}
 
 
 def raw(path):
@@ -37,6 +37,13 @@ def test_cited_values_are_used(path):
     m = ia.materials.get(d["name"])
     p = d["parameters"]
     si = {k: v["value"] * UNIT[v["unit"]] for k, v in p.items()}
+    for k, (v, _src) in FALLBACK_DEFAULTS.items():  # what a set leaves out: the stated defaults
+        si.setdefault(k, v)
+    if "IEC" in si:  # ion-exchange capacity (mol/kg) -> mass charge, Z3 = -F IEC
+        si.setdefault("Z3", -si["F"] * si["IEC"])
+    for name, v in p.items():  # a stated range holds the value
+        if "range" in v:
+            assert v["range"][0] <= v["value"] <= v["range"][1], name
     for k in ("Z3", "rho3", "phi4", "rho2", "E", "T", "F", "R", "D"):
         assert getattr(m, k) == pytest.approx(si[k], rel=1e-15), k
     # C_moy as the source defines it: eq. (17), -(1 - phi4) rho3 Z3 / (phi4 F)
@@ -45,12 +52,13 @@ def test_cited_values_are_used(path):
     used = si["C_moy"] if d["c_moy"] == "paper" else formula
     assert m.C_moy == pytest.approx(used, rel=1e-14)
     # every value has a full citation from the file's own [sources]; fallbacks say so
-    cites = {v["citation"] for v in d["sources"].values()}
+    cites = {v["citation"] for v in d["sources"].values()} | {src for _, src in FALLBACK_DEFAULTS.values()}
     for k, v in p.items():
         assert d["sources"][v["source"]]["citation"] in cites
     assert set(ia.materials.citations(m)) <= cites
-    s = material_data.load_set(d["name"])
-    assert s.fallbacks() == [k for k, v in p.items() if v.get("fallback")]
+    s = material_data.load_set(d["name"], FALLBACK_DEFAULTS)
+    assert s.fallbacks() == [k for k, v in p.items() if v.get("fallback")] + [
+        k for k in FALLBACK_DEFAULTS if k not in p]
     for model, q in d.get("permittivity", {}).items():  # the permittivity the code uses
         assert (MODELS[model].eps0, MODELS[model].deps) == (q["eps0"], q["deps"])
 
@@ -140,3 +148,13 @@ def test_scene_file_takes_a_material_file():
     assert sc.material.name == "paper-values-with-units"
     assert sc.material.C_moy == pytest.approx(ia.materials.get("nafion-li-formula").C_moy, rel=1e-14)
     assert parse_scene({"voltage": 1.0, "material": {"preset": "nafion-li-formula", "E": "100MPa"}}).material.E == 1e8
+
+
+def test_datasheet_sets_derived_values():
+    # Nafion N-115/N-117 (H+): IEC 0.98 meq/g, specific gravity 1.98, phi4 0.38 (fallback), by hand
+    for name in ("nafion-115-h", "nafion-117-h"):
+        m = ia.materials.get(name)
+        assert m.Z3 == pytest.approx(-96487.0 * 0.98, rel=1e-15)
+        assert m.C_moy == pytest.approx(0.62 * 1980.0 * 0.98 / 0.38, rel=1e-14)
+        assert m.E == 114e6
+        assert "phi4" in material_data.load_set(name).fallbacks()
