@@ -59,7 +59,8 @@ def run(args) -> int:
     o = res.optimum
     print(f"design {res.spec.name!r} [{d['model']}, material {d['material']}]: {d['objective']['sense']} "
           f"{d['objective']['name']} = {_fmt(d['objective']['value'], d['objective']['unit'])}; "
-          f"{res.evaluations} candidates through the forward model in {res.seconds:.3g} s")
+          f"{res.evaluations} candidates{f' x {res.spec.samples} samples' if res.robust else ''} through the forward model "
+          f"in {res.seconds:.3g} s")
     print("  inputs (thickness and width TOTAL):  " + ", ".join(
         f"{k} = {_fmt(o['inputs'][k], 'V' if k == 'voltage' else 'm')}" for k in INPUTS))
     print("  outputs (signed as the model gives them):")

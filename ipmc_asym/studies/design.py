@@ -364,10 +364,12 @@ class _Problem:
                 # a withheld sample counts as a failure of the constraint (finite sentinels: no inf - inf)
                 fin = np.isfinite(raw[k])
                 p = spec.probability
-                if lo is not None:
-                    feas &= np.quantile(np.where(fin, raw[k], -1e300).reshape(n, S), 1.0 - p, axis=1) >= lo
+                if lo is not None:  # the value the constraint sees: its (1 - p) quantile
+                    vals[f"{k}:min"] = np.quantile(np.where(fin, raw[k], -1e300).reshape(n, S), 1.0 - p, axis=1)
+                    feas &= vals[f"{k}:min"] >= lo
                 if hi is not None:
-                    feas &= np.quantile(np.where(fin, raw[k], 1e300).reshape(n, S), p, axis=1) <= hi
+                    vals[f"{k}:max"] = np.quantile(np.where(fin, raw[k], 1e300).reshape(n, S), p, axis=1)
+                    feas &= vals[f"{k}:max"] <= hi
                 continue
             a = vals[k]
             with np.errstate(invalid="ignore"):
@@ -634,8 +636,8 @@ def design(spec, *, pareto: bool = True) -> DesignResult:
     inputs, outputs, checks = _point_report(problem, xb)
     active = []
     for k, (lo, hi) in sp.constraints.items():
-        a = float(vb[k][0])
         for bound, lim in (("min", lo), ("max", hi)):
+            a = float(vb.get(f"{k}:{bound}", vb[k])[0])  # robust: the quantile the constraint holds at
             if lim is not None and abs(a - lim) <= ACTIVE_RTOL * abs(lim):
                 active.append({"name": k, "bound": bound, "limit": lim, "value": a})
     for k, (lo, hi, _log) in sp.ranges.items():
@@ -656,6 +658,7 @@ def design(spec, *, pareto: bool = True) -> DesignResult:
         robust = {"probability": sp.probability, "samples": sp.samples,
                   "uncertain": {k: {"dist": d, "params": list(p)} for k, (d, p) in sp.uncertain.items()},
                   "median_outputs": {k: float(vb[k][0]) for k in OUTPUTS},
+                  "constraint_quantiles": {k: float(v[0]) for k, v in vb.items() if ":" in k},
                   "note": f"each constraint met at probability {sp.probability:g} over the samples; objective = median"}
     front = _pareto(problem, *sp.pareto[:2], sp.pareto[2]) if (pareto and sp.pareto) else []
     res = DesignResult(optimum={"inputs": inputs, "outputs": outputs, "checks": checks},
