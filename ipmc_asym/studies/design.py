@@ -40,7 +40,9 @@ Search: every combination of the listed choices x a grid of the continuous varia
 vectorised forward call), then from the best few candidates a pattern search in the unit box
 (a 3^d stencil plus seeded random directions, the step halved when nothing improves, down to
 ``STEP_MIN``): the search keeps the best feasible point found, so it only ever improves on the
-grid.  The Pareto front is the non-dominated set of a dense feasible sample.
+grid.  The Pareto front (both outputs maximised): levels of ``x`` spread evenly over the
+non-dominated set of a seeded uniform sample, and at each level the largest ``y`` with
+``x >= level`` by the same pattern search, all levels in each forward call.
 """
 
 from __future__ import annotations

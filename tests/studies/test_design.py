@@ -126,3 +126,22 @@ def test_only_choices_is_an_exhaustive_search():
     r = forward(0.02, 5e-3, T, V, fidelity="corrected").withhold()
     ok = r.valid & (np.abs(r.F_block) >= 0.5e-3)
     assert res.objective["value"] == pytest.approx(float(np.max(np.where(ok, np.abs(r.w), -1))), rel=1e-12)
+
+
+def test_optimum_is_the_vertex_of_its_active_constraints():
+    """Three variables, three active limits (|w| = 2 mm, strain = 0.004, thickness = 400 um): the
+    optimum is the vertex they define, found here independently by a root solve on (L, V)."""
+    from scipy.optimize import fsolve
+
+    res = design(SPEC)
+    act = {(a["name"], a["bound"]) for a in res.active_constraints}
+    assert act == {("tip_deflection", "min"), ("max_strain", "max"), ("thickness", "max")}
+
+    def eqs(p):
+        r = forward(p[0], 5e-3, 400e-6, p[1], model="constant", fidelity="corrected")
+        return [abs(float(r.w)) / 2e-3 - 1, float(r.max_strain) / 0.004 - 1]
+
+    x = res.optimum["inputs"]
+    L, V = fsolve(eqs, [x["length"] * 1.01, x["voltage"] * 0.99], xtol=1e-13)
+    F = abs(float(forward(L, 5e-3, 400e-6, V, model="constant", fidelity="corrected").F_block))
+    assert res.objective["value"] == pytest.approx(F, rel=1e-6)
