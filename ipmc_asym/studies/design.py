@@ -49,6 +49,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import os
 import sys
 import time
 from dataclasses import dataclass, field
@@ -381,8 +382,8 @@ class _Problem:
                     feas &= a <= hi
         return vals, feas, r
 
-    def score(self, vals, feas, extra=None):
-        """Objective to maximise (``-inf`` where infeasible); ``extra``: (name, level) per row, x >= level."""
+    def score(self, vals, feas):
+        """The objective as a quantity to maximise; ``-inf`` where infeasible."""
         out, sense = self.spec.objective
         f = vals[out] if sense == "maximize" else -vals[out]
         ok = feas & np.isfinite(f)
@@ -605,13 +606,13 @@ def design(spec, *, pareto: bool = True) -> DesignResult:
     ['tip_deflection']
     """
     t0 = time.perf_counter()
-    if not isinstance(spec, dict):
-        path = str(spec)
-        spec = load_spec(path)
-        name = path.rsplit("/", 1)[-1].removesuffix(".toml")
+    if isinstance(spec, DesignSpec):
+        sp = spec
+    elif isinstance(spec, dict):
+        sp = parse_spec(spec, "design")
     else:
-        name = "design"
-    sp = spec if isinstance(spec, DesignSpec) else parse_spec(spec, name)
+        path = os.fspath(spec)
+        sp = parse_spec(load_spec(path), os.path.basename(path).removesuffix(".toml"))
     problem = _Problem(sp)
     S = sp.samples if sp.uncertain else 1
     u, c, step = _grid(problem, max(512, GRID_POINTS // S))
@@ -661,7 +662,8 @@ def design(spec, *, pareto: bool = True) -> DesignResult:
                   "uncertain": {k: {"dist": d, "params": list(p)} for k, (d, p) in sp.uncertain.items()},
                   "median_outputs": {k: float(vb[k][0]) for k in OUTPUTS},
                   "constraint_quantiles": {k: float(v[0]) for k, v in vb.items() if ":" in k},
-                  "note": f"each constraint met at probability {sp.probability:g} over the samples; objective = median"}
+                  "note": (f"each constraint met at probability {sp.probability:g} over the samples; objective = median; "
+                           "optimum.outputs are at the nominal material")}
     front = _pareto(problem, *sp.pareto[:2], sp.pareto[2]) if (pareto and sp.pareto) else []
     res = DesignResult(optimum={"inputs": inputs, "outputs": outputs, "checks": checks},
                        active_constraints=active, pareto=front,
