@@ -284,6 +284,9 @@ def material_from_spec(spec=None, labels=None) -> Material:
             raise ValueError(bad)
         kw["c_moy"] = v
     try:
+        if kw:  # the bibliography says which values are not from the set's sources
+            given = ", ".join(f"{k} = {v:g}" if isinstance(v, float) else f"{k} = {v}" for k, v in kw.items())
+            kw["sources"] = tuple(base.sources) + (f"given by the user, not from these sources: {given}",)
         return base.with_(**kw)
     except ValueError as exc:
         raise ValueError(f"material: {exc}") from None
