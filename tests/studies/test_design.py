@@ -145,3 +145,26 @@ def test_optimum_is_the_vertex_of_its_active_constraints():
     L, V = fsolve(eqs, [x["length"] * 1.01, x["voltage"] * 0.99], xtol=1e-13)
     F = abs(float(forward(L, 5e-3, 400e-6, V, model="constant", fidelity="corrected").F_block))
     assert res.objective["value"] == pytest.approx(F, rel=1e-6)
+
+
+def test_membrane_example_meets_every_constraint():
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[2] / "examples" / "design_membranes.toml"
+    res = design(path)
+    x = res.optimum["inputs"]
+    assert min(abs(x["thickness"] / t - 1) for t in (50e-6, 125e-6, 175e-6)) < 1e-15  # one of the choices
+    assert 0.5 <= x["voltage"] <= 2.0 and 0.01 <= x["length"] <= 0.04
+    assert x["length"] * x["width"] <= 1.5e-4 * (1 + 1e-12)
+    r = forward(x["length"], x["width"], x["thickness"], x["voltage"], fidelity="corrected").withhold()
+    assert bool(r.valid) and abs(float(r.F_block)) >= 1e-3
+    work = abs(float(r.F_block)) * abs(float(r.w))
+    assert res.objective["value"] == pytest.approx(work, rel=1e-12)
+    # no other listed thickness does better on a grid of length x voltage (the optimum's own check)
+    L, V = np.meshgrid(np.linspace(0.01, 0.04, 301), np.linspace(0.5, 2.0, 301))
+    best = 0.0
+    for t in (50e-6, 125e-6, 175e-6):
+        q = forward(L, 5e-3, t, V, fidelity="corrected").withhold()
+        ok = q.valid & (np.abs(q.F_block) >= 1e-3) & (L * 5e-3 <= 1.5e-4)
+        best = max(best, float(np.max(np.where(ok, np.abs(q.F_block * q.w), 0.0))))
+    assert res.objective["value"] >= best * (1 - 1e-6)
