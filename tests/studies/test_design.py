@@ -84,6 +84,13 @@ def test_pareto_front_200_points():
     r = forward(inp["length"], inp["width"], inp["thickness"], inp["voltage"], fidelity="corrected")
     assert np.all(_feasible(r))
     assert np.allclose(np.abs(r.F_block), y, rtol=1e-12)
+    # no feasible point of an independent grid dominates a point of the front
+    L, T, V = np.meshgrid(np.linspace(0.01, 0.04, 40), np.linspace(100e-6, 400e-6, 40), np.linspace(0.5, 2.0, 40))
+    g = forward(L, 5e-3, T, V, model="constant", fidelity="corrected")
+    ok = _feasible(g)
+    gx, gy = np.abs(g.w)[ok], np.abs(g.F_block)[ok]
+    for xi, yi in zip(x, y):
+        assert not np.any((gx >= xi * (1 + 1e-9)) & (gy >= yi * (1 + 1e-6)))
 
 
 def test_robust_constraint_met_at_quantile():
