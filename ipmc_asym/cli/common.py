@@ -15,6 +15,7 @@ from ipmc_asym.base.units import parse_diffusion, parse_length, parse_pressure, 
 from ipmc_asym.model.params import Strip, material_from_spec
 
 __all__ = ["UsageError", "Parser", "add_strip_options", "add_material_options", "print_citations", "material_comments",
+           "scene_with_material",
            "material_from_args", "strip_from_args",
            "arg_type", "count_type", "join_negative_values", "fmt_num", "c_moy_label", "length_type", "pressure_type",
            "voltage_type", "tol_type", "first_run_notice", "diffusion_type"]
@@ -182,6 +183,18 @@ def material_from_args(args):
     if getattr(args, "cite", False):
         print_citations(material, json_mode=bool(getattr(args, "json", False)))
     return material
+
+
+def scene_with_material(path, args):
+    """A scene file as a dict whose ``[material]`` table is ``--material`` alone when given (the
+    scene's own material keys were written for its material); the path itself without it."""
+    if getattr(args, "material", None) is None:
+        return path
+    from ipmc_asym.studies.scene_schema import load_scene  # deferred: only --material on a scene file needs it
+
+    scene = load_scene(path)
+    scene["material"] = {"preset": args.material}
+    return scene
 
 
 def material_comments(material) -> list:

@@ -204,6 +204,8 @@ FALLBACK_DEFAULTS = {
 
 
 NAFION_LI = Material(sources=(PAPER_CITATION, D_CITATION))
+#: the sets with the paper's data, for which ``c_moy = "paper"`` (3082 mol/m^3) is meaningful
+_PAPER_SETS = ("nafion-li", "nafion-li-formula")
 MATERIALS = {"nafion-li": NAFION_LI}
 
 #: keys of a material specification (scene ``[material]`` table, CLI options)
@@ -282,6 +284,9 @@ def material_from_spec(spec=None, labels=None) -> Material:
                 raise ValueError(bad) from None
         if not isinstance(v, str) and not (math.isfinite(v) and v > 0):
             raise ValueError(bad)
+        if v == "paper" and base.name not in _PAPER_SETS:  # 3082 is the paper's Nafion Li+ value
+            raise ValueError(f"{name('c_moy')} = paper is the C_moy the paper states for its Nafion Li+; the material "
+                             f"{base.name} takes formula (eq. (17) from its own data) or a number in mol/m^3")
         kw["c_moy"] = v
     try:
         if kw:  # the bibliography says which values are not from the set's sources

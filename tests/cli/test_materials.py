@@ -55,3 +55,16 @@ def test_sweep_csv_names_material_and_sources(tmp_path):
     head = [ln for ln in lines if ln.startswith("#")]
     assert head[0] == "# material set: nafion-li-formula" and head[1].startswith("# source [1]: M. Tixier")
     assert lines[len(head)].startswith("length,") and len(lines) == len(head) + 4
+
+
+def test_scene_material_option_and_paper_c_moy_guard(capsys):
+    scene = str(ROOT / "examples" / "nominal.toml")
+    assert main(["scene", scene, "--json", "--material", "nafion-117-h", "--cite"]) == 0
+    cap = capsys.readouterr()
+    d = json.loads(cap.out)
+    assert d["material"]["name"] == "nafion-117-h"
+    assert d["material"]["C_moy"] == pytest.approx(0.62 * 1980.0 * 0.98 / 0.38, rel=1e-14)  # eq. (17), its own data
+    assert "material set: nafion-117-h" in cap.err
+    # 3082 mol/m^3 is the paper's Nafion Li+ value: refused for another material
+    assert main(["estimate", "--material", "nafion-117-h", "--c-moy", "paper"]) == 2
+    assert "--c-moy" in capsys.readouterr().err
