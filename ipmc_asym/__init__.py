@@ -51,6 +51,8 @@ __all__ = [
     "scene",
     "figures",
     "transfer_function",
+    "materials",
+    "design",
 ]
 
 _LAZY = {
@@ -80,6 +82,8 @@ _LAZY = {
     "scene": ("ipmc_asym.studies.scenes", "run_scene"),
     "figures": ("ipmc_asym.plotting.figures", "make_all"),
     "transfer_function": ("ipmc_asym.dynamics.reduction", "transfer_function"),
+    "materials": ("ipmc_asym.model.materials", "MATERIAL_SETS"),
+    "design": ("ipmc_asym.studies.design", "design"),
 }
 
 

@@ -42,6 +42,8 @@ COMMANDS = {
     "charge": "charge",
     "step": "step",
     "freq": "freq",
+    "materials": "materials",
+    "design": "design",
 }
 
 #: one-line summaries for ``ipmc-asym --help`` without importing every command module
@@ -59,6 +61,8 @@ SUMMARIES = {
     "charge": "electrode charge, differential capacitance and apparent permittivity (static)",
     "step": "charging transient after a voltage step: sigma, current, moment, w vs time",
     "freq": "small-signal impedance and tip-deflection/voltage transfer function",
+    "materials": "the material sets: every value with its unit, source and range",
+    "design": "choose length, width, thickness, voltage to meet a target (optimum, active constraints, Pareto front)",
 }
 
 

@@ -14,7 +14,9 @@ import sys
 from ipmc_asym.base.units import parse_diffusion, parse_length, parse_pressure, parse_voltage
 from ipmc_asym.model.params import Strip, material_from_spec
 
-__all__ = ["UsageError", "Parser", "add_strip_options", "material_from_args", "strip_from_args",
+__all__ = ["UsageError", "Parser", "add_strip_options", "add_material_options", "print_citations", "material_comments",
+           "scene_with_material",
+           "material_from_args", "strip_from_args",
            "arg_type", "count_type", "join_negative_values", "fmt_num", "c_moy_label", "length_type", "pressure_type",
            "voltage_type", "tol_type", "first_run_notice", "diffusion_type"]
 
@@ -155,16 +157,56 @@ def add_strip_options(p, *, voltage=True):
     if voltage:
         p.add_argument("--voltage", type=voltage_type(), default=1.0,
                        help="voltage phi0 (default 1V; sign = direction)")
-    p.add_argument("--modulus", type=pressure_type("modulus"), default=1.3e8,
-                   help="Young's modulus E (default 1.3e8 Pa)")
-    p.add_argument("--c-moy", default="paper",
-                   help="mean cation concentration C_moy: paper (3082, default), formula (~3162) or a value in mol/m^3")
+    p.add_argument("--modulus", type=pressure_type("modulus"), default=None,
+                   help="Young's modulus E (default: the material set's, 1.3e8 Pa for nafion-li)")
+    p.add_argument("--c-moy", default=None,
+                   help="mean cation concentration C_moy: paper (3082), formula (~3162) or a value in mol/m^3 "
+                        "(default: the material set's, paper for nafion-li)")
+    add_material_options(p)
+
+
+def add_material_options(p):
+    """``--material NAME|FILE.toml`` and ``--cite`` (every command with a material)."""
+    p.add_argument("--material", default="nafion-li", metavar="NAME|FILE.toml",
+                   help="material set (ipmc-asym materials lists them) or a material file (default nafion-li)")
+    p.add_argument("--cite", action="store_true", help="print the bibliography of the run (material set and its sources)")
 
 
 def material_from_args(args):
     """The material of the options, through the library's one parser (params.material_from_spec)."""
-    spec = {"preset": getattr(args, "material", "nafion-li"), "E": args.modulus, "c_moy": args.c_moy}
-    return material_from_spec(spec, labels=_MATERIAL_OPTIONS)
+    spec = {"preset": getattr(args, "material", "nafion-li")}
+    if getattr(args, "modulus", None) is not None:
+        spec["E"] = args.modulus
+    if getattr(args, "c_moy", None) is not None:
+        spec["c_moy"] = args.c_moy
+    material = material_from_spec(spec, labels=_MATERIAL_OPTIONS)
+    if getattr(args, "cite", False):
+        print_citations(material, json_mode=bool(getattr(args, "json", False)))
+    return material
+
+
+def scene_with_material(path, args):
+    """A scene file as a dict whose ``[material]`` table is ``--material`` alone when given (the
+    scene's own material keys were written for its material); the path itself without it."""
+    if getattr(args, "material", None) is None:
+        return path
+    from ipmc_asym.studies.scene_schema import load_scene  # deferred: only --material on a scene file needs it
+
+    scene = load_scene(path)
+    scene["material"] = {"preset": args.material}
+    return scene
+
+
+def material_comments(material) -> list:
+    """Header comment lines of a result file: the material set and its numbered sources."""
+    return [f"material set: {material.name}"] + [f"source [{i}]: {c}" for i, c in enumerate(material.sources, 1)]
+
+
+def print_citations(material, json_mode=False):
+    """``--cite``: the bibliography of the run (to stderr when stdout carries JSON)."""
+    from ipmc_asym.model.materials import bibliography  # deferred: reads the material set files; only --cite needs it
+
+    (sys.stderr if json_mode else sys.stdout).write(bibliography(material) + "\n")
 
 
 _MATERIAL_OPTIONS = {"preset": "--material", "E": "--modulus", "c_moy": "--c-moy"}

@@ -56,7 +56,7 @@ def run(args):
         "length": strip.length, "width_total": strip.width, "thickness_total": strip.thickness,
         "half_thickness_e": strip.e, "half_width_l": strip.l, "voltage": strip.voltage,
         "modulus": material.E, "c_moy": material.C_moy, "c_moy_source": str(material.c_moy),
-        "I_p": strip.I_p, "material": material.name,
+        "I_p": strip.I_p, "material": material.name, "material_sources": list(material.sources),
     }
     if args.json:
         print(dumps({"inputs": inputs, "results": rows}, indent=2))
@@ -64,6 +64,7 @@ def run(args):
     print(f"IPMC strip: L = {fmt_length(strip.length)}, total width 2l = {fmt_length(strip.width)}, "
           f"total thickness 2e = {fmt_length(strip.thickness)} (half thickness e = {fmt_length(strip.e)}), "
           f"phi0 = {fmt_num(strip.voltage)} V, E = {material.E:.3g} Pa, C_moy = {c_moy_label(material)}")
+    print(f"material set {material.name} ({len(material.sources)} sources: --cite, ipmc-asym materials)")
     hdr = (f"{'model':9s} {'fidelity':10s} {'I':>11s} {'M_A [N m]':>11s} {'theta [rad]':>11s} "
            f"{'w [mm]':>9s} {'w_small[mm]':>11s} {'F_block[mN]':>11s} {'F_small[mN]':>11s} {'rel.err':>8s} regime")
     print(hdr)

@@ -6,7 +6,7 @@ import sys
 
 from ipmc_asym.base.units import fmt_length
 from ipmc_asym.cli import SUMMARIES
-from ipmc_asym.cli.common import fmt_num
+from ipmc_asym.cli.common import add_material_options, fmt_num, scene_with_material
 from ipmc_asym.io.jsonio import dumps
 from ipmc_asym.studies.scenes import run_scene
 
@@ -16,11 +16,17 @@ def register(sub):
     p = sub.add_parser("scene", help=SUMMARIES["scene"])
     p.add_argument("file", help="scene TOML file (see examples/*.toml)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
+    add_material_options(p)
+    p.set_defaults(material=None)  # default: the scene's [material]
 
 
 def run(args) -> int:
     """Run ``ipmc-asym scene``."""
-    res = run_scene(args.file)
+    res = run_scene(scene_with_material(args.file, args))
+    if args.cite:
+        m = res["material"]
+        lines = [f"material set: {m['name']}"] + [f"  [{i}] {c}" for i, c in enumerate(m.get("sources", []), 1)]
+        (sys.stderr if args.json else sys.stdout).write("\n".join(lines) + "\n")
     if args.json:
         print(dumps(res, indent=2))
         return 0

@@ -18,6 +18,7 @@ from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import (
     add_strip_options,
     count_type,
+    material_comments,
     material_from_args,
     strip_from_args,
     tol_type,
@@ -166,17 +167,18 @@ def run(args) -> int:
                 return {"fits": fits, "fit_notes": notes, "seconds": time.perf_counter() - t0}
 
             to_json_file = bool(args.out) and args.out.lower().endswith(".json")
+            head = {"n_rows": n, "material": mat.name, "material_sources": list(mat.sources)}
             if to_nc:
 
                 write_netcdf(sweep_dataset(chunks[0], vary, base=base, material=mat), args.out)
                 rows = chunks[0].size
             elif args.out and to_json_file:
                 with atomic_write(args.out) as fh:
-                    rows = write_json(chunks, fh, {"n_rows": n}, tail, workers=FORMAT_WORKERS)
+                    rows = write_json(chunks, fh, head, tail, workers=FORMAT_WORKERS)
             elif args.out:
-                rows = write_csv(chunks, args.out, workers=FORMAT_WORKERS)
+                rows = write_csv(chunks, args.out, workers=FORMAT_WORKERS, comments=material_comments(mat))
             elif args.json:
-                rows = write_json(chunks, sys.stdout, {"n_rows": n}, tail)
+                rows = write_json(chunks, sys.stdout, head, tail)
             else:
                 rows = write_csv(chunks, "-")
         finally:

@@ -6,7 +6,7 @@ import sys
 
 from ipmc_asym.base.registry import compiled_fidelities
 from ipmc_asym.cli import SUMMARIES
-from ipmc_asym.cli.common import count_type
+from ipmc_asym.cli.common import add_material_options, count_type, print_citations, scene_with_material
 from ipmc_asym.io.datasets import uq_dataset, write_netcdf
 from ipmc_asym.io.fileio import check_output_path
 from ipmc_asym.io.jsonio import dumps
@@ -29,6 +29,8 @@ def register(sub):
     p.add_argument("--out", default=None, metavar="F.nc", help="NetCDF file of samples, outputs and indices")
     p.add_argument("--plot", default=None, metavar="F.png", help="histograms of the outputs")
     p.add_argument("--json", action="store_true", help="print one JSON object")
+    add_material_options(p)
+    p.set_defaults(material=None)  # default: the scene's [material]
 
 
 def run(args) -> int:
@@ -39,7 +41,10 @@ def run(args) -> int:
     if args.scheduler is not None:
 
         check_scheduler(args.scheduler)
-    res = run_uq(args.scene, args.samples, seed=args.seed, fidelity=args.fidelity, scheduler=args.scheduler)
+    res = run_uq(scene_with_material(args.scene, args), args.samples, seed=args.seed, fidelity=args.fidelity,
+                 scheduler=args.scheduler)
+    if args.cite and res.material is not None:
+        print_citations(res.material, json_mode=args.json)
     if args.out:
 
         eng = write_netcdf(uq_dataset(res), args.out)

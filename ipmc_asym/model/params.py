@@ -30,6 +30,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ipmc_asym.base.units import parse_pressure
+from ipmc_asym.model import material_data
 from ipmc_asym.model.groups import Groups, debye_length, make_groups, moment_scale
 
 __all__ = [
@@ -50,6 +51,8 @@ __all__ = [
     "second_moment",
     "MATERIAL_KEYS",
     "material_from_spec",
+    "named_material",
+    "FALLBACK_DEFAULTS",
 ]
 
 #: Default cation diffusion coefficient (m^2/s) of the ``nafion-li`` preset and its source.
@@ -118,6 +121,9 @@ class Material:
     D: float = D_CATION_DEFAULT
     c_moy: object = "paper"
     name: str = "nafion-li"
+    #: full citations of the sources of the values (a material set's; :data:`NAFION_LI` carries
+    #: the paper's)
+    sources: tuple = ()
 
     def __post_init__(self):
         z3 = check_finite("Z3", self.Z3, "a finite number < 0 C/kg")
@@ -158,8 +164,48 @@ class Material:
     def with_(self, **kw) -> "Material":
         return replace(self, **kw)
 
+    @classmethod
+    def from_file(cls, path) -> "Material":
+        """A user's material file (TOML, the schema of ``ipmc_asym/materials/*.toml``, units accepted).
 
-NAFION_LI = Material()
+        A parameter the file does not give falls back visibly to :data:`FALLBACK_DEFAULTS`
+        (``ipmc-asym materials FILE.toml`` lists it as such); ``Z3`` (or ``IEC``), ``rho3``,
+        ``phi4`` and ``E`` are required.
+
+        Raises
+        ------
+        ValueError
+            One line naming the file and the key.
+        """
+        return cls(**material_data.read_set(path, FALLBACK_DEFAULTS).material_kwargs())
+
+    @classmethod
+    def named(cls, name: str) -> "Material":
+        """A built-in material set (``ipmc_asym/materials/NAME.toml``)."""
+        return cls(**material_data.load_set(name, FALLBACK_DEFAULTS).material_kwargs())
+
+
+#: the sources of the paper's set (``ipmc_asym/materials/nafion-li.toml``; a test keeps them equal)
+PAPER_CITATION = ("M. Tixier, J. Pouget, Validation d'un modèle pour un polymère électroactif (in French; conference "
+                  "paper: static model of an IPMC strip, sections 3-6), Université de Versailles Saint-Quentin and "
+                  "Sorbonne Université, Institut Jean le Rond d'Alembert")
+D_CITATION = ("ipmc_asym default cation diffusion coefficient (params.D_CATION_SOURCE): order of the self-diffusion "
+              "coefficients of alkali cations in hydrated Nafion 117, A. Goswami et al., J. Phys. Chem. B 105 (2001) "
+              "9196; not a value of this set's source")
+#: what a parameter a material file does not give falls back to: (value SI, full citation);
+#: the values of the paper's set (``nafion-li``)
+FALLBACK_DEFAULTS = {
+    "rho2": (1000.0, PAPER_CITATION),
+    "T": (300.0, PAPER_CITATION),
+    "F": (96487.0, PAPER_CITATION),
+    "R": (8.31, PAPER_CITATION),
+    "D": (D_CATION_DEFAULT, D_CITATION),
+}
+
+
+NAFION_LI = Material(sources=(PAPER_CITATION, D_CITATION))
+#: the sets with the paper's data, for which ``c_moy = "paper"`` (3082 mol/m^3) is meaningful
+_PAPER_SETS = ("nafion-li", "nafion-li-formula")
 MATERIALS = {"nafion-li": NAFION_LI}
 
 #: keys of a material specification (scene ``[material]`` table, CLI options)
@@ -172,8 +218,8 @@ def material_from_spec(spec=None, labels=None) -> Material:
     Parameters
     ----------
     spec : dict or None
-        Any of :data:`MATERIAL_KEYS`: ``preset`` (a key of :data:`MATERIALS`, default
-        ``nafion-li``); ``E`` or ``modulus`` (Pa, number or string with units such as
+        Any of :data:`MATERIAL_KEYS`: ``preset`` (a built-in set name, default ``nafion-li``,
+        or a user's material file ``FILE.toml``: :func:`named_material`); ``E`` or ``modulus`` (Pa, number or string with units such as
         ``"130MPa"``); ``c_moy`` (``"paper"``, ``"formula"``, or a number > 0 in mol/m^3,
         also as a string); ``phi4``, ``Z3``, ``rho3``, ``rho2``, ``T`` (numbers, SI).
     labels : dict, optional
@@ -201,8 +247,13 @@ def material_from_spec(spec=None, labels=None) -> Material:
         if k not in MATERIAL_KEYS:
             raise ValueError(f"unknown key {k!r} in [material]; allowed: {', '.join(sorted(MATERIAL_KEYS))}")
     preset = spec.get("preset", "nafion-li")
-    if preset not in MATERIALS:
-        raise ValueError(f"{name('preset')} must be one of {', '.join(MATERIALS)}; got {preset!r}")
+    if isinstance(preset, Material):
+        base = preset
+    else:
+        try:
+            base = named_material(preset)
+        except ValueError as exc:
+            raise ValueError(f"{name('preset')}: {exc}") from None
     if "E" in spec and "modulus" in spec:
         raise ValueError(f"{name('E')}: give E or modulus, not both")
     kw = {}
@@ -233,11 +284,29 @@ def material_from_spec(spec=None, labels=None) -> Material:
                 raise ValueError(bad) from None
         if not isinstance(v, str) and not (math.isfinite(v) and v > 0):
             raise ValueError(bad)
+        if v == "paper" and base.name not in _PAPER_SETS:  # 3082 is the paper's Nafion Li+ value
+            raise ValueError(f"{name('c_moy')} = paper is the C_moy the paper states for its Nafion Li+; the material "
+                             f"{base.name} takes formula (eq. (17) from its own data) or a number in mol/m^3")
         kw["c_moy"] = v
     try:
-        return MATERIALS[preset].with_(**kw)
+        if kw:  # the bibliography says which values are not from the set's sources
+            given = ", ".join(f"{k} = {v:g}" if isinstance(v, float) else f"{k} = {v}" for k, v in kw.items())
+            kw["sources"] = tuple(base.sources) + (f"given by the user, not from these sources: {given}",)
+        return base.with_(**kw)
     except ValueError as exc:
         raise ValueError(f"material: {exc}") from None
+
+
+def named_material(spec) -> Material:
+    """A material from a name: ``nafion-li`` (:data:`NAFION_LI`), another built-in set
+    (``ipmc_asym/materials/NAME.toml``) or a user's file ``FILE.toml``."""
+    if not isinstance(spec, str) or not spec.strip():
+        raise ValueError(f"material must be a set name or a file NAME.toml; got {spec!r}")
+    if spec in MATERIALS:
+        return MATERIALS[spec]
+    if spec.endswith(".toml"):
+        return Material.from_file(spec)
+    return Material.named(spec)
 
 
 @dataclass(frozen=True)

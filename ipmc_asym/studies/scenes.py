@@ -148,7 +148,8 @@ def run_scene(scene) -> dict:
     material = sc.material
     res = {"scene": sc.name, "model": sc.model if isinstance(sc.model, str) else "custom", "tolerance": tol,
            "material": {"name": material.name, "E": material.E, "C_moy": material.C_moy,
-                        "c_moy": str(material.c_moy), "phi4": material.phi4},
+                        "c_moy": str(material.c_moy), "phi4": material.phi4,
+                        "sources": list(material.sources)},
            "swept": list(sc.swept),
            "defaults_used": {k: float(pts[k][0]) for k in defaults},
            "notes": (["the [uncertain] table is for `ipmc-asym uq`; this scene is evaluated at the "

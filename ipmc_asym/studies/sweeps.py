@@ -425,18 +425,21 @@ def _byte_writer(fh):
     return lambda b: fh.write(b.decode("utf-8"))
 
 
-def write_csv(arr, path, progress=None, workers: int = 1):
+def write_csv(arr, path, progress=None, workers: int = 1, comments=()):
     """CSV with SI columns (header labels say units and TOTAL thickness/width).
 
     ``arr`` is a structured array or an iterable of chunks (streamed, memory independent of
     the number of rows); ``path`` ``None``/``"-"`` is stdout, otherwise written atomically.
-    ``workers``: threads formatting pieces at once (the text is the same).  Returns the
-    number of rows written.
+    ``workers``: threads formatting pieces at once (the text is the same).  ``comments``:
+    lines written first, each after ``# `` (e.g. the material set and its sources).  Returns
+    the number of rows written.
     """
     chunks = [arr] if isinstance(arr, np.ndarray) else arr
 
     def rows(fh):
         put = _byte_writer(fh)
+        for c in comments:
+            put(("# " + " ".join(str(c).split()) + "\n").encode("utf-8"))
         put((csv_header() + "\n").encode("ascii"))
         n = 0
         for text, k in _texts(chunks, "csv", int(workers)):

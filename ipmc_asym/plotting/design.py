@@ -1,0 +1,48 @@
+"""The Pareto front of a design (``ipmc-asym design SPEC.toml --plot F.png``)."""
+
+from __future__ import annotations
+
+from ipmc_asym.plotting import pyplot, savefig
+
+__all__ = ["plot_design"]
+
+#: display scale of each output's unit
+_SCALE = {"m": (1e3, "mm"), "N": (1e3, "mN"), "N m": (1e6, "µN m"), "rad": (1.0, "rad"), "1": (1.0, "")}
+
+
+def plot_design(result, path) -> str:
+    """The front (magnitudes of the two outputs of ``[pareto]``), coloured by the TOTAL
+    thickness, and the optimum of the objective.
+
+    Parameters
+    ----------
+    result : ipmc_asym.studies.design.DesignResult
+    path : str   PNG path (written atomically)
+    """
+    from ipmc_asym.studies.design import OUTPUTS  # deferred: the names only; plotting sits above studies
+
+    plt = pyplot()
+    sp = result.spec
+    if sp.pareto is None or not result.pareto:
+        raise ValueError("--plot needs a [pareto] table in the spec (x, y, points) with a non-empty front")
+    xn, yn, _ = sp.pareto
+    fx, ux = _SCALE.get(OUTPUTS[xn], (1.0, OUTPUTS[xn]))
+    fy, uy = _SCALE.get(OUTPUTS[yn], (1.0, OUTPUTS[yn]))
+    x = [p["outputs"][xn] * fx for p in result.pareto]
+    y = [p["outputs"][yn] * fy for p in result.pareto]
+    th = [p["inputs"]["thickness"] * 1e6 for p in result.pareto]
+    fig, ax = plt.subplots(figsize=(6.4, 4.6))
+    sc = ax.scatter(x, y, c=th, s=12, cmap="viridis")
+    fig.colorbar(sc, ax=ax, label="total thickness 2e [µm]")
+    o = result.optimum["outputs"]
+    if o.get(xn) is not None and o.get(yn) is not None:
+        ax.plot([abs(o[xn]) * fx], [abs(o[yn]) * fy], "r*", ms=14,
+                label=f"optimum: {result.objective['sense']} {result.objective['name']}")
+        ax.legend(loc="best", fontsize=9)
+    ax.set_xlabel(f"|{xn}| [{ux}]")
+    ax.set_ylabel(f"|{yn}| [{uy}]")
+    ax.grid(alpha=0.3)
+    ax.set_title(f"Pareto front ({len(result.pareto)} points), model {sp.model}, material {sp.material.name}",
+                 fontsize=10)
+    fig.tight_layout()
+    return savefig(fig, path, dpi=110)

@@ -1,0 +1,673 @@
+"""Design for a target: the strip (length, width, thickness, voltage) that maximises or
+minimises an output subject to constraints on the others, and a Pareto front of two outputs.
+
+Spec file (TOML; units as everywhere, thickness and width TOTAL)::
+
+    model = "constant"               # a name of ipmc_asym.base.registry.MODELS
+    material = "nafion-li"           # optional: a material set or a file FILE.toml
+    fidelity = "corrected"           # optional: cheapest rung tried (escalation climbs from there)
+    [strip]                          # fixed values
+    width = "5mm"
+    voltage = "1V"
+    [vary]                           # design variables: [low, high], or a list of choices
+    length = ["1cm", "4cm"]          # (two values: a range; three or more: choices;
+    thickness = ["100um", "400um"]   #  {choices = [a, b]} for two choices, {range = [a, b], log = true})
+    [objective]
+    maximize = "blocking_force"      # or minimize = ...
+    [constraints]                    # magnitudes; min and/or max
+    tip_deflection = {min = "2mm"}
+    voltage = {max = "2V"}
+    [pareto]                         # optional: front of two outputs (both maximised)
+    x = "tip_deflection"
+    y = "blocking_force"
+    points = 200
+    [uncertain]                      # optional (the uq schema; modulus and c_moy): robust design
+    modulus = {dist = "normal", mean = "130MPa", sd = "10MPa"}
+    [robust]
+    probability = 0.95               # every constraint met at this probability (a quantile)
+    samples = 32
+
+Outputs (scene-file names): ``tip_deflection`` (|w|, large displacement), ``blocking_force``
+(|F|, large displacement), ``rotation`` (|theta|), ``moment`` (|M_A|), ``I``, ``work``
+(|F| |w|, force x deflection), ``max_strain`` (``e|kappa|``); besides them the inputs and
+``footprint`` (length x width) can be constrained.  Objective and constraints are magnitudes.
+
+Every candidate goes through the one forward model (:func:`ipmc_asym.forward.model.forward`,
+with escalation); a candidate any of whose checks withholds an output the design reads, or
+whose moment has no valid rung, is infeasible: no design is chosen on an invalid number.
+
+Search: every combination of the listed choices x a grid of the continuous variables (one
+vectorised forward call), then from the best few candidates a pattern search in the unit box
+(a 3^d stencil plus seeded random directions, the step halved when nothing improves, down to
+``STEP_MIN``): the search keeps the best feasible point found, so it only ever improves on the
+grid.  The Pareto front (both outputs maximised): levels of ``x`` spread evenly over the
+non-dominated set of a seeded uniform sample, and at each level the largest ``y`` with
+``x >= level`` by the same pattern search, all levels in each forward call.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+import os
+import sys
+import time
+from dataclasses import dataclass, field
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover - Python 3.10
+    import tomli as tomllib
+
+import numpy as np
+
+from ipmc_asym.base.registry import fidelity_names, model_names
+from ipmc_asym.base.settings import STRAIN_LIMIT
+from ipmc_asym.base.units import parse_force, parse_length, parse_quantity, parse_voltage
+from ipmc_asym.forward.model import CHECKS, forward
+from ipmc_asym.model.materials import citations
+from ipmc_asym.model.params import NOMINAL_STRIP, Material, check_positive, named_material
+from ipmc_asym.studies.uq import _transform, parse_uncertain
+
+__all__ = ["DesignSpec", "DesignResult", "design", "parse_spec", "load_spec", "OUTPUTS", "INPUTS", "CONSTRAINABLE",
+           "STEP_MIN", "ACTIVE_RTOL", "MAX_COMBOS", "MAX_PARETO_POINTS", "MAX_SAMPLES"]
+
+#: design inputs (SI; width and thickness TOTAL)
+INPUTS = ("length", "width", "thickness", "voltage")
+#: outputs (scene-file names) -> unit
+OUTPUTS = {"tip_deflection": "m", "blocking_force": "N", "rotation": "rad", "moment": "N m", "I": "1",
+           "work": "N m", "max_strain": "1"}
+#: what a constraint may name -> unit
+CONSTRAINABLE = {**OUTPUTS, "length": "m", "width": "m", "thickness": "m", "voltage": "V", "footprint": "m^2"}
+#: the pattern search stops when its step (in the unit box) is below this
+STEP_MIN = 1e-11
+#: a constraint is reported active when its relative slack is below this
+ACTIVE_RTOL = 1e-4
+#: caps (size-like inputs): choice combinations, Pareto points, robust samples
+MAX_COMBOS = 512
+MAX_PARETO_POINTS = 1000
+MAX_SAMPLES = 256
+#: candidates of the first grid (all combinations together) and of the Pareto sample
+GRID_POINTS = 32_768
+PARETO_SAMPLE = 131_072
+_ITER_MAX = 400
+_STARTS = 4
+_AREA = {"m2": 1.0, "m^2": 1.0, "cm2": 1e-4, "cm^2": 1e-4, "mm2": 1e-6, "mm^2": 1e-6}
+_WORK = {"J": 1.0, "mJ": 1e-3, "uJ": 1e-6, "µJ": 1e-6, "N m": 1.0, "Nm": 1.0}
+_TOP = {"name", "model", "material", "fidelity", "tolerance", "strip", "vary", "objective", "constraints", "pareto",
+        "uncertain", "robust"}
+
+
+def _quantity(where: str, name: str, v) -> float:
+    """A value of ``name`` (a number, SI, or a string with units)."""
+    if isinstance(v, bool) or not isinstance(v, (int, float, str)):
+        raise ValueError(f"{where} must be a number or a string with units; got {v!r}")
+    if name in ("length", "width", "thickness", "tip_deflection"):
+        return parse_length(where, v)
+    if name == "voltage":
+        return parse_voltage(where, v)
+    if name == "blocking_force":
+        return parse_force(where, v)
+    if name == "footprint":
+        return parse_quantity(where, v, _AREA, "area")
+    if name in ("work", "moment"):
+        return parse_quantity(where, v, _WORK, "work/moment (N m)")
+    return parse_quantity(where, v, {}, f"number ({CONSTRAINABLE.get(name, '1')})")
+
+
+@dataclass(frozen=True)
+class DesignSpec:
+    """A checked design specification (SI).
+
+    Attributes
+    ----------
+    fixed : dict       input -> value (the inputs not varied)
+    ranges : dict      continuous input -> (low, high, log)
+    choices : dict     discrete input -> tuple of values
+    objective : tuple  (output, "maximize" | "minimize")
+    constraints : dict name -> (low or None, high or None), magnitudes
+    pareto : tuple or None   (x, y, points)
+    uncertain : dict or None the uq schema's ``{name: (dist, params)}`` (modulus, c_moy)
+    probability : float      robust: each constraint met at this probability
+    samples : int            robust: samples per candidate
+    """
+
+    name: str
+    model: str
+    material: Material
+    fidelity: str
+    tol: float | None
+    fixed: dict
+    ranges: dict
+    choices: dict
+    objective: tuple
+    constraints: dict
+    pareto: tuple | None = None
+    uncertain: dict | None = None
+    probability: float = 0.95
+    samples: int = 32
+    notes: list = field(default_factory=list)
+
+
+def _check_keys(where, d, allowed):
+    if not isinstance(d, dict):
+        raise ValueError(f"{where} must be a table")
+    for k in d:
+        if k not in allowed:
+            raise ValueError(f"unknown key {k!r} in {where}; allowed: {', '.join(sorted(allowed))}")
+
+
+def parse_spec(spec: dict, name: str = "design") -> DesignSpec:
+    """Check a design specification (the dict of a spec file); one-line ``ValueError`` naming the key."""
+    _check_keys("the design spec", spec, _TOP)
+    model = spec.get("model", "constant")
+    if model not in model_names():
+        raise ValueError(f"model must be one of {', '.join(model_names())}; got {model!r}")
+    material = spec.get("material", "nafion-li")
+    material = material if isinstance(material, Material) else named_material(material)
+    fidelity = spec.get("fidelity", "corrected")
+    if fidelity not in fidelity_names():
+        raise ValueError(f"fidelity must be one of {', '.join(fidelity_names())}; got {fidelity!r}")
+    tol = spec.get("tolerance")
+    if tol is not None and (isinstance(tol, bool) or not isinstance(tol, (int, float)) or not 0 < tol < 1):
+        raise ValueError(f"tolerance must be a relative tolerance in (0, 1); got {tol!r}")
+    strip = spec.get("strip", {})
+    _check_keys("[strip]", strip, set(INPUTS))
+    vary = spec.get("vary", {})
+    _check_keys("[vary]", vary, set(INPUTS))
+    if not vary:
+        raise ValueError("[vary] must name at least one design variable (length, width, thickness, voltage)")
+    fixed, ranges, choices, notes = {}, {}, {}, []
+    for k in INPUTS:
+        if k in strip and k in vary:
+            raise ValueError(f"{k} is given both in [strip] and [vary]")
+        if k in strip:
+            fixed[k] = _quantity(f"strip.{k}", k, strip[k])
+        elif k not in vary:
+            fixed[k] = getattr(NOMINAL_STRIP, k)
+            notes.append(f"{k} not given: the nominal strip's {fixed[k]:g} (SI)")
+    for k, v in vary.items():
+        where = f"vary.{k}"
+        log = False
+        if isinstance(v, dict):
+            _check_keys(where, v, {"range", "choices", "log"})
+            log = v.get("log", False)
+            if not isinstance(log, bool):
+                raise ValueError(f"{where}.log must be true or false")
+            if ("range" in v) == ("choices" in v):
+                raise ValueError(f"{where}: give range = [low, high] or choices = [...]")
+            kind, vals = ("range", v["range"]) if "range" in v else ("choices", v["choices"])
+        elif isinstance(v, list):
+            kind, vals = ("range" if len(v) == 2 else "choices"), v
+        else:
+            raise ValueError(f"{where} must be [low, high] or a list of choices; got {v!r}")
+        if not isinstance(vals, list) or not vals:
+            raise ValueError(f"{where}: {kind} must be a non-empty list")
+        xs = [_quantity(f"{where}[{i}]", k, x) for i, x in enumerate(vals)]
+        for x in xs:
+            if k != "voltage":
+                check_positive(where, x, "m")
+        if kind == "range":
+            if len(xs) != 2 or not xs[0] < xs[1]:
+                raise ValueError(f"{where}: a range is [low, high] with low < high; got {vals!r}")
+            if log and (xs[0] <= 0):
+                raise ValueError(f"{where}: a log range needs low > 0")
+            ranges[k] = (xs[0], xs[1], log)
+        else:
+            if len(set(xs)) != len(xs):
+                raise ValueError(f"{where}: the choices repeat a value")
+            choices[k] = tuple(xs)
+    if "thickness" in fixed:
+        check_positive("strip.thickness", fixed["thickness"], "m")
+    ncomb = math.prod(len(c) for c in choices.values()) if choices else 1
+    if ncomb > MAX_COMBOS:
+        raise ValueError(f"[vary]: {ncomb} combinations of choices; at most {MAX_COMBOS}")
+    obj = spec.get("objective")
+    _check_keys("[objective]", obj if obj is not None else {}, {"maximize", "minimize"})
+    if not obj or len(obj) != 1:
+        raise ValueError("[objective] must hold exactly one of maximize = OUTPUT or minimize = OUTPUT")
+    sense, out = next(iter(obj.items()))
+    if out not in OUTPUTS:
+        raise ValueError(f"objective.{sense} must be one of {', '.join(OUTPUTS)}; got {out!r}")
+    cons = {}
+    for k, c in (spec.get("constraints") or {}).items():
+        if k not in CONSTRAINABLE:
+            raise ValueError(f"constraints: unknown name {k!r}; allowed: {', '.join(CONSTRAINABLE)}")
+        _check_keys(f"constraints.{k}", c, {"min", "max"})
+        if not c:
+            raise ValueError(f"constraints.{k} must give min and/or max")
+        lo = _quantity(f"constraints.{k}.min", k, c["min"]) if "min" in c else None
+        hi = _quantity(f"constraints.{k}.max", k, c["max"]) if "max" in c else None
+        if (lo is not None and lo < 0) or (hi is not None and hi <= 0):
+            raise ValueError(f"constraints.{k}: bounds are on magnitudes (min >= 0, max > 0)")
+        if lo is not None and hi is not None and not lo < hi:
+            raise ValueError(f"constraints.{k}: min must be below max")
+        cons[k] = (lo, hi)
+    pareto = None
+    if "pareto" in spec:
+        p = spec["pareto"]
+        _check_keys("[pareto]", p, {"x", "y", "points"})
+        x, y, n = p.get("x", "tip_deflection"), p.get("y", "blocking_force"), p.get("points", 200)
+        for key, o in (("x", x), ("y", y)):
+            if o not in OUTPUTS:
+                raise ValueError(f"pareto.{key} must be one of {', '.join(OUTPUTS)}; got {o!r}")
+        if x == y:
+            raise ValueError("pareto.x and pareto.y must be two different outputs")
+        if isinstance(n, bool) or not isinstance(n, int) or not 2 <= n <= MAX_PARETO_POINTS:
+            raise ValueError(f"pareto.points must be an integer in [2, {MAX_PARETO_POINTS}]; got {n!r}")
+        pareto = (x, y, n)
+    unc, prob, samples = None, 0.95, 32
+    if "uncertain" in spec:
+        unc = parse_uncertain(spec["uncertain"])
+        for k in unc:
+            if k not in ("modulus", "c_moy"):
+                raise ValueError(f"uncertain.{k}: a robust design samples modulus and c_moy only "
+                                 "(the strip's dimensions and voltage are the design)")
+        rb = spec.get("robust", {})
+        _check_keys("[robust]", rb, {"probability", "samples"})
+        prob = rb.get("probability", 0.95)
+        if isinstance(prob, bool) or not isinstance(prob, (int, float)) or not 0.5 <= prob < 1:
+            raise ValueError(f"robust.probability must be in [0.5, 1); got {prob!r}")
+        samples = rb.get("samples", 32)
+        if isinstance(samples, bool) or not isinstance(samples, int) or not 4 <= samples <= MAX_SAMPLES:
+            raise ValueError(f"robust.samples must be an integer in [4, {MAX_SAMPLES}]; got {samples!r}")
+    elif "robust" in spec:
+        raise ValueError("[robust] needs an [uncertain] table (the uq schema: modulus, c_moy)")
+    return DesignSpec(name=spec.get("name", name), model=model, material=material, fidelity=fidelity, tol=tol,
+                      fixed=fixed, ranges=ranges, choices=choices, objective=(out, sense), constraints=cons,
+                      pareto=pareto, uncertain=unc, probability=float(prob), samples=samples, notes=notes)
+
+
+def load_spec(path) -> dict:
+    """Read a spec file (TOML) into a dict (``ValueError`` on unreadable TOML)."""
+    try:
+        with open(path, "rb") as f:
+            return tomllib.load(f)
+    except tomllib.TOMLDecodeError as exc:
+        raise ValueError(f"{path}: not valid TOML ({exc})") from None
+
+
+# ---- evaluation --------------------------------------------------------------------------------
+class _Problem:
+    """The spec's variables in the unit box and one vectorised evaluation of candidates."""
+
+    def __init__(self, spec: DesignSpec):
+        self.spec = spec
+        self.cont = list(spec.ranges)
+        self.combos = list(itertools.product(*spec.choices.values())) if spec.choices else [()]
+        self.disc = list(spec.choices)
+        self.evaluations = 0
+        self.samples = None
+        if spec.uncertain:
+            S = spec.samples
+            rng = np.random.default_rng(0)
+            cols = {}
+            for k, (dist, vals) in spec.uncertain.items():  # stratified (Latin hypercube) samples
+                u = (rng.permutation(S) + rng.uniform(size=S)) / S
+                cols[k] = np.asarray(_transform(u, dist, vals), dtype=float)
+            self.samples = cols
+
+    def inputs(self, u: np.ndarray, combo_idx: np.ndarray) -> dict:
+        """Unit-box coordinates ``u`` (n, d) and combination indices -> inputs (SI arrays)."""
+        n = len(combo_idx)
+        out = {k: np.full(n, v) for k, v in self.spec.fixed.items()}
+        for j, k in enumerate(self.cont):
+            lo, hi, log = self.spec.ranges[k]
+            t = np.clip(u[:, j], 0.0, 1.0)
+            out[k] = lo * (hi / lo) ** t if log else lo + (hi - lo) * t
+        if self.disc:
+            table = np.asarray(self.combos, dtype=float)
+            for j, k in enumerate(self.disc):
+                out[k] = table[combo_idx, j]
+        return out
+
+    def evaluate(self, x: dict) -> tuple[dict, np.ndarray, object]:
+        """``(values, feasible, forward result)`` of candidates ``x`` (SI input arrays).
+
+        ``values`` holds every output magnitude (robust: the median over the samples), the
+        inputs and ``footprint``; NaN where an output is withheld.  ``feasible``: the outputs
+        read are valid and every constraint holds (robust: at the stated probability).
+        """
+        spec = self.spec
+        n = len(x["length"])
+        self.evaluations += n
+        kw = {}
+        S = 1
+        L, W, T, V = (x[k] for k in INPUTS)
+        if self.samples is not None:
+            S = spec.samples
+            L, W, T, V = (np.repeat(a, S) for a in (L, W, T, V))
+            for k, col in self.samples.items():
+                kw[k] = np.tile(col, n)
+        with np.errstate(all="ignore"):
+            r = forward(L, W, T, V, material=spec.material, model=spec.model, fidelity=spec.fidelity,
+                        tol=spec.tol, **kw).withhold()
+            w, F = np.abs(r.w), np.abs(r.F_block)
+            raw = {"tip_deflection": w, "blocking_force": F, "rotation": np.abs(r.theta), "moment": np.abs(r.M_A),
+                   "I": np.abs(r.I), "work": w * F, "max_strain": np.asarray(r.max_strain, float)}
+        used = {spec.objective[0]} | {k for k in spec.constraints if k in OUTPUTS}
+        ok = np.asarray(r.moment_valid, bool).reshape(n, S).all(axis=1)
+        vals = {}
+        for k, a in raw.items():
+            a = a.reshape(n, S)
+            finite = np.isfinite(a).all(axis=1)
+            if k in used:
+                ok &= finite
+            if S == 1:
+                vals[k] = a[:, 0]
+            else:
+                with np.errstate(all="ignore"):
+                    vals[k] = np.where(finite, np.median(np.where(finite[:, None], a, 0.0), axis=1), np.nan)
+        for k in INPUTS:
+            vals[k] = np.abs(x[k])
+        vals["footprint"] = x["length"] * x["width"]
+        feas = ok.copy()
+        for k, (lo, hi) in spec.constraints.items():
+            if k in OUTPUTS and S > 1:
+                # a withheld sample counts as a failure of the constraint (finite sentinels: no inf - inf)
+                fin = np.isfinite(raw[k])
+                p = spec.probability
+                if lo is not None:  # the value the constraint sees: its (1 - p) quantile
+                    vals[f"{k}:min"] = np.quantile(np.where(fin, raw[k], -1e300).reshape(n, S), 1.0 - p, axis=1)
+                    feas &= vals[f"{k}:min"] >= lo
+                if hi is not None:
+                    vals[f"{k}:max"] = np.quantile(np.where(fin, raw[k], 1e300).reshape(n, S), p, axis=1)
+                    feas &= vals[f"{k}:max"] <= hi
+                continue
+            a = vals[k]
+            with np.errstate(invalid="ignore"):
+                if lo is not None:
+                    feas &= a >= lo
+                if hi is not None:
+                    feas &= a <= hi
+        return vals, feas, r
+
+    def score(self, vals, feas):
+        """The objective as a quantity to maximise; ``-inf`` where infeasible."""
+        out, sense = self.spec.objective
+        f = vals[out] if sense == "maximize" else -vals[out]
+        ok = feas & np.isfinite(f)
+        return np.where(ok, f, -np.inf)
+
+
+def _grid_1d(m):
+    return (np.arange(m) + 0.5) / m if m > 1 else np.array([0.5])
+
+
+def _grid(problem: _Problem, total: int):
+    """A grid of the continuous variables x every combination (about ``total`` candidates)."""
+    d = len(problem.cont)
+    nc = len(problem.combos)
+    per = max(1, total // nc)
+    m = max(2, int(round(per ** (1.0 / d)))) if d else 1
+    axes = [np.linspace(0.0, 1.0, m) for _ in range(d)]
+    U = np.stack(np.meshgrid(*axes, indexing="ij"), -1).reshape(-1, d) if d else np.zeros((1, 0))
+    u = np.tile(U, (nc, 1))
+    c = np.repeat(np.arange(nc), len(U))
+    return u, c, (1.0 / (m - 1) if d and m > 1 else 0.0)
+
+
+def _search(problem: _Problem, u0, c0, s0, step0, score=None, step_min=STEP_MIN):
+    """Pattern search from the rows (``u0``, ``c0``, score ``s0``), all rows in each forward call.
+
+    Each iteration tries, around each row's best point, the ``3^d - 1`` stencil and ``2 d + 8``
+    seeded random directions at the current step; a row whose best does not improve halves its
+    step.  ``score(vals, feas, rows)`` (default: the objective) scores candidates of the given
+    rows (``-inf`` where infeasible).  Returns the improved ``(u, s)``.
+    """
+    d = u0.shape[1]
+    if d == 0:
+        return u0, s0
+    score = score or (lambda vals, feas, rows: problem.score(vals, feas))
+    rng = np.random.default_rng(1)
+    sten = np.array([p for p in itertools.product((-1.0, 0.0, 1.0), repeat=d) if any(p)])
+    nr = 2 * d + 8
+    u, s = u0.copy(), s0.copy()
+    step = np.full(len(u), step0)
+    active = np.isfinite(s)
+    for _ in range(_ITER_MAX):
+        rows = np.flatnonzero(active & (step > step_min))
+        if rows.size == 0:
+            break
+        rnd = rng.normal(size=(nr, d))
+        rnd /= np.linalg.norm(rnd, axis=1, keepdims=True)
+        dirs = np.vstack([sten, rnd])
+        k = len(dirs)
+        cand = (u[rows][:, None, :] + step[rows][:, None, None] * dirs[None]).reshape(-1, d)
+        cand = np.clip(cand, 0.0, 1.0)
+        cc = np.repeat(c0[rows], k)
+        vals, feas, _ = problem.evaluate(problem.inputs(cand, cc))
+        sc = score(vals, feas, np.repeat(rows, k)).reshape(len(rows), k)
+        j = np.argmax(sc, axis=1)
+        best = sc[np.arange(len(rows)), j]
+        better = best > s[rows]
+        ib = rows[better]
+        u[ib] = cand.reshape(len(rows), k, d)[better, j[better]]
+        s[ib] = best[better]
+        step[rows[~better]] *= 0.5
+    return u, s
+
+
+@dataclass
+class DesignResult:
+    """The answer of :func:`design` (``as_dict()`` is the ``--json`` object).
+
+    Attributes
+    ----------
+    optimum : dict   {"inputs", "outputs", "checks"} of the chosen design (SI; outputs signed as
+                     the forward model gives them, scene-file names)
+    active_constraints : list of dict   {"name", "bound", "limit", "value"} at the optimum
+    pareto : list of dict   {"inputs", "outputs"} along the front (empty without [pareto])
+    objective : dict, material : str, sources : list, evaluations : int, seconds : float
+    """
+
+    optimum: dict
+    active_constraints: list
+    pareto: list
+    objective: dict
+    spec: DesignSpec
+    evaluations: int
+    seconds: float
+    robust: dict | None = None
+    notes: list = field(default_factory=list)
+
+    def as_dict(self) -> dict:
+        m = self.spec.material
+        d = {"optimum": self.optimum, "active_constraints": self.active_constraints, "pareto": self.pareto,
+             "objective": self.objective, "model": self.spec.model, "fidelity": self.spec.fidelity,
+             "material": m.name, "material_sources": list(citations(m)),
+             "constraints": {k: {"min": lo, "max": hi, "unit": CONSTRAINABLE[k]}
+                             for k, (lo, hi) in self.spec.constraints.items()},
+             "evaluations": self.evaluations, "seconds": self.seconds, "notes": self.notes,
+             "units": {**CONSTRAINABLE}, "thickness_is": "TOTAL 2e", "width_is": "TOTAL 2l"}
+        if self.robust is not None:
+            d["robust"] = self.robust
+        return d
+
+
+def _point_report(problem: _Problem, x: dict) -> tuple[dict, dict, dict]:
+    """Inputs, signed outputs and checks of one candidate (``x``: 1-element arrays)."""
+    spec = problem.spec
+    r = forward(*(x[k] for k in INPUTS), material=spec.material, model=spec.model, fidelity=spec.fidelity,
+                tol=spec.tol).withhold()
+
+    def num(a):
+        v = float(np.asarray(a).reshape(-1)[0])
+        return v if math.isfinite(v) else None
+
+    w, F = num(r.w), num(r.F_block)
+    outputs = {"tip_deflection": w, "blocking_force": F, "rotation": num(r.theta), "moment": num(r.M_A),
+               "I": num(r.I), "work": (abs(w) * abs(F)) if w is not None and F is not None else None,
+               "max_strain": num(r.max_strain), "footprint": float(x["length"][0] * x["width"][0])}
+    checks = {c: bool(np.asarray(getattr(r, c)).reshape(-1)[0]) for c in CHECKS}
+    checks["valid"] = bool(np.asarray(r.valid).reshape(-1)[0])
+    checks["fidelity_used"] = str(np.asarray(r.fidelity_used).reshape(-1)[0])
+    checks["escalated"] = bool(np.asarray(r.escalated).reshape(-1)[0])
+    return {k: float(x[k][0]) for k in INPUTS}, outputs, checks
+
+
+def _violation(problem, vals):
+    """The smallest total relative violation of the constraints among candidates (for the refusal)."""
+    spec = problem.spec
+    tot = np.zeros(len(vals["length"]))
+    worst = {}
+    for k, (lo, hi) in spec.constraints.items():
+        a = vals[k]
+        v = np.zeros_like(a)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            if lo is not None:
+                v = np.maximum(v, (lo - a) / max(lo, 1e-300))
+            if hi is not None:
+                v = np.maximum(v, (a - hi) / hi)
+        v = np.where(np.isfinite(v), v, np.inf)
+        tot += v
+        worst[k] = v
+    i = int(np.argmin(tot))
+    parts = [f"{k} {vals[k][i]:.3g} {CONSTRAINABLE[k]} (min {lo}, max {hi})" for k, (lo, hi) in spec.constraints.items()
+             if worst[k][i] > 0]
+    return "; ".join(parts) if math.isfinite(tot[i]) else "no candidate has a valid result"
+
+
+def _front(xs, ys, idx):
+    """Indices (of ``idx``) of the non-dominated points, both maximised, x ascending."""
+    order = idx[np.lexsort((-ys[idx], -xs[idx]))]  # x descending, then y descending
+    best_y = -np.inf
+    front = []
+    for i in order:
+        if ys[i] > best_y:
+            front.append(i)
+            best_y = ys[i]
+    return np.array(front[::-1], dtype=int)
+
+
+def _pareto(problem: _Problem, x_name: str, y_name: str, n_points: int) -> list:
+    """``n_points`` of the front of (x, y), both maximised: levels of x evenly spread over the
+    front of a seeded uniform sample, and at each level the largest y with ``x >= level``
+    (epsilon-constraint), by the pattern search from the best sample point at that level."""
+    rng = np.random.default_rng(2)
+    nc, d = len(problem.combos), len(problem.cont)
+    n_s = max(4096, PARETO_SAMPLE // 8)
+    u = rng.uniform(size=(n_s, d))
+    c = rng.integers(0, nc, n_s)
+    vals, feas, _ = problem.evaluate(problem.inputs(u, c))
+    xs, ys = vals[x_name], vals[y_name]
+    idx = np.flatnonzero(feas & np.isfinite(xs) & np.isfinite(ys))
+    if idx.size == 0:
+        return []
+    f = _front(xs, ys, idx)
+    levels = np.linspace(xs[f[0]], xs[f[-1]], n_points)
+    # start of each level: the front point with the largest y among those with x >= level
+    start = f[np.searchsorted(xs[f], levels).clip(0, len(f) - 1)]
+    u0, c0, s0 = u[start], c[start], ys[start]
+
+    def score(v, ok, rows):
+        good = ok & np.isfinite(v[y_name]) & (v[x_name] >= levels[rows])
+        return np.where(good, v[y_name], -np.inf)
+
+    uu, _ = _search(problem, u0, c0, s0.copy(), 0.05, score=score, step_min=1e-7)
+    x_in = problem.inputs(uu, c0)
+    v, ok, _ = problem.evaluate(x_in)
+    xs2, ys2 = v[x_name], v[y_name]
+    keep = _front(xs2, ys2, np.flatnonzero(ok & np.isfinite(xs2) & np.isfinite(ys2)))
+    return [{"inputs": {k: float(x_in[k][i]) for k in INPUTS},
+             "outputs": {x_name: float(xs2[i]), y_name: float(ys2[i])}} for i in keep]
+
+
+def design(spec, *, pareto: bool = True) -> DesignResult:
+    """Choose length, width, thickness and voltage within bounds to optimise an output.
+
+    Parameters
+    ----------
+    spec : dict or str or path
+        A design specification (module docstring) or the path of its TOML file.
+    pareto : bool
+        Compute the Pareto front when the spec has ``[pareto]``.
+
+    Returns
+    -------
+    DesignResult
+        ``as_dict()``: ``{"optimum": {"inputs", "outputs", "checks"}, "active_constraints",
+        "pareto", ...}`` (SI; thickness and width TOTAL).
+
+    Raises
+    ------
+    ValueError
+        A bad spec (one line naming the key), or no candidate in the bounds meets the
+        constraints with a valid result (one line with the closest candidate's violation).
+
+    Examples
+    --------
+    >>> import ipmc_asym as ia
+    >>> r = ia.design({"strip": {"width": "5mm", "voltage": "1V"},
+    ...                "vary": {"length": ["1cm", "4cm"], "thickness": ["100um", "400um"]},
+    ...                "objective": {"maximize": "blocking_force"},
+    ...                "constraints": {"tip_deflection": {"min": "2mm"}}})
+    >>> [a["name"] for a in r.active_constraints]
+    ['tip_deflection']
+    """
+    t0 = time.perf_counter()
+    if isinstance(spec, DesignSpec):
+        sp = spec
+    elif isinstance(spec, dict):
+        sp = parse_spec(spec, "design")
+    else:
+        path = os.fspath(spec)
+        sp = parse_spec(load_spec(path), os.path.basename(path).removesuffix(".toml"))
+    problem = _Problem(sp)
+    S = sp.samples if sp.uncertain else 1
+    u, c, step = _grid(problem, max(512, GRID_POINTS // S))
+    vals, feas, _ = problem.evaluate(problem.inputs(u, c))
+    s = problem.score(vals, feas)
+    if not np.isfinite(s).any():
+        raise ValueError("no design within the bounds meets the constraints with a valid result; closest: "
+                         + _violation(problem, vals))
+    # the best few distinct starts (best first), refined together
+    order = np.argsort(-s)
+    starts = []
+    for i in order:
+        if not np.isfinite(s[i]) or len(starts) >= _STARTS:
+            break
+        if all(c[i] != c[j] or np.max(np.abs(u[i] - u[j])) > 2 * step for j in starts):
+            starts.append(i)
+    starts = np.array(starts)
+    uu, ss = _search(problem, u[starts], c[starts], s[starts], max(step, 1e-3))
+    b = int(np.argmax(ss))
+    xb = problem.inputs(uu[b:b + 1], c[starts][b:b + 1])
+    vb, fb, _ = problem.evaluate(xb)
+    if not bool(fb[0]):  # the search only keeps feasible points; this re-check is the contract
+        raise ValueError("design: the optimum failed its re-evaluation")
+    inputs, outputs, checks = _point_report(problem, xb)
+    active = []
+    for k, (lo, hi) in sp.constraints.items():
+        for bound, lim in (("min", lo), ("max", hi)):
+            a = float(vb.get(f"{k}:{bound}", vb[k])[0])  # robust: the quantile the constraint holds at
+            if lim is not None and abs(a - lim) <= ACTIVE_RTOL * abs(lim):
+                active.append({"name": k, "bound": bound, "limit": lim, "value": a})
+    for k, (lo, hi, _log) in sp.ranges.items():
+        a = float(xb[k][0])
+        for bound, lim in (("min", lo), ("max", hi)):
+            if abs(a - lim) <= ACTIVE_RTOL * abs(hi - lo):
+                active.append({"name": k, "bound": bound, "limit": lim, "value": a, "kind": "variable bound"})
+    # model-validity limits the optimum sits on (the checks withhold outputs beyond them)
+    if outputs["max_strain"] is not None and abs(outputs["max_strain"] - STRAIN_LIMIT) <= ACTIVE_RTOL * STRAIN_LIMIT:
+        active.append({"name": "max_strain", "bound": "max", "limit": STRAIN_LIMIT, "value": outputs["max_strain"],
+                       "kind": "model validity: settings.STRAIN_LIMIT (small-strain beam)"})
+    if outputs["rotation"] is not None and abs(abs(outputs["rotation"]) - math.pi / 2) <= ACTIVE_RTOL * math.pi / 2:
+        active.append({"name": "rotation", "bound": "max", "limit": math.pi / 2, "value": abs(outputs["rotation"]),
+                       "kind": "model validity: free strip within a quarter turn (beam regime)"})
+    out, sense = sp.objective
+    robust = None
+    if sp.uncertain:
+        robust = {"probability": sp.probability, "samples": sp.samples,
+                  "uncertain": {k: {"dist": d, "params": list(p)} for k, (d, p) in sp.uncertain.items()},
+                  "median_outputs": {k: float(vb[k][0]) for k in OUTPUTS},
+                  "constraint_quantiles": {k: float(v[0]) for k, v in vb.items() if ":" in k},
+                  "note": (f"each constraint met at probability {sp.probability:g} over the samples; objective = median; "
+                           "optimum.outputs are at the nominal material")}
+    front = _pareto(problem, *sp.pareto[:2], sp.pareto[2]) if (pareto and sp.pareto) else []
+    res = DesignResult(optimum={"inputs": inputs, "outputs": outputs, "checks": checks},
+                       active_constraints=active, pareto=front,
+                       objective={"name": out, "sense": sense, "value": float(vb[out][0]), "unit": OUTPUTS[out]},
+                       spec=sp, evaluations=problem.evaluations, seconds=0.0, robust=robust, notes=list(sp.notes))
+    res.seconds = time.perf_counter() - t0
+    return res
