@@ -189,9 +189,9 @@ class Material:
 PAPER_CITATION = ("M. Tixier, J. Pouget, Validation d'un modèle pour un polymère électroactif (in French; conference "
                   "paper: static model of an IPMC strip, sections 3-6), Université de Versailles Saint-Quentin and "
                   "Sorbonne Université, Institut Jean le Rond d'Alembert")
-D_CITATION = ("ipmc_asym default cation diffusion coefficient (params.D_CATION_SOURCE): order of the self-diffusion "
-              "coefficients of alkali cations in hydrated Nafion 117, A. Goswami et al., J. Phys. Chem. B 105 (2001) "
-              "9196; not a value of this set's source")
+D_CITATION = ("ipmc_asym default cation diffusion coefficient D = 1e-10 m^2/s (params.D_CATION_SOURCE): an "
+              "assumption, not a measured value for Li+ in Nafion (no source read gives one); not a value of this "
+              "set's source")
 #: what a parameter a material file does not give falls back to: (value SI, full citation);
 #: the values of the paper's set (``nafion-li``)
 FALLBACK_DEFAULTS = {
