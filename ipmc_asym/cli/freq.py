@@ -46,9 +46,14 @@ def run(args):
     f = np.geomspace(args.f1, args.f2, args.points)
     r = frequency_response(f, strip=strip, model=args.model, material=material, method=args.method)
     cols = {"f": r.f, "Z_re": r.Z.real, "Z_im": r.Z.imag, "w_amp": r.w_amp, "w_phase": r.w_phase}
+    if r.error is not None:
+        cols["error"] = r.error
     head = {"tau": r.tau, "model": r.model, "method": r.method, "thickness_total": strip.thickness,
+            "f_d": r.f_d, "error_max": None if r.error is None else r.error_max,
+            "reference": "pnp-linear (exact linearised Nernst-Planck/Gauss)",
             "electrode_area": strip.width * strip.length, "diffusion_coefficient": material.D,
-            "units": {"f": "Hz", "Z": "Ohm (strip, electrode area 2l L)", "w_amp": "m/V", "w_phase": "rad"},
+            "units": {"f": "Hz", "Z": "Ohm (strip, electrode area 2l L)", "w_amp": "m/V", "w_phase": "rad",
+                      "error": "relative, of Z and w against pnp-linear"},
             "notes": r.notes + ["about phi0 = 0; w from the layers' charge, small displacements"]}
     if args.json:
         out = dict(head)
@@ -57,9 +62,12 @@ def run(args):
         return 0
     print(f"small signal about 0 V, model {r.model}, method {r.method}, total thickness 2e = "
           f"{strip.thickness * 1e6:.4g} um: tau = {r.tau:.4g} s, D = {material.D:.3g} m^2/s")
-    print(f"{'f [Hz]':>11s} {'Z_re [Ohm]':>12s} {'Z_im [Ohm]':>12s} {'|w|/V [mm/V]':>13s} {'phase [rad]':>11s}")
+    ecol = r.error is not None
+    print(f"{'f [Hz]':>11s} {'Z_re [Ohm]':>12s} {'Z_im [Ohm]':>12s} {'|w|/V [mm/V]':>13s} {'phase [rad]':>11s}"
+          + (f" {'error':>9s}" if ecol else ""))
     for i in range(f.size):
-        print(f"{f[i]:11.4g} {r.Z.real[i]:12.5g} {r.Z.imag[i]:12.5g} {r.w_amp[i] * 1e3:13.5g} {r.w_phase[i]:11.4g}")
+        print(f"{f[i]:11.4g} {r.Z.real[i]:12.5g} {r.Z.imag[i]:12.5g} {r.w_amp[i] * 1e3:13.5g} {r.w_phase[i]:11.4g}"
+              + (f" {r.error[i]:9.2g}" if ecol else ""))
     for n in head["notes"]:
         print(f"note: {n}")
     return 0
