@@ -55,6 +55,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.polynomial import Polynomial as P
 
 from ipmc_asym.kernels.jit import jit
 from ipmc_asym.model.params import Material, check_positive, second_moment
@@ -290,8 +291,6 @@ def _second_static(support, beam: Beam):
     ``(EI/rho A) d4w2/dx4 = w1`` with the support's homogeneous conditions (the operator's
     inverse applied twice).  Returns ``(w2(L), w2'(L), w2''(0), w2'''(L))`` in SI.
     """
-    from numpy.polynomial import Polynomial as P
-
     L, EI = beam.length, beam.EI
     if support == "clamped-free":
         w1 = P([0.0, 0.0, -0.5]) * (L * L / EI)  # in xi = x/L
