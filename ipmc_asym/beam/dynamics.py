@@ -394,15 +394,19 @@ def _propagate(t, M, S, omega, tau_v, P, rhoAL, q0, v0, y0, ys0, out_q, out_dq, 
     p21 = np.empty(nm)
     p22 = np.empty(nm)
     ef = 0.0
+    gw = np.empty(nm)
     for n in range(nm):
-        out_q[0, n] = q[n] + y * P[n] / (rhoAL * omega[n] * omega[n])
+        gw[n] = -P[n] / (rhoAL * omega[n] * omega[n])
+    for n in range(nm):
+        out_q[0, n] = q[n] - gw[n] * y
         out_dq[0, n] = v[n]
     out_y[0] = y
     for j in range(ns):
         out_ys[0, j] = ys[j]
     for k in range(1, t.shape[0]):
         h = t[k] - t[k - 1]
-        if h != h_prev:
+        # an equally spaced grid differs in the last bits only: keep its transition matrices
+        if abs(h - h_prev) > 1e-13 * h:
             for n in range(nm):
                 w = omega[n]
                 a = 0.5 * tau_v * w * w
@@ -443,19 +447,16 @@ def _propagate(t, M, S, omega, tau_v, P, rhoAL, q0, v0, y0, ys0, out_q, out_dq, 
             for j in range(ns):
                 ys[j] = S[k, j]
         for n in range(nm):
-            w2 = omega[n] * omega[n]
-            g = -P[n] / rhoAL  # forcing per unit moment
-            c = tau_v * w2
-            # particular solution of q'' + c q' + w2 q = g (M_k + bM s): qp = g (M_k - c bM/w2)/w2 + g bM s/w2
-            qp0 = g * (M[k - 1] - c * bM / w2) / w2
-            vp = g * bM / w2
-            yq = q[n] - qp0
+            # particular solution of q'' + c q' + w2 q = g (M_k + bM s): qp = gw (M_k - cw bM) + gw bM s,
+            # gw = g/w2, cw = c/w2 = tau_v
+            yq = q[n] - gw[n] * (M[k - 1] - tau_v * bM)
+            vp = gw[n] * bM
             yv = v[n] - vp
-            q[n] = qp0 + vp * h + p11[n] * yq + p12[n] * yv
+            q[n] = gw[n] * (M[k] - tau_v * bM) + p11[n] * yq + p12[n] * yv
             v[n] = vp + p21[n] * yq + p22[n] * yv
-            out_q[k, n] = q[n] - g * y_new / w2
-            # d/dt of the quasi-static part: g y'/w2, y' = (M - y)/tau_v (0 without creep: not used then)
-            out_dq[k, n] = v[n] - (g * (M[k] - y_new) / (tau_v * w2) if tau_v > 0.0 else 0.0)
+            out_q[k, n] = q[n] - gw[n] * y_new
+            # d/dt of the quasi-static part: gw y', y' = (M - y)/tau_v (0 without creep: not used then)
+            out_dq[k, n] = v[n] - (gw[n] * (M[k] - y_new) / tau_v if tau_v > 0.0 else 0.0)
         y = y_new
         out_y[k] = y
         for j in range(ns):
@@ -483,6 +484,8 @@ class ModalIntegrator:
         self.y = 0.0
         self.ys = None
         self.t_last = None
+        self.hist_t = np.zeros(0)
+        self.hist_y = np.zeros(0)
         md = self.md
         g = -md.P / (beam.rhoA * beam.length)
         _, _, d2w20, d3w2L = _second_static(support, beam) if beam.electrode is None else (0.0, 0.0, 0.0, 0.0)
@@ -510,8 +513,17 @@ class ModalIntegrator:
         self.ys = np.asarray(ys)
         self.t_last = float(t[-1])
         # forces: the modes past the kept ones add EI (w2''' - sum_kept) d^2y/dt^2 (y the moment through the
-        # creep filter), the second static of transfer(); the kinematic outputs' tail is below rounding
-        ydd = np.gradient(np.gradient(oy, t), t) if t.size > 2 else np.zeros(t.size)
+        # creep filter), the second static of transfer(); the kinematic outputs' tail is below rounding.
+        # d^2y/dt^2 by the backward second difference, carried over chunks (causal, the same split or not)
+        th = np.concatenate((self.hist_t, t[1:] if self.hist_t.size else t))
+        yh = np.concatenate((self.hist_y, oy[1:] if self.hist_y.size else oy))
+        ydd_all = np.zeros(th.size)
+        if th.size > 2:
+            h1 = th[2:] - th[1:-1]
+            h0 = th[1:-1] - th[:-2]
+            ydd_all[2:] = 2.0 * ((yh[2:] - yh[1:-1]) / h1 - (yh[1:-1] - yh[:-2]) / h0) / (h0 + h1)
+        ydd = ydd_all[th.size - t.size:]
+        self.hist_t, self.hist_y = th[-2:], yh[-2:]
         out = {}
         for j, k in enumerate(names):
             if k == "w":

@@ -42,6 +42,7 @@ COMMANDS = {
     "charge": "charge",
     "step": "step",
     "freq": "freq",
+    "drive": "drive",
 }
 
 #: one-line summaries for ``ipmc-asym --help`` without importing every command module
@@ -59,6 +60,7 @@ SUMMARIES = {
     "charge": "electrode charge, differential capacitance and apparent permittivity (static)",
     "step": "charging transient after a voltage step: sigma, current, moment, w vs time",
     "freq": "small-signal impedance and tip-deflection/voltage transfer function",
+    "drive": "response to any voltage waveform (step, ramp, sine, square, triangle, sums, CSV), streamed",
 }
 
 
