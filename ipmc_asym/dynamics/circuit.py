@@ -563,12 +563,12 @@ class FrequencyResult:
     H_theta: object = None
     H_F: object = None
     resonances: dict = field(default_factory=dict)
-    beam: str = "dynamic"
+    beam: str = "quasi-static"
     voltage: float = 0.0
 
 
 def frequency_response(f, *, strip: Strip | None = None, model="constant", material: Material | None = None,
-                       method="pnp-linear", beam="dynamic", viscous_modulus=0.0, n_modes=DEFAULT_MODES,
+                       method="pnp-linear", beam="quasi-static", viscous_modulus=0.0, n_modes=DEFAULT_MODES,
                        voltage=0.0) -> FrequencyResult:
     """Impedance and tip-deflection/voltage transfer function about zero volts.
 
@@ -584,9 +584,10 @@ def frequency_response(f, *, strip: Strip | None = None, model="constant", mater
         (1 + i omega R C_g)`` (core resistance in parallel with the bulk capacitance ``C_g``, in
         series with the layers), with its error against the reference per frequency
         (:func:`circuit_impedance_error`; at most ``lambda/2``).
-    beam : {"dynamic", "quasi-static"}
+    beam : {"quasi-static", "dynamic"}
         ``dynamic``: the strip's inertia and Kelvin-Voigt damping (resonances;
-        :func:`ipmc_asym.beam.dynamics.transfer`); ``quasi-static``: the beam follows the moment.
+        :func:`ipmc_asym.beam.dynamics.transfer`; the default of ``ipmc-asym freq``);
+        ``quasi-static`` (default): the beam follows the moment.
     viscous_modulus : float
         ``eta_E`` (Pa s), default 0.
     n_modes : int

@@ -74,7 +74,7 @@ def test_frequency_response_dynamic_over_quasi_static_is_the_beam_transfer():
     from ipmc_asym.beam.dynamics import transfer
 
     f = np.array([0.5, 5.0, 21.0, 24.0, 60.0])
-    d = frequency_response(f)
+    d = frequency_response(f, beam="dynamic")
     q = frequency_response(f, beam="quasi-static")
     b = strip_beam(Strip(), NAFION_LI)
     tr = transfer(f, b, "clamped-free")
