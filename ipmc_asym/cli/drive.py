@@ -142,6 +142,7 @@ def run(args):
     print(f"{'t [s]':>11s} {'phi0 [V]':>9s} {'sigma [C/m^2]':>14s} {'J [A/m^2]':>11s} {'M_A [N m]':>11s} "
           f"{'theta':>9s} {'w [mm]':>9s} {'F_block [mN]':>12s}")
     for r in shown:
+        r = {k: v + 0.0 for k, v in r.items()}  # no "-0" in the table
         print(f"{r['t']:11.4g} {r['phi0']:9.4g} {r['sigma']:14.6g} {r['current_density']:11.4g} {r['M_A']:11.4g} "
               f"{r['theta']:9.4g} {r['w'] * 1e3:9.4g} {r['F_block'] * 1e3:12.4g}")
     for n in info["notes"]:
