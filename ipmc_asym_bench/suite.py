@@ -108,6 +108,7 @@ SECTIONS: dict[str, str] = {
     "uq": "ipmc_asym_bench.uq:section",
     "distributed": "ipmc_asym_bench.distributed:section",
     "charge": "ipmc_asym_bench.charge:section",  # charge, step circuit/pnp
+    "dynamics": "ipmc_asym_bench.dynamics:section",  # freq 1000 frequencies, 10^5-point sine drive
 }
 
 

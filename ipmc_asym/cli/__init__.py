@@ -44,6 +44,7 @@ COMMANDS = {
     "freq": "freq",
     "materials": "materials",
     "design": "design",
+    "drive": "drive",
 }
 
 #: one-line summaries for ``ipmc-asym --help`` without importing every command module
@@ -63,6 +64,7 @@ SUMMARIES = {
     "freq": "small-signal impedance and tip-deflection/voltage transfer function",
     "materials": "the material sets: every value with its unit, source and range",
     "design": "choose length, width, thickness, voltage to meet a target (optimum, active constraints, Pareto front)",
+    "drive": "response to any voltage waveform (step, ramp, sine, square, triangle, sums, CSV), streamed",
 }
 
 

@@ -7,7 +7,16 @@ import numpy as np
 from ipmc_asym.base.registry import model_names
 from ipmc_asym.base.units import parse_quantity
 from ipmc_asym.cli import SUMMARIES
-from ipmc_asym.cli.common import add_strip_options, arg_type, count_type, diffusion_type, material_from_args, strip_from_args
+from ipmc_asym.cli.common import (
+    add_strip_options,
+    arg_type,
+    count_type,
+    diffusion_type,
+    material_from_args,
+    strip_from_args,
+    voltage_type,
+)
+from ipmc_asym.cli.drive import add_beam_options
 from ipmc_asym.dynamics.circuit import FREQ_METHODS, frequency_response
 from ipmc_asym.dynamics.reduction import transfer_function
 from ipmc_asym.io.fileio import atomic_write, check_output_path
@@ -35,6 +44,9 @@ def register(sub):
                    help="pnp-linear (exact linearised PNP, closed form) or circuit (R + 1/(i w C_d))")
     p.add_argument("--diffusion", type=diffusion_type(), default=None,
                    help="cation diffusion coefficient D (1e-10m2/s, 1e-6cm2/s; a bare number is m^2/s)")
+    p.add_argument("--voltage", type=voltage_type("--voltage"), default=0.0,
+                   help="DC bias (e.g. 0.5V): small signal about the biased static state (method circuit)")
+    add_beam_options(p, "dynamic")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--export", metavar="F.json", default=None,
                    help="write reduced-order models of V -> w and V -> charge over [--from, --to] (poles, residues, "
@@ -65,15 +77,29 @@ def run(args):
         material = material.with_(D=args.diffusion)
     strip = strip_from_args(args)
     f = np.geomspace(args.f1, args.f2, args.points)
-    r = frequency_response(f, strip=strip, model=args.model, material=material, method=args.method)
-    cols = {"f": r.f, "Z_re": r.Z.real, "Z_im": r.Z.imag, "w_amp": r.w_amp, "w_phase": r.w_phase}
+    if args.voltage != 0.0 and args.method != "circuit":
+        raise ValueError("--voltage (a DC bias) needs --method circuit: pnp-linear is the linearisation about 0 V")
+    r = frequency_response(f, strip=strip, model=args.model, material=material, method=args.method, beam=args.beam,
+                           viscous_modulus=args.viscous_modulus, voltage=args.voltage)
+    cols = {"f": r.f, "Z_re": r.Z.real, "Z_im": r.Z.imag, "w_amp": r.w_amp, "w_phase": r.w_phase,
+            "theta_amp": np.abs(r.H_theta), "theta_phase": np.angle(r.H_theta),
+            "F_amp": np.abs(r.H_F), "F_phase": np.angle(r.H_F)}
+    if r.error is not None:
+        cols["error"] = r.error
     head = {"tau": r.tau, "model": r.model, "method": r.method, "thickness_total": strip.thickness,
+            "f_d": r.f_d, "voltage": r.voltage, "beam": r.beam, "viscous_modulus": args.viscous_modulus,
+            "resonances": r.resonances, "error_max": None if r.error is None else r.error_max,
+            "reference": "pnp-linear (exact linearised Nernst-Planck/Gauss)",
             "electrode_area": strip.width * strip.length, "diffusion_coefficient": material.D,
-            "units": {"f": "Hz", "Z": "Ohm (strip, electrode area 2l L)", "w_amp": "m/V", "w_phase": "rad"},
-            "notes": r.notes + ["about phi0 = 0; w from the layers' charge, small displacements"]}
+            "units": {"f": "Hz", "Z": "Ohm (strip, electrode area 2l L)", "w_amp": "m/V", "w_phase": "rad",
+                      "theta_amp": "rad/V (free tip)", "theta_phase": "rad", "F_amp": "N/V (blocked tip)",
+                      "F_phase": "rad", "error": "relative, of Z and w against pnp-linear"},
+            "notes": r.notes + [f"about phi0 = {r.voltage:g} V; w from the layers' charge, small displacements"]}
     if args.export is not None:
         fits = {o: transfer_function(args.f1, args.f2, strip=strip, model=args.model, material=material, output=o,
-                                     method=args.method, tol=args.export_tol) for o in ("w", "charge")}
+                                     method=args.method, tol=args.export_tol, beam=args.beam,
+                                     viscous_modulus=args.viscous_modulus, voltage=args.voltage)
+                for o in ("w", "charge")}
         doc = {"models": {o: t.to_dict() for o, t in fits.items()}, "thickness_total": strip.thickness,
                "electrode_area": strip.width * strip.length, "diffusion_coefficient": material.D,
                "notes": ["current = s x charge (the bulk's geometric capacitance makes V -> current improper)"]}
@@ -86,11 +112,17 @@ def run(args):
         out.update(cols)
         print(dumps(out, indent=1))
         return 0
-    print(f"small signal about 0 V, model {r.model}, method {r.method}, total thickness 2e = "
+    print(f"small signal about {r.voltage:g} V, model {r.model}, method {r.method}, beam {r.beam}, total thickness 2e = "
           f"{strip.thickness * 1e6:.4g} um: tau = {r.tau:.4g} s, D = {material.D:.3g} m^2/s")
-    print(f"{'f [Hz]':>11s} {'Z_re [Ohm]':>12s} {'Z_im [Ohm]':>12s} {'|w|/V [mm/V]':>13s} {'phase [rad]':>11s}")
+    if r.beam == "dynamic":
+        print(f"resonances: free tip {', '.join(f'{v:.4g}' for v in r.resonances['clamped-free'])} Hz; "
+              f"blocked tip {', '.join(f'{v:.4g}' for v in r.resonances['clamped-pinned'])} Hz")
+    ecol = r.error is not None
+    print(f"{'f [Hz]':>11s} {'Z_re [Ohm]':>12s} {'Z_im [Ohm]':>12s} {'|w|/V [mm/V]':>13s} {'phase [rad]':>11s}"
+          + (f" {'error':>9s}" if ecol else ""))
     for i in range(f.size):
-        print(f"{f[i]:11.4g} {r.Z.real[i]:12.5g} {r.Z.imag[i]:12.5g} {r.w_amp[i] * 1e3:13.5g} {r.w_phase[i]:11.4g}")
+        print(f"{f[i]:11.4g} {r.Z.real[i]:12.5g} {r.Z.imag[i]:12.5g} {r.w_amp[i] * 1e3:13.5g} {r.w_phase[i]:11.4g}"
+              + (f" {r.error[i]:9.2g}" if ecol else ""))
     for n in head["notes"]:
         print(f"note: {n}")
     if args.export is not None:

@@ -19,7 +19,9 @@ from ipmc_asym.cli.common import (
     material_from_args,
     strip_from_args,
 )
+from ipmc_asym.cli.drive import add_beam_options
 from ipmc_asym.dynamics.circuit import STEP_FIDELITIES, step_response
+from ipmc_asym.dynamics.waveforms import parse_waveform
 from ipmc_asym.io.fileio import atomic_write, check_output_path
 from ipmc_asym.io.jsonio import dumps
 
@@ -40,11 +42,17 @@ def register(sub):
                    help="end time (e.g. 0.2s, 50ms; default 5 tau)")
     p.add_argument("--fidelity", default="circuit", choices=STEP_FIDELITIES,
                    help="circuit (reduced nonlinear capacitor) or pnp (transient Nernst-Planck/Gauss)")
-    p.add_argument("--model", default="constant", choices=list(model_names()), help="permittivity model")
+    p.add_argument("--model", default="constant", choices=list(model_names()) + ["all"],
+                   help="permittivity model (all: each in turn)")
     p.add_argument("--diffusion", type=diffusion_type(), default=None,
                    help="cation diffusion coefficient D (1e-10m2/s, 1e-6cm2/s; a bare number is m^2/s)")
     p.add_argument("--points", type=count_type("--points", 2), default=1000, help="output times (default 1000)")
-    p.add_argument("--out", default=None, help="CSV file (columns t, phi0, sigma, current_density, M_A, theta, w)")
+    p.add_argument("--waveform", type=arg_type(parse_waveform, "--waveform"), default=None,
+                   help="instead of the step of --voltage: a SPEC such as 'sine:1V@10Hz' or 'step:1V+square:0.1V@5Hz' "
+                        "(see ipmc-asym drive --help)")
+    add_beam_options(p, "quasi-static")
+    p.add_argument("--out", default=None, help="CSV file (columns t, phi0, sigma, current_density, M_A, theta, w; "
+                                               "a first column model with --model all)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
 
 
@@ -56,36 +64,62 @@ def run(args):
         material = material.with_(D=args.diffusion)
     strip = strip_from_args(args)
     first_run_notice()
-    r = step_response(strip.voltage, args.duration, strip=strip, model=args.model, fidelity=args.fidelity,
-                      material=material, points=args.points)
-    cols = {"t": r.t, "phi0": r.phi0, "sigma": r.sigma, "current_density": r.current_density, "M_A": r.M_A,
-            "theta": r.theta, "w": r.w}
+    models = list(model_names()) if args.model == "all" else [args.model]
+    kind = args.waveform if args.waveform is not None else "step"
+    results = {}
+    for mname in models:
+        results[mname] = step_response(strip.voltage, args.duration, strip=strip, model=mname, fidelity=args.fidelity,
+                                       material=material, points=args.points, waveform_kind=kind, beam=args.beam,
+                                       viscous_modulus=args.viscous_modulus)
+
+    def cols_of(r):
+        return {"t": r.t, "phi0": r.phi0, "sigma": r.sigma, "current_density": r.current_density, "M_A": r.M_A,
+                "theta": r.theta, "w": r.w}
+
+    r0 = results[models[0]]
+    drive = "step" if args.waveform is None else args.waveform.spec
     if args.out:
+        many = len(models) > 1
         with atomic_write(args.out) as fh:
             wr = csv.writer(fh)
-            wr.writerow([f"# tau = {r.tau!r} s; thickness_total = {strip.thickness!r} m; model = {r.model}; "
-                         f"fidelity = {r.fidelity}; SI units"])
-            wr.writerow(COLUMNS)
-            for i in range(r.t.size):
-                wr.writerow([repr(float(cols[c][i])) for c in COLUMNS])
-        sys.stderr.write(f"step: {r.t.size} rows -> {args.out}\n")
-    head = {"tau": r.tau, "R": r.R, "C_d0": r.C_d0, "model": r.model, "fidelity": r.fidelity,
-            "voltage": strip.voltage, "thickness_total": strip.thickness, "half_thickness_e": strip.e,
-            "diffusion_coefficient": material.D, "seconds": r.seconds, "notes": r.notes, "message": r.message}
+            taus = ", ".join(f"{m}: {results[m].tau!r}" for m in models)
+            wr.writerow([f"# tau = {taus} s; thickness_total = {strip.thickness!r} m; model = {args.model}; "
+                         f"fidelity = {r0.fidelity}; drive = {drive}; beam = {args.beam}; SI units; {r0.notes[0]}"])
+            wr.writerow((("model",) if many else ()) + COLUMNS)
+            for mname in models:
+                cols = cols_of(results[mname])
+                for i in range(results[mname].t.size):
+                    wr.writerow(([mname] if many else []) + [repr(float(cols[c][i])) for c in COLUMNS])
+        sys.stderr.write(f"step: {sum(r.t.size for r in results.values())} rows -> {args.out}\n")
+
+    def head_of(r):
+        return {"tau": r.tau, "R": r.R, "C_d0": r.C_d0, "model": r.model, "fidelity": r.fidelity,
+                "voltage": strip.voltage, "thickness_total": strip.thickness, "half_thickness_e": strip.e,
+                "diffusion_coefficient": material.D, "seconds": r.seconds, "notes": r.notes, "message": r.message,
+                "waveform": drive, "beam": args.beam}
+
     if args.json:
-        out = dict(head)
-        out.update({c: cols[c] for c in COLUMNS})
+        if len(models) == 1:
+            out = head_of(r0)
+            out.update(cols_of(r0))
+        else:
+            out = {"model": "all", "notes": r0.notes, "thickness_total": strip.thickness,
+                   "models": {m: dict(head_of(results[m]), **cols_of(results[m])) for m in models}}
         print(dumps(out, indent=1))
         return 0
     if not args.out:
-        print(f"step {strip.voltage:g} V, total thickness 2e = {fmt_length(strip.thickness)}, model {r.model}, "
-              f"fidelity {r.fidelity}: tau = {r.tau:.4g} s (R = {r.R:.4g} Ohm m^2, C_d(0) = {r.C_d0:.4g} F/m^2, "
-              f"D = {material.D:.3g} m^2/s)")
-        idx = np.unique(np.linspace(0, r.t.size - 1, min(r.t.size, 11)).astype(int))
-        print(f"{'t [s]':>11s} {'sigma [C/m^2]':>14s} {'J [A/m^2]':>11s} {'M_A [N m]':>11s} {'theta':>9s} {'w [mm]':>9s}")
-        for i in idx:
-            print(f"{r.t[i]:11.4g} {r.sigma[i]:14.6g} {r.current_density[i]:11.4g} {r.M_A[i]:11.4g} "
-                  f"{r.theta[i]:9.4g} {r.w[i] * 1e3:9.4g}")
-        for n in r.notes:
+        for mname in models:
+            r = results[mname]
+            what = f"step {strip.voltage:g} V" if args.waveform is None else f"waveform {drive}"
+            print(f"{what}, total thickness 2e = {fmt_length(strip.thickness)}, model {r.model}, "
+                  f"fidelity {r.fidelity}, beam {args.beam}: tau = {r.tau:.4g} s (R = {r.R:.4g} Ohm m^2, "
+                  f"C_d(0) = {r.C_d0:.4g} F/m^2, D = {material.D:.3g} m^2/s)")
+            idx = np.unique(np.linspace(0, r.t.size - 1, min(r.t.size, 11)).astype(int))
+            print(f"{'t [s]':>11s} {'sigma [C/m^2]':>14s} {'J [A/m^2]':>11s} {'M_A [N m]':>11s} {'theta':>9s} "
+                  f"{'w [mm]':>9s}")
+            for i in idx:
+                print(f"{r.t[i]:11.4g} {r.sigma[i]:14.6g} {r.current_density[i]:11.4g} {r.M_A[i]:11.4g} "
+                      f"{r.theta[i]:9.4g} {r.w[i] * 1e3:9.4g}")
+        for n in r0.notes:
             print(f"note: {n}")
     return 0

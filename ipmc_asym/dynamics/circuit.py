@@ -28,8 +28,8 @@ Outside this model (stated in every dynamic output): water transport (the paper'
 and the back-relaxation it causes; the solvent is at rest.
 
 Small signal about ``phi0 = 0``: the exact linearised PNP impedance and moment transfer
-(closed forms, ``derivations/charge.py``), and the circuit's ``R + 1/(i omega C_d(0))`` and
-``H(0)/(1 + i omega tau)``.
+(closed forms, ``derivations/charge.py``; the reference), and the circuit linearised,
+``(R + 1/(i omega C_d(0)))/(1 + i omega R C_g)``, with its error against the reference.
 """
 
 from __future__ import annotations
@@ -41,11 +41,20 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ipmc_asym.base.registry import check_choice
+from ipmc_asym.beam.dynamics import (
+    DEFAULT_MODES,
+    VISCOUS_MODULUS_SOURCE,
+    Beam,
+    ModalIntegrator,
+    natural_frequencies,
+    transfer,
+)
 from ipmc_asym.dynamics.electrode import (
     _GL_W,
     _GL_X,
     _model_id,
     capacitance_scale,
+    charge,
     charge_hat_point,
     charge_scale,
     core_resistance,
@@ -67,15 +76,71 @@ from ipmc_asym.model.params import (
 from ipmc_asym.model.permittivity import Permittivity, get_model
 
 __all__ = ["DYNAMIC_NOTES", "StepResult", "FrequencyResult", "core_resistance", "time_constant",
-           "waveform", "step_response", "frequency_response", "circuit_response", "quasi_static_mechanics"]
+           "waveform", "step_response", "frequency_response", "circuit_response", "quasi_static_mechanics",
+           "circuit_impedance_error", "circuit_band"]
 
 #: stated in every dynamic output
+WATER_NOTE = ("water transport (the paper's Darcy law) and the back-relaxation it causes are outside this model: "
+              "the solvent is at rest")
+QUASI_STATIC_NOTE = "no beam inertia or damping: theta, w and the blocking force follow the moment quasi-statically"
+INERTIA_NOTE = ("beam dynamics: Euler-Bernoulli strip with inertia (rho = (1 - phi4) rho3 + phi4 rho2) and Kelvin-Voigt "
+                "damping (eq. (3)), modal expansion on the exact modes (free tip: w, theta; blocked tip: F_block), "
+                "static limit = the quasi-static forward model; the dynamic correction is linear (small displacements)")
 DYNAMIC_NOTES = (
-    "water transport (the paper's Darcy law) and the back-relaxation it causes are outside this model: "
-    "the solvent is at rest",
-    "no beam inertia or damping: theta, w and the blocking force follow the moment quasi-statically",
+    WATER_NOTE,
+    QUASI_STATIC_NOTE,
     "the cation diffusion coefficient D is not in the paper; " + D_CATION_SOURCE,
 )
+BEAM_CHOICES = ("quasi-static", "dynamic")
+
+
+def dynamic_notes(beam="quasi-static", viscous_modulus=0.0):
+    """The notes every dynamic output carries (water transport out of scope, beam model, D source)."""
+    check_choice("beam", beam, BEAM_CHOICES)
+    notes = list(DYNAMIC_NOTES)
+    if beam == "dynamic":
+        notes[1] = INERTIA_NOTE + f"; viscous modulus {float(viscous_modulus):g} Pa s"
+        notes.append(VISCOUS_MODULUS_SOURCE)
+    return notes
+
+
+def strip_beam(strip: Strip, material: Material, viscous_modulus=0.0) -> Beam:
+    """The strip's beam (``E I_p``, mass per length of the hydrated membrane, ``tau_v = eta_E/E``)."""
+    return Beam.from_strip(strip.length, strip.width, strip.thickness, material, viscous_modulus)
+
+
+#: modes kept in the time domain (with the static correction the tip deflection's tail from mode 21 on is
+#: ~(f/f_21)^2 b_21^-3 ~ 1e-11 of the static value for content at the first resonance)
+TIME_MODES = 20
+
+
+class BeamDynamics:
+    """Free tip (``w``, ``theta``) and blocked tip (``F_block``) driven by ``M_A(t)``, chunk by chunk."""
+
+    def __init__(self, strip: Strip, material: Material, viscous_modulus=0.0, n_modes=TIME_MODES):
+        self.beam = strip_beam(strip, material, viscous_modulus)
+        self.free = ModalIntegrator(self.beam, "clamped-free", n_modes)
+        self.blocked = ModalIntegrator(self.beam, "clamped-pinned", n_modes)
+        self.period = 1.0 / float(natural_frequencies("clamped-free", self.beam, 1)[0])
+
+    def advance(self, t, M, theta, w, F_block):
+        a = self.free.advance(t, M, {"w": w, "theta": theta})
+        b = self.blocked.advance(t, M, {"F": F_block})
+        return a["theta"], a["w"], b["F"]
+
+
+def _beam_grid(t, period, cap=5_000_000):
+    """``t`` refined to >= 40 points per period of the first mode (first-order hold of M_A); indices of ``t``."""
+    h = period / 40.0
+    dt = np.diff(t)
+    k = np.maximum(1, np.ceil(dt / h)).astype(np.int64)
+    if k.sum() > cap:
+        raise ValueError(f"beam dynamics need >= 40 time points per period of the first mode (T1 = {period:.3g} s): "
+                         f"{int(k.sum())} points exceed {cap}; shorten the duration")
+    idx = np.concatenate(([0], np.cumsum(k)))
+    frac = np.arange(idx[-1]) - np.repeat(idx[:-1], k)
+    tf = np.concatenate((np.repeat(t[:-1], k) + np.repeat(dt / k, k) * frac, [t[-1]]))
+    return tf, idx
 
 STEP_FIDELITIES = ("circuit", "pnp")
 WAVEFORMS = ("step", "ramp", "sine")
@@ -123,7 +188,8 @@ class StepResult:
     current_density : ndarray     dsigma/dt, A/m^2
     layer_voltage : ndarray       voltage across the two electrode layers, V (circuit: V(sigma_L); pnp: phi0 - R J)
     M_A, theta, w, F_block : ndarray   moment (N m), rotation (rad), tip deflection (m),
-                                  blocking force (N), quasi-static
+                                  blocking force (N); quasi-static, or with beam="dynamic" the
+                                  strip's inertia and damping (quasi-static values in ``extra``)
     tau : float                   linear time constant R C_d(0), s
     R : float                     core resistance per area, Ohm m^2
     C_d0 : float                  C_d(0), F/m^2
@@ -163,19 +229,21 @@ def _shat(A, rho, mid, X, Wt):
 
 
 @jit
-def _integrate(tt, ps, rho, mid, X, Wt, A_out, s_out):
+def _integrate(tt, ps, rho, mid, X, Wt, A_out, s_out, state):
     """Variable-step BDF2 (first step backward Euler) for ds/dt = (psi0 - A)/2, s = s(A).
 
     Time in units of tau, voltages in R T/F.  Each implicit step solves the monotone scalar
-    equation a0 s(A) + h A/2 = rhs by Newton with a bisection safeguard.
+    equation a0 s(A) + h A/2 = rhs by Newton with a bisection safeguard.  ``state`` =
+    ``(A, A_prev, s, s_prev, h_prev)`` at ``tt[0]`` on entry (zeros: at rest, uncharged), at
+    ``tt[-1]`` on return: a run split into chunks is the same run.
     """
-    A = 0.0
-    A_prev = 0.0
-    s = 0.0
-    s_prev = 0.0
-    h_prev = 0.0
-    A_out[0] = 0.0
-    s_out[0] = 0.0
+    A = state[0]
+    A_prev = state[1]
+    s = state[2]
+    s_prev = state[3]
+    h_prev = state[4]
+    A_out[0] = A
+    s_out[0] = s
     for n in range(1, tt.shape[0]):
         h = tt[n] - tt[n - 1]
         if h <= 0.0:
@@ -218,6 +286,11 @@ def _integrate(tt, ps, rho, mid, X, Wt, A_out, s_out):
         h_prev = h
         A_out[n] = A
         s_out[n] = s
+    state[0] = A
+    state[1] = A_prev
+    state[2] = s
+    state[3] = s_prev
+    state[4] = h_prev
 
 
 def quasi_static_mechanics(u, strip: Strip, perm: Permittivity, material: Material):
@@ -249,43 +322,70 @@ def _time_grid(duration, t, points):
     return np.linspace(0.0, d, n)
 
 
+class CircuitStepper:
+    """The reduced model integrated chunk by chunk on increasing output times (state carried over).
+
+    ``advance(t)`` (s; the first time equal to the previous chunk's last, or 0 at the start,
+    uncharged) returns ``(u, ub)``: the layer voltage ``V(sigma_L)`` and the core's voltage
+    ``phi0 - u`` (V), and ``sigma`` (C/m^2, layers plus the bulk's displacement charge).
+    Substeps between output times: BDF2 with ``h <= tau/200``, at least ``substeps`` on an
+    interval longer than ``tau/400``.
+    """
+
+    def __init__(self, phi0_fun, strip: Strip, perm: Permittivity, material: Material, substeps: int = 2):
+        self.fun, self.strip, self.perm, self.m = phi0_fun, strip, perm, material
+        self.VT = groups.thermal_voltage(material)
+        self.tau = float(time_constant(strip.thickness, perm, material))
+        self.substeps = int(substeps)
+        self.state = np.zeros(5)
+        self.rho = perm.eps0 / perm.eps_moy
+        self.mid = _model_id(perm, "corrected")
+        self.Cg = float(groups.geometric_capacitance(strip.thickness, perm.eps_moy))
+        self.S = charge_scale(perm, material)
+        self.t_last = 0.0
+
+    def advance(self, t):
+        t = np.asarray(t, dtype=float)
+        if t[0] != self.t_last:
+            raise ValueError("each chunk must start at the last time of the previous one (0 at the start)")
+        tau = self.tau
+        dt = np.diff(t) / tau
+        k = np.maximum(np.ceil(dt / 5e-3), np.where(dt <= 2.5e-3, 1, self.substeps)).astype(np.int64)
+        if k.sum() > 5_000_000:
+            raise ValueError("duration is too long for the reduced model's fixed substeps (> 1e6 tau in one chunk); "
+                             "use fewer time constants")
+        idx = np.concatenate(([0], np.cumsum(k)))
+        frac = np.arange(idx[-1]) - np.repeat(idx[:-1], k)
+        tt = np.concatenate((np.repeat(t[:-1] / tau, k) + np.repeat(dt / k, k) * frac, [t[-1] / tau]))
+        ps = self.fun(tt * tau) / self.VT
+        A = np.empty(tt.size)
+        s = np.empty(tt.size)
+        _integrate(tt, ps, self.rho, self.mid, _GL_X, _GL_W, A, s, self.state)
+        A, s = A[idx], s[idx]
+        u = self.VT * A
+        self.t_last = float(t[-1])
+        ub = self.fun(t) - u
+        # the bulk is a leaky dielectric: besides the layers' charge the electrodes carry the
+        # displacement charge C_g (phi0 - u) of the core, C_g = eps_core/(2e) (its relaxation time
+        # R C_g = lambda^2 e^2/D is instantaneous on the scale tau); C_g/C_d(0) = lambda
+        sigma = self.S * s + self.Cg * ub
+        return u, ub, sigma
+
+
 def circuit_response(t, phi0_fun, strip: Strip, perm: Permittivity, material: Material, substeps: int = 2):
     """Integrate the reduced model on the time grid ``t`` (s); returns ``(sigma, u, J)``."""
-    m = material
-    VT = groups.thermal_voltage(m)
-    tau = float(time_constant(strip.thickness, perm, m))
-    # substeps between output times (BDF2 accuracy): at least `substeps`, and h <= tau/200;
-    # times in units of tau
-    dt = np.diff(t) / tau
-    k = np.maximum(int(substeps), np.ceil(dt / 5e-3)).astype(np.int64)
-    if k.sum() > 5_000_000:
-        raise ValueError("duration is too long for the reduced model's fixed substeps (> 1e6 tau); "
-                         "use fewer time constants")
-    idx = np.concatenate(([0], np.cumsum(k)))
-    frac = np.arange(idx[-1]) - np.repeat(idx[:-1], k)
-    tt = np.concatenate((np.repeat(t[:-1] / tau, k) + np.repeat(dt / k, k) * frac, [t[-1] / tau]))
-    ps = phi0_fun(tt * tau) / VT
-    A = np.empty(tt.size)
-    s = np.empty(tt.size)
-    rho = perm.eps0 / perm.eps_moy
-    _integrate(tt, ps, rho, _model_id(perm, "corrected"), _GL_X, _GL_W, A, s)
-    A, s = A[idx], s[idx]
-    u = VT * A
-    # the bulk is a leaky dielectric: besides the layers' charge the electrodes carry the
-    # displacement charge C_g (phi0 - u) of the core, C_g = eps_core/(2e) (its relaxation time
-    # R C_g = lambda^2 e^2/D is instantaneous on the scale tau); C_g/C_d(0) = lambda
-    Cg = groups.geometric_capacitance(strip.thickness, perm.eps_moy)
-    ub = phi0_fun(t) - u
-    sigma = charge_scale(perm, m) * s + Cg * ub
-    J = ub / float(core_resistance(strip.thickness, m))
+    stepper = CircuitStepper(phi0_fun, strip, perm, material, substeps)
+    u, ub, sigma = stepper.advance(t)
+    J = ub / float(core_resistance(strip.thickness, material))
     if t.size > 2:
-        J = J + Cg * np.gradient(ub, t)
+        J = J + stepper.Cg * np.gradient(ub, t)
     return sigma, u, J
 
 
 def step_response(voltage=1.0, duration=None, *, strip: Strip | None = None, model="constant",
                   fidelity="circuit", material: Material | None = None, t=None, points: int = 1000,
-                  waveform_kind="step", ramp_time=None, frequency=None, pnp_options=None) -> StepResult:
+                  waveform_kind="step", ramp_time=None, frequency=None, pnp_options=None, beam="quasi-static",
+                  viscous_modulus=0.0, n_modes=TIME_MODES) -> StepResult:
     """Charging transient of the strip under an imposed ``phi0(t)`` (starting uncharged at t = 0).
 
     Parameters
@@ -310,6 +410,14 @@ def step_response(voltage=1.0, duration=None, *, strip: Strip | None = None, mod
         For ``ramp`` (s) and ``sine`` (Hz).
     pnp_options : dict, optional
         Passed to :func:`ipmc_asym.dynamics.transient.solve_transient` (``cells_per_debye``, ``rtol``, ...).
+    beam : {"quasi-static", "dynamic"}
+        ``dynamic``: the strip's inertia and Kelvin-Voigt damping (:mod:`ipmc_asym.beam.dynamics`)
+        on top of the quasi-static outputs (kept in ``extra``); the time grid is refined to 40
+        points per period of the first mode for the mechanics.
+    viscous_modulus : float
+        ``eta_E`` (Pa s) of the Kelvin-Voigt law; default 0 (no source gives a value).
+    n_modes : int
+        Modes kept (the static correction makes the tail negligible).
 
     Returns
     -------
@@ -327,8 +435,12 @@ def step_response(voltage=1.0, duration=None, *, strip: Strip | None = None, mod
     tau = float(time_constant(s.thickness, perm, m))
     tgrid = _time_grid(5.0 * tau if duration is None and t is None else duration, t, points)
     R = float(core_resistance(s.thickness, m))
-    notes = list(DYNAMIC_NOTES)
+    notes = dynamic_notes(beam, viscous_modulus)
     extra = {}
+    dyn = BeamDynamics(s, m, viscous_modulus, n_modes) if beam == "dynamic" else None
+    tout = tgrid
+    if dyn is not None:
+        tgrid, keep = _beam_grid(tgrid, dyn.period)
     if fidelity == "circuit":
         sigma, u, J = circuit_response(tgrid, fun, s, perm, m)
         success, message = True, "reduced model integrated (variable-step BDF2, 2 substeps per output interval)"
@@ -348,10 +460,66 @@ def step_response(voltage=1.0, duration=None, *, strip: Strip | None = None, mod
                      "extra['M_A_profiles']")
         extra = dict(extra, M_A_profiles=r.M_A_profiles)
     M, th, w, Fb = quasi_static_mechanics(u, s, perm, m)
+    if dyn is not None:
+        thd, wd, Fd = dyn.advance(tgrid, M, th, w, Fb)
+        extra = dict(extra, theta_quasi_static=th[keep], w_quasi_static=w[keep], F_block_quasi_static=Fb[keep],
+                     beam_frequencies={"clamped-free": natural_frequencies("clamped-free", dyn.beam, 3).tolist(),
+                                       "clamped-pinned": natural_frequencies("clamped-pinned", dyn.beam, 3).tolist()})
+        sigma, J, u, M, th, w, Fb = (a[keep] for a in (sigma, J, u, M, thd, wd, Fd))
+        tgrid = tout
     return StepResult(t=tgrid, phi0=fun(tgrid), sigma=sigma, current_density=J, layer_voltage=u, M_A=M,
                       theta=th, w=w, F_block=Fb, tau=tau, R=R, C_d0=0.5 * capacitance_scale(perm, m),
                       fidelity=fidelity, model=perm.name, notes=notes, success=success, message=message,
                       extra=extra, seconds=time.perf_counter() - t0)
+
+
+def circuit_impedance_error(f, thickness, perm: Permittivity, material: Material):
+    """Relative error of the circuit's impedance against the linearised PNP, per frequency.
+
+    The linearised Nernst-Planck/Gauss impedance about 0 V (``derivations/charge.py``) is
+    ``Z = [R + g/(i omega C_d(0))]/(1 + i omega R C_g)`` with the layers' exact factor
+    ``g = tanh(k e)/(k lambda_D)``, ``(k lambda_D)^2 = 1 + i omega lambda_D^2/D``; the circuit has
+    ``g = 1`` (layers in equilibrium with their charge).  Hence, exactly,
+    ``|Z_circuit - Z_pnp|/|Z_pnp| = |1 - g|/|i omega tau + g|``: ``(Omega/2)/|1 + i omega tau|``
+    well below the dielectric relaxation frequency ``f_d = D/(2 pi lambda_D^2)`` (``Omega = f/f_d``,
+    ``omega tau = Omega/lambda``), at most ``lambda/2`` (``lambda = lambda_D/e``) at any frequency
+    (checked on 20 um - 1 mm, three models, 1 mHz - 100 MHz).
+
+    Parameters
+    ----------
+    f : array_like   frequencies, Hz
+    thickness : float   TOTAL thickness 2e, m
+    perm : Permittivity ; material : Material
+
+    Returns
+    -------
+    ndarray   relative error of ``Z`` (and, to first order, of ``H_w``)
+    """
+    m = material
+    lam = float(groups.debye_length(thickness, perm.eps_moy, m))
+    lD = lam * 0.5 * thickness
+    omega = 2.0 * math.pi * np.asarray(f, dtype=float)
+    q = np.sqrt(1.0 + 1j * omega * lD * lD / m.D)
+    g = np.tanh(q / lam) / q
+    tau = float(time_constant(thickness, perm, m))
+    return np.abs(1.0 - g) / np.abs(1j * omega * tau + g)
+
+
+def circuit_band(f, error, tol):
+    """``[f_lo, f_hi]`` intervals of the sampled ``f`` (Hz) where ``error <= tol`` (list of pairs)."""
+    ok = np.asarray(error) <= tol
+    out = []
+    i = 0
+    while i < ok.size:
+        if ok[i]:
+            j = i
+            while j + 1 < ok.size and ok[j + 1]:
+                j += 1
+            out.append([float(f[i]), float(f[j])])
+            i = j + 1
+        else:
+            i += 1
+    return out
 
 
 @dataclass
@@ -368,6 +536,14 @@ class FrequencyResult:
                               H_w is the layers' (quasi-static) moment at the layer voltage V(sigma)
     tau : float ; method : str ; model : str ; notes : list
     H_w_profiles : ndarray complex or None   pnp-linear only: transfer of the full profile moment
+    error : ndarray or None   circuit: relative error of Z (and H_w) against the linearised PNP
+                              (:func:`circuit_impedance_error`); None for the reference pnp-linear
+    f_d : float               dielectric relaxation frequency D/(2 pi lambda_D^2), Hz
+    error_max : float         circuit: bound lambda/2 on ``error`` over all frequencies (0 V)
+    H_theta : ndarray complex tip rotation per volt (free tip), rad/V
+    H_F : ndarray complex     blocking force per volt (blocked tip), N/V
+    resonances : dict         first three natural frequencies (Hz) of the free and the blocked strip
+    beam : str ; voltage : float  (DC bias, V)
     """
 
     f: np.ndarray
@@ -381,13 +557,19 @@ class FrequencyResult:
     model: str
     notes: list
     H_w_profiles: object = None
-
-
-
+    error: object = None
+    f_d: float = math.nan
+    error_max: float = math.nan
+    H_theta: object = None
+    H_F: object = None
+    resonances: dict = field(default_factory=dict)
+    beam: str = "quasi-static"
+    voltage: float = 0.0
 
 
 def frequency_response(f, *, strip: Strip | None = None, model="constant", material: Material | None = None,
-                       method="pnp-linear") -> FrequencyResult:
+                       method="pnp-linear", beam="quasi-static", viscous_modulus=0.0, n_modes=DEFAULT_MODES,
+                       voltage=0.0) -> FrequencyResult:
     """Impedance and tip-deflection/voltage transfer function about zero volts.
 
     Parameters
@@ -396,15 +578,30 @@ def frequency_response(f, *, strip: Strip | None = None, model="constant", mater
         Frequencies (Hz), > 0.
     strip : Strip, optional ; model : str or Permittivity ; material : Material, optional
     method : {"pnp-linear", "circuit"}
-        ``pnp-linear``: exact closed form of the linearised Nernst-Planck/Gauss equations
-        (constant core permittivity: at 0 V every affine model linearises about ``eps_core``);
-        ``circuit``: ``R + 1/(i omega C_d(0))`` and ``H_w(0)/(1 + i omega tau)``.
+        ``pnp-linear`` (the reference): exact closed form of the linearised Nernst-Planck/Gauss
+        equations (constant core permittivity: at 0 V every affine model linearises about
+        ``eps_core``); ``circuit``: the step circuit linearised, ``Z = (R + 1/(i omega C_d(0)))/
+        (1 + i omega R C_g)`` (core resistance in parallel with the bulk capacitance ``C_g``, in
+        series with the layers), with its error against the reference per frequency
+        (:func:`circuit_impedance_error`; at most ``lambda/2``).
+    beam : {"quasi-static", "dynamic"}
+        ``dynamic``: the strip's inertia and Kelvin-Voigt damping (resonances;
+        :func:`ipmc_asym.beam.dynamics.transfer`; the default of ``ipmc-asym freq``);
+        ``quasi-static`` (default): the beam follows the moment.
+    viscous_modulus : float
+        ``eta_E`` (Pa s), default 0.
+    n_modes : int
+    voltage : float
+        DC bias (V): small signal about the biased static state (``method="circuit"`` only:
+        ``R`` in series with the layers' differential capacitance ``C_d(V)``, ``C_g`` across the
+        core; the moment slope ``dM_A/dV`` of the forward model).
 
     Returns
     -------
     FrequencyResult
     """
     check_choice("method", method, FREQ_METHODS)
+    check_choice("beam", beam, BEAM_CHOICES)
     s = Strip() if strip is None else strip
     m = NAFION_LI if material is None else material
     perm = get_model(model)
@@ -413,6 +610,9 @@ def frequency_response(f, *, strip: Strip | None = None, model="constant", mater
     f = np.asarray(f, dtype=float)
     if not np.all(np.isfinite(f)) or np.any(f <= 0):
         raise ValueError("frequencies must be finite and > 0 Hz")
+    bias = check_finite("voltage (DC bias)", voltage, "a finite number of volts")
+    if bias != 0.0 and method != "circuit":
+        raise ValueError("voltage: a DC bias needs method 'circuit' (pnp-linear is the linearisation about 0 V)")
     e = s.e
     lam = float(groups.debye_length(s.thickness, perm.eps_moy, m))
     kappa = float(groups.kappa(m))
@@ -421,25 +621,61 @@ def frequency_response(f, *, strip: Strip | None = None, model="constant", mater
     tau = float(time_constant(s.thickness, perm, m))
     # tip deflection per volt, small displacements: w = -M L^2/(2 E I_p),
     # M per volt = A5(1 V) (1 + A3) * (moment transfer), A5(1 V) = 6 l e^2 C_moy F (N m/V)
-    k_w = -s.length**2 / (2.0 * m.E * s.I_p) * float(groups.A5(s.width, s.thickness, 1.0, m)) * (1.0 + A3)
+    w_per_M = -s.length**2 / (2.0 * m.E * s.I_p)
+    k_w = w_per_M * float(groups.A5(s.width, s.thickness, 1.0, m)) * (1.0 + A3)
     R = float(core_resistance(s.thickness, m))
+    C0 = 0.5 * capacitance_scale(perm, m)
     # DC transfer: the static moment slope at 0 V, I(0+) = (1 + A3)(lam coth(1/lam) - lam^2)
     h0 = k_w * float(GC.moment_transfer_hat(np.array([1e-12]), lam)[0].real)
+    err = None
+    if bias != 0.0:
+        # about the biased static state: the layers' differential capacitance C_d(V) and the
+        # forward model's moment slope dM_A/dV (central difference, step 1e-4 R T/F)
+        C0 = float(charge(s.thickness, bias, perm, "corrected", material=m).C_diff)
+        tau = R * C0
+        dv = 1e-4 * groups.thermal_voltage(m)
+        Mp, Mm = (quasi_static_mechanics(np.array([bias + d]), s, perm, m)[0][0] for d in (dv, -dv))
+        h0 = w_per_M * (Mp - Mm) / (2.0 * dv)
     if method == "pnp-linear":
         W = omega * e * e / m.D
         Za = (e / kappa) * GC.impedance_hat(W, lam)
         Hprof = k_w * GC.moment_transfer_hat(W, lam)
     else:
-        C0 = 0.5 * capacitance_scale(perm, m)
-        Za = R + 1.0 / (1j * omega * C0)
+        # the step circuit (circuit_response) linearised: layers C_d in series with the core,
+        # the core's resistance R in parallel with its geometric capacitance C_g (a leaky dielectric)
+        Cg = float(groups.geometric_capacitance(s.thickness, perm.eps_moy))
+        Za = (R + 1.0 / (1j * omega * C0)) / (1.0 + 1j * omega * R * Cg)
         Hprof = None
-    # the layers' moment follows their charge: u = V(sigma) = sigma/C_d(0) = J/(i omega C_d(0))
-    Hw = h0 / (1j * omega * 0.5 * capacitance_scale(perm, m) * Za)
+        err = circuit_impedance_error(f, s.thickness, perm, m) if bias == 0.0 else None
+    # the layers' moment follows their charge: u = V(sigma) = sigma/C_d = J/(i omega C_d)
+    Hw = h0 / (1j * omega * C0 * Za)
+    HM = Hw / w_per_M  # moment per volt, N m/V
+    b = strip_beam(s, m, viscous_modulus)
+    if beam == "dynamic":
+        cf = transfer(f, b, "clamped-free", n_modes)
+        cp = transfer(f, b, "clamped-pinned", n_modes)
+        Hw = HM * cf["w"]
+        Htheta = HM * cf["theta"]
+        HF = HM * cp["F"]
+    else:
+        Htheta = HM * (-s.length / b.EI)
+        HF = HM * (1.5 / s.length)
+    resonances = {sup: natural_frequencies(sup, b, 3).tolist() for sup in ("clamped-free", "clamped-pinned")}
     area = s.width * s.length
-    notes = list(DYNAMIC_NOTES)
+    notes = dynamic_notes(beam, viscous_modulus)
+    if bias != 0.0:
+        notes.append(f"small signal about the static state at {bias:g} V (circuit: R, C_d({bias:g} V), C_g; "
+                     "dM_A/dV of the forward model); its error against a linearised PNP about the bias is not computed")
+    f_d = m.D / (2.0 * math.pi * (lam * e) ** 2)
     if Hprof is not None:
         notes.append("H_w_profiles: the moment of the linearised profiles, p' = (C + A3) E, which adds the pressure "
                      "gradient of the ohmic core field (-> (1 + A3)/3 per unit psi0 at high frequency, ~1/(3 lambda) "
                      "times the static slope); with the solvent at rest nothing relaxes it -- water flow would")
+    else:
+        notes.append(f"circuit: relative error of Z and H_w against the linearised PNP (the reference) in 'error', "
+                     f"~(f/(2 f_d))/|1 + i omega tau| below the dielectric relaxation frequency f_d = {f_d:.4g} Hz, at most "
+                     f"lambda/2 = {0.5 * lam:.3g} at any frequency")
     return FrequencyResult(f=f, Z=Za / area, Z_area=Za, H_w=Hw, w_amp=np.abs(Hw), w_phase=np.angle(Hw), tau=tau,
-                           method=method, model=perm.name, notes=notes, H_w_profiles=Hprof)
+                           method=method, model=perm.name, notes=notes, H_w_profiles=Hprof, error=err, f_d=f_d,
+                           error_max=0.5 * lam if err is not None else math.nan, H_theta=Htheta, H_F=HF,
+                           resonances=resonances, beam=beam, voltage=bias)

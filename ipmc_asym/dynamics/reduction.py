@@ -167,7 +167,7 @@ def vector_fit(s, H, order, iterations=12, proper=True):
 
 
 def transfer_function(f_min, f_max, *, strip: Strip | None = None, model="constant", material: Material | None = None,
-                      output="w", method="pnp-linear", tol=1e-4, points=200) -> RationalModel:
+                      output="w", method="pnp-linear", tol=1e-4, points=200, **response_kw) -> RationalModel:
     """A reduced-order rational model of ``output`` over the band ``[f_min, f_max]`` (Hz).
 
     Parameters
@@ -185,6 +185,10 @@ def transfer_function(f_min, f_max, *, strip: Strip | None = None, model="consta
         Relative error aimed at on the band, in (0, 1).
     points : int
         Log-spaced fit frequencies (the check grid has four times as many), 20-5000.
+    **response_kw
+        Passed to :func:`~ipmc_asym.dynamics.circuit.frequency_response` (``beam="dynamic"``,
+        ``viscous_modulus``, ``voltage``): the fit is of that response.  An undamped dynamic
+        beam has its resonances on the imaginary axis; give a viscous modulus for a fit across them.
 
     Returns
     -------
@@ -214,7 +218,7 @@ def transfer_function(f_min, f_max, *, strip: Strip | None = None, model="consta
     m = NAFION_LI if material is None else material
 
     def full(f):
-        r = frequency_response(f, strip=s_, model=model, material=m, method=method)
+        r = frequency_response(f, strip=s_, model=model, material=m, method=method, **response_kw)
         if output in ("charge", "current"):
             # fitted as the charge per volt Q = Y/s: the current I = s Q has a zero at s = 0 that
             # a relative fit of Y itself cannot pin

@@ -1,0 +1,150 @@
+"""``ipmc-asym drive``: response to any voltage waveform (sums of step, ramp, sine, square, triangle, CSV)."""
+
+from __future__ import annotations
+
+import sys
+
+import numpy as np
+
+from ipmc_asym.base.registry import model_names
+from ipmc_asym.base.units import fmt_length, parse_quantity, parse_time
+from ipmc_asym.cli import SUMMARIES
+from ipmc_asym.cli.common import (
+    add_strip_options,
+    arg_type,
+    count_type,
+    diffusion_type,
+    first_run_notice,
+    material_from_args,
+    strip_from_args,
+)
+from ipmc_asym.dynamics.circuit import BEAM_CHOICES
+from ipmc_asym.dynamics.drive import DRIVE_COLUMNS, MAX_DRIVE_POINTS, drive_chunks, drive_info
+from ipmc_asym.dynamics.waveforms import parse_waveform
+from ipmc_asym.io.fileio import atomic_write, check_output_path
+from ipmc_asym.io.jsonio import dumps
+from ipmc_asym.io.textfmt import format_table
+
+#: --json holds every row in memory: at most this many (the CSV is streamed)
+MAX_JSON_POINTS = 1_000_000
+
+_VISCOSITY = {"Pa s": 1.0, "Pa*s": 1.0, "Pa.s": 1.0, "kPa s": 1e3, "kPa*s": 1e3, "MPa s": 1e6, "MPa*s": 1e6}
+
+
+def viscous_modulus_type(name="--viscous-modulus"):
+    def conv(text):
+        v = parse_quantity(name, str(text).replace("·", " ").strip(), _VISCOSITY, "viscous modulus (Pa s)")
+        if v < 0:
+            raise ValueError(f"{name} must be >= 0 Pa s (e.g. 0, 1e4, '2kPa s'); got {text!r}")
+        return v
+
+    return arg_type(conv, name)
+
+
+def _duration(text):
+    v = parse_time("--duration", text)
+    if v <= 0:
+        raise ValueError(f"--duration must be > 0 (e.g. 0.5s, 200ms); got {text!r}")
+    return v
+
+
+def _waveform(text):
+    return parse_waveform(text)
+
+
+def add_beam_options(p, default):
+    p.add_argument("--beam", default=default, choices=BEAM_CHOICES,
+                   help=f"strip mechanics: dynamic (inertia, Kelvin-Voigt damping, resonances) or quasi-static "
+                        f"(default {default})")
+    p.add_argument("--viscous-modulus", dest="viscous_modulus", type=viscous_modulus_type(), default=0.0,
+                   help="Kelvin-Voigt viscous modulus eta_E (Pa s; '2kPa s'); default 0: no source gives a value")
+
+
+def register(sub):
+    p = sub.add_parser("drive", help=SUMMARIES["drive"])
+    add_strip_options(p, voltage=False)
+    p.add_argument("--waveform", type=arg_type(_waveform, "--waveform"), required=True,
+                   help="SPEC: terms joined by '+': dc:V, step:V[@T0], ramp:V/TR[@T0], sine:V@F[,PHASE_deg], "
+                        "square:V@F, triangle:V@F, csv:FILE (t, V); e.g. 'dc:0.2V+sine:0.5V@10Hz'")
+    p.add_argument("--duration", type=arg_type(_duration, "duration"), required=True, help="end time (e.g. 2s, 500ms)")
+    p.add_argument("--points", type=count_type("--points", 2), default=10001,
+                   help=f"equally spaced output times (default 10001, at most {MAX_DRIVE_POINTS:g})")
+    p.add_argument("--model", default="constant", choices=list(model_names()), help="permittivity model")
+    p.add_argument("--diffusion", type=diffusion_type(), default=None,
+                   help="cation diffusion coefficient D (1e-10m2/s, 1e-6cm2/s; a bare number is m^2/s)")
+    add_beam_options(p, "dynamic")
+    p.add_argument("--out", default=None, help="CSV file, written as computed (columns " + ", ".join(DRIVE_COLUMNS) + ")")
+    p.add_argument("--json", action="store_true", help=f"print one JSON object (at most {MAX_JSON_POINTS:g} points)")
+
+
+def _csv_rows(chunk):
+    cols = [("f", np.ascontiguousarray(chunk[c], dtype=float)) for c in DRIVE_COLUMNS]
+    text = format_table(cols, [""] + [","] * (len(cols) - 1), 17, nonfinite="nan", row_end="\n", row_sep="")
+    if text is None:  # a rounding too close to call for the compiled formatter: Python's repr
+        n = chunk["t"].size
+        text = "".join(",".join(repr(float(chunk[c][i])) for c in DRIVE_COLUMNS) + "\n" for i in range(n))
+    return text
+
+
+def run(args):
+    if args.points > MAX_DRIVE_POINTS:
+        raise ValueError(f"--points must be at most {MAX_DRIVE_POINTS:g}; got {args.points}")
+    if args.json and args.points > MAX_JSON_POINTS:
+        raise ValueError(f"--json holds every row in memory: --points at most {MAX_JSON_POINTS:g} (use --out F.csv)")
+    if args.out:
+        check_output_path(args.out, "file")
+    material = material_from_args(args)
+    if args.diffusion is not None:
+        material = material.with_(D=args.diffusion)
+    strip = strip_from_args(args)
+    info = drive_info(strip, args.model, material, args.beam, args.viscous_modulus)
+    head = dict(info, waveform=args.waveform.spec, duration=args.duration, points=args.points,
+                thickness_total=strip.thickness, half_thickness_e=strip.e, diffusion_coefficient=material.D,
+                units={"t": "s", "phi0": "V", "sigma": "C/m^2 (face z = -e)", "current_density": "A/m^2",
+                       "layer_voltage": "V", "M_A": "N m", "theta": "rad (free tip)", "w": "m (free tip)",
+                       "F_block": "N (blocked tip)"})
+    first_run_notice()
+    gen = drive_chunks(args.waveform, args.duration, args.points, strip=strip, model=args.model, material=material,
+                       beam=args.beam, viscous_modulus=args.viscous_modulus)
+    show = set(np.unique(np.linspace(0, args.points - 1, min(args.points, 11)).astype(int)).tolist())
+    shown, kept = [], []
+    i0 = 0
+    if args.out:
+        with atomic_write(args.out) as fh:
+            fh.write(f"# drive {args.waveform.spec}; thickness_total = {strip.thickness!r} m; model = {info['model']}; "
+                     f"beam = {args.beam}; tau = {info['tau']!r} s; SI units; "
+                     f"{'; '.join(info['notes'][:1])}\n")
+            fh.write(",".join(DRIVE_COLUMNS) + "\n")
+            for ch in gen:
+                fh.write(_csv_rows(ch))
+                n = ch["t"].size
+                shown += [{c: float(ch[c][i - i0]) for c in DRIVE_COLUMNS} for i in range(i0, i0 + n) if i in show]
+                i0 += n
+        sys.stderr.write(f"drive: {args.points} rows -> {args.out}\n")
+    else:
+        for ch in gen:
+            n = ch["t"].size
+            if args.json:
+                kept.append(ch)
+            shown += [{c: float(ch[c][i - i0]) for c in DRIVE_COLUMNS} for i in range(i0, i0 + n) if i in show]
+            i0 += n
+    if args.json:
+        out = dict(head)
+        if kept:
+            out.update({c: np.concatenate([k[c] for k in kept]) for c in DRIVE_COLUMNS})
+        print(dumps(out, indent=1))
+        return 0
+    print(f"drive {args.waveform.spec}, total thickness 2e = {fmt_length(strip.thickness)}, model {info['model']}, "
+          f"beam {args.beam}: tau = {info['tau']:.4g} s")
+    if "resonances" in info:
+        print(f"first resonances: free tip {', '.join(f'{v:.4g}' for v in info['resonances']['clamped-free'])} Hz; "
+              f"blocked tip {', '.join(f'{v:.4g}' for v in info['resonances']['clamped-pinned'])} Hz")
+    print(f"{'t [s]':>11s} {'phi0 [V]':>9s} {'sigma [C/m^2]':>14s} {'J [A/m^2]':>11s} {'M_A [N m]':>11s} "
+          f"{'theta':>9s} {'w [mm]':>9s} {'F_block [mN]':>12s}")
+    for r in shown:
+        r = {k: v + 0.0 for k, v in r.items()}  # no "-0" in the table
+        print(f"{r['t']:11.4g} {r['phi0']:9.4g} {r['sigma']:14.6g} {r['current_density']:11.4g} {r['M_A']:11.4g} "
+              f"{r['theta']:9.4g} {r['w'] * 1e3:9.4g} {r['F_block'] * 1e3:12.4g}")
+    for n in info["notes"]:
+        print(f"note: {n}")
+    return 0

@@ -1,0 +1,172 @@
+"""Voltage waveforms ``phi0(t)``: a small text grammar, sums of terms, and a measured CSV.
+
+``SPEC`` is one or more terms joined by ``+`` (volts and seconds/hertz with units, as on the
+command line)::
+
+    dc:V                    constant V (from t = 0)
+    step:V[@T0]             V from T0 (default 0)
+    ramp:V/TR[@T0]          0 -> V linearly over TR from T0, then V
+    sine:V@F[,PHASE]        V sin(2 pi F t + PHASE)            (PHASE in degrees, default 0)
+    square:V@F              V sign(sin(2 pi F t))              (bipolar, +V first)
+    triangle:V@F            bipolar triangle of amplitude V, in phase with the sine
+    csv:PATH                measured (t, V) columns, linear between samples, held outside
+
+e.g. ``dc:0.2V+sine:0.5V@10Hz`` or ``step:1V+square:0.1V@50Hz``.  :func:`parse_waveform`
+returns a vectorised callable (volts); any Python callable ``f(t)`` is accepted by the dynamic
+functions as well.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import os
+import re
+
+import numpy as np
+
+from ipmc_asym.base.units import parse_quantity, parse_time, parse_voltage
+
+__all__ = ["Waveform", "parse_waveform", "WAVEFORM_KINDS", "MAX_CSV_ROWS"]
+
+WAVEFORM_KINDS = ("dc", "step", "ramp", "sine", "square", "triangle", "csv")
+
+#: a measured waveform is held in memory: at most this many samples
+MAX_CSV_ROWS = 10_000_000
+
+
+def _freq(name, text):
+    v = parse_quantity(name, text, {"Hz": 1.0, "kHz": 1e3, "mHz": 1e-3, "MHz": 1e6}, "frequency")
+    if not v > 0:
+        raise ValueError(f"{name} must be > 0 Hz; got {text!r}")
+    return v
+
+
+class Waveform:
+    """A sum of terms, callable on an array of times (s) -> volts; ``spec`` is the text it was read from.
+
+    Attributes
+    ----------
+    spec : str ; terms : list of (kind, params) ; max_frequency : float (Hz, 0 if none)
+    """
+
+    def __init__(self, spec, terms):
+        self.spec = spec
+        self.terms = terms
+        self.max_frequency = max((p["f"] for k, p in terms if "f" in p), default=0.0)
+
+    def __call__(self, t):
+        t = np.asarray(t, dtype=float)
+        v = np.zeros(t.shape)
+        for kind, p in self.terms:
+            v = v + _term(kind, p, t)
+        return v
+
+    def __repr__(self):
+        return f"Waveform({self.spec!r})"
+
+
+def _term(kind, p, t):
+    V = p.get("V", 0.0)
+    if kind == "dc":
+        return np.full(t.shape, V)
+    if kind == "step":
+        return np.where(t >= p["t0"], V, 0.0)
+    if kind == "ramp":
+        return V * np.clip((t - p["t0"]) / p["tr"], 0.0, 1.0)
+    if kind == "csv":
+        return np.interp(t, p["t"], p["v"])
+    x = p["f"] * t + p.get("phase", 0.0) / 360.0  # cycles
+    if kind == "sine":
+        return V * np.sin(2.0 * math.pi * x)
+    frac = x - np.floor(x)
+    if kind == "square":
+        return np.where(frac < 0.5, V, -V)
+    # triangle: 0 -> V at a quarter period, -V at three quarters, in phase with the sine
+    return V * np.where(frac < 0.25, 4.0 * frac, np.where(frac < 0.75, 2.0 - 4.0 * frac, 4.0 * frac - 4.0))
+
+
+def _read_csv(path):
+    if not os.path.isfile(path):
+        raise ValueError(f"waveform csv: no such file {path!r}")
+    ts, vs = [], []
+    with open(path, newline="") as fh:
+        for i, row in enumerate(csv.reader(fh)):
+            if not row or row[0].lstrip().startswith("#"):
+                continue
+            if len(row) < 2:
+                raise ValueError(f"waveform csv {path!r} line {i + 1}: needs two columns t, V")
+            try:
+                t = parse_time("waveform csv t", row[0].strip())
+                v = parse_voltage("waveform csv V", row[1].strip())
+            except ValueError:
+                if not ts and i == 0:
+                    continue  # header row
+                raise ValueError(f"waveform csv {path!r} line {i + 1}: cannot read t, V from {row[:2]!r}") from None
+            ts.append(t)
+            vs.append(v)
+            if len(ts) > MAX_CSV_ROWS:
+                raise ValueError(f"waveform csv {path!r}: more than {MAX_CSV_ROWS} samples")
+    t = np.asarray(ts)
+    if t.size < 2 or np.any(np.diff(t) <= 0):
+        raise ValueError(f"waveform csv {path!r}: needs >= 2 rows with strictly increasing times")
+    return t, np.asarray(vs)
+
+
+_TERM = re.compile(r"^\s*([a-z]+)\s*:\s*(.+?)\s*$", re.IGNORECASE)
+
+
+def parse_waveform(spec) -> Waveform:
+    """Read a waveform ``SPEC`` (module docstring); ``ValueError`` naming the bad term.
+
+    >>> parse_waveform("dc:0.2V+sine:0.5V@10Hz")(np.array([0.025]))
+    array([0.7])
+    """
+    if isinstance(spec, Waveform):
+        return spec
+    if not isinstance(spec, str) or not spec.strip():
+        raise ValueError("waveform must be a SPEC such as 'sine:1V@10Hz' or 'step:1V+square:0.1V@50Hz'")
+    parts = [p for p in re.split(r"\+(?=\s*[a-zA-Z]+\s*:)", spec) if p.strip()]
+    terms = []
+    for part in parts:
+        m = _TERM.match(part)
+        if not m:
+            raise ValueError(f"waveform term {part!r}: expected KIND:ARGS with KIND one of {', '.join(WAVEFORM_KINDS)}")
+        kind, arg = m.group(1).lower(), m.group(2)
+        name = f"waveform term {part.strip()!r}"
+        try:
+            if kind == "csv":
+                t, v = _read_csv(arg)
+                terms.append((kind, {"t": t, "v": v}))
+                continue
+            if kind not in WAVEFORM_KINDS:
+                raise ValueError(f"kind must be one of {', '.join(WAVEFORM_KINDS)}")
+            if kind in ("dc",):
+                terms.append((kind, {"V": parse_voltage(name, arg)}))
+            elif kind == "step":
+                a, _, t0 = arg.partition("@")
+                terms.append((kind, {"V": parse_voltage(name, a), "t0": parse_time(name, t0) if t0 else 0.0}))
+            elif kind == "ramp":
+                a, _, rest = arg.partition("/")
+                tr, _, t0 = rest.partition("@")
+                if not tr:
+                    raise ValueError("ramp needs V/TR, e.g. ramp:1V/0.1s")
+                trv = parse_time(name, tr)
+                if not trv > 0:
+                    raise ValueError("the ramp time TR must be > 0 s")
+                terms.append((kind, {"V": parse_voltage(name, a), "tr": trv, "t0": parse_time(name, t0) if t0 else 0.0}))
+            else:
+                a, _, rest = arg.partition("@")
+                if not rest:
+                    raise ValueError(f"{kind} needs V@F, e.g. {kind}:1V@10Hz")
+                fq, _, ph = rest.partition(",")
+                p = {"V": parse_voltage(name, a), "f": _freq(name, fq)}
+                if ph:
+                    if kind != "sine":
+                        raise ValueError("a phase is only read for a sine")
+                    p["phase"] = float(ph)
+                terms.append((kind, p))
+        except ValueError as exc:
+            msg = str(exc)
+            raise ValueError(msg if msg.startswith("waveform") else f"{name}: {msg}") from None
+    return Waveform(spec, terms)

@@ -1,0 +1,47 @@
+"""Bench section ``dynamics``: ``freq`` with 1000 frequencies (beam dynamics on) and a 10^5-point sine
+response at circuit fidelity (the drive run: circuit, the forward model's mechanics per time point,
+the modal beam), measured side by side in one run."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from ipmc_asym.dynamics.circuit import frequency_response
+from ipmc_asym.dynamics.drive import drive_response
+
+__all__ = ["section", "TARGETS"]
+
+#: seconds (the issue's targets)
+TARGETS = {"freq_1000_s": 0.05, "sine_1e5_quasi_static_s": 0.5, "sine_1e5_dynamic_s": 0.5}
+
+
+def _best(fn, repeats):
+    best = np.inf
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        fn()
+        best = min(best, time.perf_counter() - t0)
+    return best
+
+
+def section(quick: bool = False) -> dict:
+    """The ``dynamics`` bench section (see the module docstring)."""
+    reps = 1 if quick else 3
+    f = np.geomspace(1e-2, 1e4, 1000)
+    frequency_response(f[:10], method="circuit", beam="dynamic")
+    drive_response("sine:1V@10Hz", 0.05, 5001)  # compile / load the kernels once
+    n = 10**4 if quick else 10**5
+    r = {
+        "freq_1000_s": _best(lambda: frequency_response(f, method="circuit", beam="dynamic"), 5 * reps),
+        "sine_1e5_quasi_static_s": _best(lambda: drive_response("sine:1V@10Hz", 1.0, n, beam="quasi-static"), reps),
+        "sine_1e5_dynamic_s": _best(lambda: drive_response("sine:1V@10Hz", 1.0, n, beam="dynamic"), reps),
+    }
+    what = {"freq_1000_s": "freq, 1000 frequencies, circuit, beam dynamics (free and blocked tip)",
+            "sine_1e5_quasi_static_s": f"drive sine 10 Hz, {n} time points, circuit, quasi-static beam",
+            "sine_1e5_dynamic_s": f"drive sine 10 Hz, {n} time points, circuit, beam dynamics"}
+    figs = [{"what": what[k], "value": r[k], "unit": "s", "target": TARGETS[k], "pass": bool(r[k] <= TARGETS[k]),
+             "note": "wall clock on this machine, best of the repeats" + (" (quick: 10^4 points)" if quick else "")}
+            for k in TARGETS]
+    return {"figures": figs}

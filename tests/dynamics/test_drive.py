@@ -1,0 +1,86 @@
+"""Chunked drive runs against one-pass runs, the step API, the static limit and the small-signal circuit."""
+
+import math
+
+import numpy as np
+import pytest
+
+from ipmc_asym.beam.dynamics import natural_frequencies, viscous_modulus_from_damping_ratio
+from ipmc_asym.dynamics.circuit import circuit_response, frequency_response, quasi_static_mechanics, step_response, strip_beam
+from ipmc_asym.dynamics.drive import drive_chunks, drive_response
+from ipmc_asym.dynamics.waveforms import parse_waveform
+from ipmc_asym.model.params import NAFION_LI, Strip
+from ipmc_asym.model.permittivity import MODELS
+
+SPEC = "step:1V+square:0.2V@30Hz"
+
+
+def test_chunks_are_one_run_and_equal_the_step_api():
+    a = drive_response(SPEC, 0.3, 3001, chunk=10**6)
+    b = drive_response(SPEC, 0.3, 3001, chunk=37)
+    for k in a:
+        assert np.array_equal(a[k], b[k]) or np.max(np.abs(a[k] - b[k])) <= 1e-12 * np.max(np.abs(a[k]))
+    s = step_response(t=np.linspace(0, 0.3, 3001), waveform_kind=parse_waveform(SPEC), beam="dynamic")
+    for k in ("sigma", "current_density", "M_A", "theta", "w", "F_block"):
+        assert np.max(np.abs(a[k] - getattr(s, k))) <= 1e-12 * np.max(np.abs(a[k]))
+    # memory: the chunks hold at most `chunk` rows
+    assert max(c["t"].size for c in drive_chunks(SPEC, 0.3, 3001, chunk=500)) <= 501
+
+
+def test_damped_slow_drive_ends_at_the_quasi_static_forward_model():
+    strip = Strip()
+    b = strip_beam(strip, NAFION_LI)
+    f1 = natural_frequencies("clamped-free", b, 1)[0]
+    eta = viscous_modulus_from_damping_ratio(0.2, f1, NAFION_LI.E)
+    r = drive_response("ramp:0.8V/0.2s", 1.0, 4001, beam="dynamic", viscous_modulus=eta)
+    M, th, w, F = quasi_static_mechanics(r["layer_voltage"][-1:], strip, MODELS["constant"], NAFION_LI)
+    assert r["w"][-1] == pytest.approx(w[0], rel=1e-8)
+    assert r["theta"][-1] == pytest.approx(th[0], rel=1e-8)
+    assert r["F_block"][-1] == pytest.approx(F[0], rel=1e-6)
+    q = drive_response("ramp:0.8V/0.2s", 1.0, 4001, beam="quasi-static")
+    assert np.array_equal(q["M_A"], r["M_A"])  # the beam does not feed back on the electrochemistry
+
+
+def test_beam_grid_too_coarse_is_refused():
+    with pytest.raises(ValueError, match="points"):
+        drive_response("sine:1V@1Hz", 10.0, 100, beam="dynamic")
+
+
+def test_small_signal_about_a_bias_matches_a_small_sine_in_the_circuit():
+    """Drive the reduced circuit with 1 mV about 0.5 V; fit the periodic current; compare Z and H_w."""
+    s = Strip()
+    V, amp = 0.5, 1e-3
+    fr0 = frequency_response([1.0], method="circuit", voltage=V, beam="quasi-static")
+    f = 1 / (2 * math.pi * fr0.tau)
+    per = 1 / f
+    t = np.linspace(0, 30 * per, 30 * 64 + 1)
+    fun = parse_waveform(f"dc:{V}V+sine:{amp}V@{f}Hz")
+    sig, u, J = circuit_response(t, fun, s, MODELS["constant"], NAFION_LI)
+    M, _, w, _ = quasi_static_mechanics(u, s, MODELS["constant"], NAFION_LI)
+    sel = t >= 26 * per
+    A = np.column_stack([np.sin(2 * math.pi * f * t[sel]), np.cos(2 * math.pi * f * t[sel]), np.ones(sel.sum())])
+    a, b, _ = np.linalg.lstsq(A, J[sel], rcond=None)[0]
+    Z_t = amp / (a + 1j * b) / (s.width * s.length)
+    fr = frequency_response([f], method="circuit", voltage=V, beam="quasi-static")
+    assert abs(Z_t / fr.Z[0] - 1) < 5e-3
+    # the moment: M = M(V) + dM/dV u~, the small-displacement deflection slope
+    a, b, _ = np.linalg.lstsq(A, M[sel], rcond=None)[0]
+    H_M = (a + 1j * b) / amp
+    w_per_M = -s.length**2 / (2 * NAFION_LI.E * s.I_p)
+    assert abs(H_M * w_per_M / fr.H_w[0] - 1) < 5e-3
+
+
+def test_frequency_response_dynamic_over_quasi_static_is_the_beam_transfer():
+    from ipmc_asym.beam.dynamics import transfer
+
+    f = np.array([0.5, 5.0, 21.0, 24.0, 60.0])
+    d = frequency_response(f, beam="dynamic")
+    q = frequency_response(f, beam="quasi-static")
+    b = strip_beam(Strip(), NAFION_LI)
+    tr = transfer(f, b, "clamped-free")
+    assert np.allclose(d.H_w / q.H_w, tr["dynamic_factor"]["w"], rtol=1e-12)
+    assert np.allclose(d.H_F / q.H_F, transfer(f, b, "clamped-pinned")["dynamic_factor"]["F"], rtol=1e-12)
+    assert d.resonances["clamped-free"][0] == pytest.approx(natural_frequencies("clamped-free", b, 1)[0])
+    assert any("Darcy" in n for n in d.notes) and any("inertia" in n for n in d.notes)
+    # the resonance of the free strip shows in |H_w|
+    assert d.w_amp[2] > 5 * q.w_amp[2] and d.w_amp[3] > 5 * q.w_amp[3]

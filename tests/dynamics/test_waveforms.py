@@ -1,0 +1,45 @@
+"""The waveform grammar against the formulas it names."""
+
+import math
+
+import numpy as np
+import pytest
+
+from ipmc_asym.dynamics.waveforms import parse_waveform
+
+T = np.linspace(0.0, 0.37, 1001)
+
+
+def test_each_kind_and_sums():
+    f = 7.0
+    assert np.allclose(parse_waveform("dc:0.2V")(T), 0.2)
+    assert np.array_equal(parse_waveform("step:1V@50ms")(T), np.where(T >= 0.05, 1.0, 0.0))
+    assert np.allclose(parse_waveform("ramp:2V/100ms@10ms")(T), 2 * np.clip((T - 0.01) / 0.1, 0, 1))
+    assert np.allclose(parse_waveform("sine:0.5V@7Hz,90")(T), 0.5 * np.cos(2 * math.pi * f * T), atol=1e-15)
+    sq = parse_waveform("square:300mV@7Hz")(T)
+    s = np.sin(2 * math.pi * f * T)
+    ok = np.abs(s) > 1e-9
+    assert np.array_equal(sq[ok], 0.3 * np.sign(s[ok]))
+    tri = parse_waveform("triangle:1V@7Hz")(T)
+    assert np.allclose(tri, (2 / math.pi) * np.arcsin(np.sin(2 * math.pi * f * T)), atol=1e-12)
+    total = parse_waveform("dc:0.2V+sine:0.5V@7Hz + square:0.1V@3Hz")(T)
+    parts = parse_waveform("dc:0.2V")(T) + parse_waveform("sine:0.5V@7Hz")(T) + parse_waveform("square:0.1V@3Hz")(T)
+    assert np.array_equal(total, parts)
+    assert parse_waveform("step:-1.5e+0V")(np.array([1.0]))[0] == -1.5  # a '+' inside a number is not a sum
+
+
+def test_measured_csv(tmp_path):
+    p = tmp_path / "v.csv"
+    p.write_text("t,V\n0,0\n10ms,1V\n0.03,-0.5\n")
+    w = parse_waveform(f"csv:{p}+dc:0.1V")
+    assert np.allclose(w(np.array([0.0, 0.005, 0.02, 1.0])), [0.1, 0.6, 0.35, -0.4])
+
+
+@pytest.mark.parametrize("spec,word", [
+    ("", "SPEC"), ("sin:1V@1Hz", "kind"), ("sine:1V", "V@F"), ("ramp:1V", "TR"), ("sine:1V@-2Hz", "> 0"),
+    ("csv:/nonexistent.csv", "no such file"), ("square:1V@1Hz,30", "phase"), ("step:1Q", "unit"),
+])
+def test_bad_specs_one_line(spec, word):
+    with pytest.raises(ValueError, match=word) as ei:
+        parse_waveform(spec)
+    assert "\n" not in str(ei.value)
