@@ -4,7 +4,9 @@
   full thickness + log zooms at each electrode (:mod:`ipmc_asym.studies.profiles`);
 * ``influence_length.png`` (Fig 8), ``influence_thickness.png`` (Fig 9),
   ``influence_voltage.png`` (Fig 10), ``influence_width.png``: deflection, blocking force and
-  rotation, three models overlaid; points past a quarter turn drawn dotted (outside the model);
+  rotation, three models overlaid; each curve dotted where a model assumption that concerns it
+  fails (the rule of ``forward.model.FLAGS``, as in ``estimate``: the free strip past a quarter
+  turn for w and theta, the strain limit for every mechanical output), empty only where withheld;
 * ``speed_accuracy.png`` from a bench result (:func:`ipmc_asym.plotting.speed.plot_speed_accuracy`)
   when one is given or can be measured.
 
@@ -18,13 +20,13 @@ import os
 import numpy as np
 
 from ipmc_asym.base.registry import model_names
-from ipmc_asym.base.settings import OUTSIDE_REGIMES
+from ipmc_asym.forward.model import flag_mask
 from ipmc_asym.model.params import NAFION_LI, Material, Strip
 from ipmc_asym.plotting import MODEL_COLOURS, pyplot, savefig
 from ipmc_asym.plotting.profiles import write_all
 from ipmc_asym.plotting.speed import plot_speed_accuracy
 from ipmc_asym.studies.profiles import compute_all
-from ipmc_asym.studies.sweeps import sweep
+from ipmc_asym.studies.sweeps import sweep, withhold
 
 __all__ = ["influence_figure", "make_all", "INFLUENCE"]
 
@@ -49,19 +51,19 @@ def influence_figure(var, path, base: Strip | None = None, material: Material = 
     vals, sc, xlabel, _stem, fig_no = INFLUENCE[var]
     vals = vals if values is None else np.asarray(values, float)
     base = Strip() if base is None else base
-    arr = sweep({var: vals}, list(MODELS3), "quadrature", base, material)
+    arr = withhold(sweep({var: vals}, list(MODELS3), "quadrature", base, material))
     fig, axs = plt.subplots(1, 3, figsize=(13, 4.0), dpi=dpi)
     handles = []
     ymax = [0.0, 0.0, 0.0]
     for m in MODELS3:
         a = arr[arr["model"] == m]
         x = a[var] * sc
-        # outside the beam model: past a quarter turn, or strain above settings.STRAIN_LIMIT
-        out = ~(a["check_beam_regime"] & a["check_strain"]) | np.isin(a["regime"], OUTSIDE_REGIMES)
-        inside = ~out
         for k, (ax, q, qs, fac) in enumerate(((axs[0], "w", "w_small", 1e3),
                                               (axs[1], "F_block", "F_block_small", 1e3),
                                               (axs[2], "theta", None, 1.0))):
+            # the estimate's rule (forward.model.flag_mask): dotted where an assumption concerning q fails
+            out = flag_mask(lambda c: a["check_" + c], q)
+            inside = ~out
             y = np.abs(a[q]) * fac
             yi = np.where(inside, y, np.nan)
             (h,) = ax.plot(x, yi, "-", color=_COL[m], label=f"{m}")
@@ -70,9 +72,8 @@ def influence_figure(var, path, base: Strip | None = None, material: Material = 
             if np.any(np.isfinite(yi)):
                 ymax[k] = max(ymax[k], float(np.nanmax(yi)))
             if out.any():
-                # beyond the quarter turn: marked dotted, up to the first point past it only
-                edge = out & (np.roll(inside, 1) | np.roll(inside, -1))
-                yo = np.where(edge | (inside & np.roll(out, -1)) | (inside & np.roll(out, 1)), y, np.nan)
+                # outside a model assumption: kept, drawn dotted (joined to the solid part)
+                yo = np.where(out | np.roll(out, -1) | np.roll(out, 1), y, np.nan)
                 ax.plot(x, yo, ":", color=_COL[m], alpha=0.8)
                 if k == 0 and inside.any() and out.any():
                     xq = x[np.flatnonzero(out)[0]] if out[-1] else x[np.flatnonzero(out)[-1]]
