@@ -85,6 +85,8 @@ def run(args):
             "voltage": strip.voltage, "thickness_total": strip.thickness, "half_thickness_e": strip.e,
             "diffusion_coefficient": material.D, "seconds": r.seconds, "notes": r.notes, "message": r.message,
             "warnings": r.warnings}
+    for w in r.warnings:  # the forward model's flags, one line each (also in --json's "warnings")
+        sys.stderr.write(f"step: warning: {w}\n")
     if args.json:
         out = dict(head)
         out.update({c: cols[c] for c in COLUMNS})
@@ -103,6 +105,4 @@ def run(args):
                   f"{_num(r.theta[i], 1.0):>9s} {_num(r.w[i], 1e3):>9s} {'yes' if r.valid[i] else 'no'}")
         for n in r.notes:
             print(f"note: {n}")
-    for w in r.warnings:
-        sys.stderr.write(f"step: warning: {w}\n")
     return 0
