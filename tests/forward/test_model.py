@@ -192,3 +192,44 @@ def test_bad_input_is_refused():
         forward(0.02, 5e-3, 200e-6, 1.0, tol=2.0)
     with pytest.raises(ValueError, match="thickness"):
         forward(0.02, 5e-3, 1e-12, 1.0)
+
+
+def test_step_uq_figures_and_estimate_agree_on_every_points_checks():
+    """Random strips, some outside each model assumption: estimate, uq's samples, the sweep rows
+    the figures draw (and their dotted-curve rule) and step's time points report the same checks."""
+    from ipmc_asym.dynamics.circuit import step_response
+    from ipmc_asym.forward.model import ASSUMPTION_CHECKS, FLAGS, flag_mask
+
+    rng = np.random.default_rng(18)
+    n = 24
+    L = np.exp(rng.uniform(np.log(5e-3), np.log(5e-2), n))
+    wd = np.exp(rng.uniform(np.log(1e-3), np.log(2e-2), n))
+    th = np.exp(rng.uniform(np.log(20e-6), np.log(2e-3), n))
+    v = rng.choice([-1, 1], n) * np.where(rng.random(n) < 0.8, rng.uniform(0.05, 15.0, n), rng.uniform(25.0, 40.0, n))
+    rows = [evaluate(Strip(length=L[i], width=wd[i], thickness=th[i], voltage=v[i]), "constant") for i in range(n)]
+    est = {c: np.array([r["checks"][c] for r in rows]) for c in CHECKS}
+    for c in ASSUMPTION_CHECKS:  # the draw reaches both sides of every assumption
+        assert est[c].any() and not est[c].all(), c
+    # uq's per-sample evaluation
+    cols = {"length": L, "width": wd, "thickness": th, "voltage": v, "modulus": np.full(n, NAFION_LI.E),
+            "c_moy": np.full(n, NAFION_LI.C_moy)}
+    _, _, uchk, _ = uq.evaluate_samples(cols, ["rotation"], "constant", NAFION_LI, 1e-3, fidelity="quadrature")
+    for c in CHECKS:
+        assert np.array_equal(uchk[c], est[c]), c
+    # the figures: sweep rows and the dotted-curve rule, one point at a time
+    for i in range(n):
+        a = sweep({"voltage": np.array([v[i]])}, "constant", "quadrature",
+                  Strip(length=L[i], width=wd[i], thickness=th[i], voltage=v[i]))
+        assert {c: bool(a["check_" + c][0]) for c in CHECKS} == rows[i]["checks"]
+        for q in ("w", "F_block", "theta"):
+            want = any(not rows[i]["checks"][c] for c, keys in FLAGS.items() if q in keys)
+            assert bool(flag_mask(lambda c: a["check_" + c], q)[0]) == want
+    # step: each time point against estimate at that point's layer voltage (the voltage check
+    # also sees the applied voltage)
+    for i in range(0, n, 4):
+        s = Strip(length=L[i], width=wd[i], thickness=th[i], voltage=v[i])
+        r = step_response(v[i], strip=s, points=4)
+        for j in range(1, 4):
+            ev = evaluate(s.with_(voltage=float(r.layer_voltage[j])), "constant")["checks"]
+            ev["voltage"] = ev["voltage"] and abs(r.phi0[j]) <= 20.0
+            assert {c: bool(r.checks[c][j]) for c in CHECKS} == ev, (i, j)
