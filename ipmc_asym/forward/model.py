@@ -43,7 +43,7 @@ from ipmc_asym.model.permittivity import get_model
 
 __all__ = ["forward", "ForwardResult", "CHECKS", "NUMERICAL_CHECKS", "ASSUMPTION_CHECKS", "FLAGS", "MOMENT_KEYS",
            "FREE_STRIP_KEYS", "MECHANICAL_KEYS", "TIP_POSITION_KEYS", "WITHHOLD", "SAMPLING_FIDELITIES",
-           "distinct_pairs", "strain_reason", "regime_reason", "voltage_reason", "flag_mask", "assumption_warnings",
+           "ASSUMPTION_LIMITS", "distinct_pairs", "strain_reason", "regime_reason", "voltage_reason", "flag_mask", "assumption_warnings",
            "blocked_rotation"]
 
 #: numerical validity: the rung's error bound on ``I`` and separate layers (escalation fixes
@@ -64,6 +64,16 @@ MECHANICAL_KEYS = FREE_STRIP_KEYS + ("F_block", "F_block_small")
 #: the free strip's tip position: meaningless past a full turn (the arc passes through itself;
 #: ``w`` is periodic in ``M``), withheld there
 TIP_POSITION_KEYS = ("w", "w_small", "x_tip", "y_tip")
+#: model assumption -> its limit and the limit's source, in one line (summaries of many rows)
+ASSUMPTION_LIMITS = {
+    "beam_regime": "free strip within a quarter turn, |theta| <= pi/2 (past it the arc of eq. 12 curls back: w not "
+                   "monotone in M)",
+    "strain": f"face strain e|kappa| <= Material.strain_limit (default settings.STRAIN_LIMIT = {STRAIN_LIMIT:g}: "
+              f"{STRAIN_LIMIT_SOURCE})",
+    "voltage": f"|voltage| <= settings.VALIDATED_VOLTAGE = {VALIDATED_VOLTAGE:g} V (validated against the BVP; water "
+               "electrolysis, ~1.23 V, is outside this blocking-electrode model)",
+    "slender": "slender strip: L/2e >= 10, 2l/2e >= 10, 2l/L <= 1 (model.limits.SLENDER_LIMITS, each with its reason)",
+}
 #: model assumption -> the outputs it concerns (flagged where it fails, :func:`flag_mask`)
 FLAGS = {"beam_regime": FREE_STRIP_KEYS, "strain": MECHANICAL_KEYS, "voltage": MOMENT_KEYS + MECHANICAL_KEYS,
          "slender": MOMENT_KEYS + MECHANICAL_KEYS}
