@@ -13,7 +13,8 @@ quasi-static mechanics).  The chain (paper sections 3-4):
 * the checks of :data:`CHECKS`, of two kinds.  *Numerical validity*
   (:data:`NUMERICAL_CHECKS`: the rung's error bound, separate layers) is fixed by escalation;
   where no rung holds, the outputs are withheld (:data:`WITHHOLD`).  *Model assumptions*
-  (:data:`ASSUMPTION_CHECKS`: the free strip within a quarter turn, the face strain within
+  (:data:`ASSUMPTION_CHECKS`: the free strip within a quarter turn, the blocked strip within a
+  quarter turn (the lever arm of eq. 15), the face strain within
   ``Material.strain_limit``, the voltage within ``settings.VALIDATED_VOLTAGE``, a slender
   strip, :mod:`ipmc_asym.model.limits`) keep the numbers and flag the row
   (:data:`FLAGS`: which outputs each concerns; :func:`assumption_warnings`: one line each,
@@ -43,16 +44,18 @@ from ipmc_asym.model.permittivity import get_model
 
 __all__ = ["forward", "ForwardResult", "CHECKS", "NUMERICAL_CHECKS", "ASSUMPTION_CHECKS", "FLAGS", "MOMENT_KEYS",
            "FREE_STRIP_KEYS", "MECHANICAL_KEYS", "TIP_POSITION_KEYS", "WITHHOLD", "SAMPLING_FIDELITIES",
-           "ASSUMPTION_LIMITS", "distinct_pairs", "strain_reason", "regime_reason", "voltage_reason", "flag_mask", "assumption_warnings",
+           "ASSUMPTION_LIMITS", "distinct_pairs", "strain_reason", "regime_reason", "voltage_reason", "blocked_reason",
+           "flag_mask", "assumption_warnings",
            "blocked_rotation"]
 
 #: numerical validity: the rung's error bound on ``I`` and separate layers (escalation fixes
 #: them; where no rung holds, the outputs are withheld)
 NUMERICAL_CHECKS = ("electrochemistry", "layer_separation")
-#: model assumptions: the free strip within a quarter turn (``beam_regime``), the face strain
+#: model assumptions: the free strip within a quarter turn (``beam_regime``), the blocked strip
+#: within a quarter turn (``blocked_regime``: the lever arm ``L - s`` of eq. 15), the face strain
 #: within ``Material.strain_limit``, ``|voltage| <= settings.VALIDATED_VOLTAGE``, a slender
 #: strip (:data:`ipmc_asym.model.limits.SLENDER_LIMITS`); a failed one flags, never withholds
-ASSUMPTION_CHECKS = ("beam_regime", "strain", "voltage", "slender")
+ASSUMPTION_CHECKS = ("beam_regime", "blocked_regime", "strain", "voltage", "slender")
 #: the validity checks of a result, in the order of the chain (electrochemistry -> beam)
 CHECKS = NUMERICAL_CHECKS + ASSUMPTION_CHECKS
 #: outputs of the moment integral (withheld where no rung is valid)
@@ -68,6 +71,8 @@ TIP_POSITION_KEYS = ("w", "w_small", "x_tip", "y_tip")
 ASSUMPTION_LIMITS = {
     "beam_regime": "free strip within a quarter turn, |theta| <= pi/2 (past it the arc of eq. 12 curls back: w not "
                    "monotone in M)",
+    "blocked_regime": "blocked strip within a quarter turn, |kappa L| (1 - psi/2) <= pi/2 (the paper's lever arm "
+                      "L - s of eq. 15)",
     "strain": f"face strain e|kappa| <= Material.strain_limit (default settings.STRAIN_LIMIT = {STRAIN_LIMIT:g}: "
               f"{STRAIN_LIMIT_SOURCE})",
     "voltage": f"|voltage| <= settings.VALIDATED_VOLTAGE = {VALIDATED_VOLTAGE:g} V (validated against the BVP; water "
@@ -75,7 +80,8 @@ ASSUMPTION_LIMITS = {
     "slender": "slender strip: L/2e >= 10, 2l/2e >= 10, 2l/L <= 1 (model.limits.SLENDER_LIMITS, each with its reason)",
 }
 #: model assumption -> the outputs it concerns (flagged where it fails, :func:`flag_mask`)
-FLAGS = {"beam_regime": FREE_STRIP_KEYS, "strain": MECHANICAL_KEYS, "voltage": MOMENT_KEYS + MECHANICAL_KEYS,
+FLAGS = {"beam_regime": FREE_STRIP_KEYS, "blocked_regime": ("F_block", "F_block_small"), "strain": MECHANICAL_KEYS,
+         "voltage": MOMENT_KEYS + MECHANICAL_KEYS,
          "slender": MOMENT_KEYS + MECHANICAL_KEYS}
 #: the withholding rule, most severe first: (what failed, outputs withheld).  ``"moment"``: no
 #: rung is valid (electrochemistry or layer separation failed at every rung tried);
@@ -117,20 +123,20 @@ def regime_reason(regime, theta=None) -> str:
     """One line: the free strip is past a quarter turn (what is kept, what holds)."""
     th = "" if theta is None else f", |theta| = {abs(float(theta)):.3g} rad"
     if regime == "multi-turn":
-        line = (f"free strip {regime}{th} > 2 pi: theta kept, flagged check_beam_regime = false; the arc passes "
+        return (f"free strip {regime}{th} > 2 pi: theta kept, flagged check_beam_regime = false; the arc passes "
                 "through itself past a full turn, so its tip position means nothing: w, w_small, x_tip, y_tip withheld")
-    else:
-        line = (f"free strip {regime}{th} > pi/2: the arc formula (paper eq. 12) still gives theta, w, x_tip, "
-                "y_tip (strips do curl), kept and flagged check_beam_regime = false; w is not monotone in M")
-    if theta is not None and np.isfinite(float(theta)):
-        tb = float(blocked_rotation(theta))
-        if tb <= 0.5 * np.pi:
-            line += (f"; F_block kept: with its tip held the blocked strip turns at most {tb:.3g} rad "
-                     "(within a quarter turn), so the lever arm L - s of eq. 15 holds")
-        elif np.isfinite(tb):
-            line += (f"; F_block kept as the root of eq. 15, but the blocked strip itself winds ({tb:.3g} rad "
-                     "between clamp and held tip), where the paper's lever arm L - s is only an approximation")
-    return line
+    return (f"free strip {regime}{th} > pi/2: the arc formula (paper eq. 12) still gives theta, w, x_tip, "
+            "y_tip (strips do curl), kept and flagged check_beam_regime = false; w is not monotone in M; "
+            "the blocking force is a separate check (blocked_regime)")
+
+
+def blocked_reason(theta) -> str:
+    """One line: the BLOCKED strip itself turns past a quarter turn (``theta`` = free-strip rotation)."""
+    tb = float(blocked_rotation(theta))
+    what = f"turns up to {tb:.3g} rad along its length" if np.isfinite(tb) else "winds beyond the tracked branch"
+    return (f"blocked strip past a quarter turn: with its tip held on the axis it still {what} (> pi/2), where the "
+            "paper's lever arm L - s of eq. 15 is only an approximation; F_block kept as the root of eq. 15, flagged "
+            "check_blocked_regime = false")
 
 
 def voltage_reason(voltage) -> str:
@@ -179,7 +185,7 @@ class ForwardResult:
     error : ndarray  relative error bound of ``I`` (inf where no rung is valid)
     fidelity_used : ndarray of str   rung that produced ``I`` ("" where none)
     escalated : ndarray of bool   ``fidelity_used`` is a rung above the requested one
-    electrochemistry, layer_separation, beam_regime, strain, voltage, slender : ndarray of bool
+    electrochemistry, layer_separation, beam_regime, blocked_regime, strain, voltage, slender : ndarray of bool
         the checks (:data:`CHECKS`)
     moment_valid : ndarray of bool   a rung is valid (``I`` computed)
     valid : ndarray of bool   every check
@@ -211,6 +217,7 @@ class ForwardResult:
     electrochemistry: np.ndarray
     layer_separation: np.ndarray
     beam_regime: np.ndarray
+    blocked_regime: np.ndarray
     strain: np.ndarray
     voltage: np.ndarray
     slender: np.ndarray
@@ -291,6 +298,8 @@ def assumption_warnings(r: "ForwardResult", index=None) -> list:
             line = strain_reason(np.asarray(r.max_strain).reshape(-1)[j], r.strain_limit)
         elif c == "beam_regime":
             line = regime_reason(str(np.asarray(r.regime).reshape(-1)[j]), np.asarray(r.theta).reshape(-1)[j])
+        elif c == "blocked_regime":
+            line = blocked_reason(np.asarray(r.theta).reshape(-1)[j])
         elif c == "voltage":
             line = voltage_reason(np.asarray(r.inputs["voltage"]).reshape(-1)[j])
         else:
@@ -453,12 +462,14 @@ def forward(length, width, thickness, voltage, *, modulus=None, c_moy=None, mate
     rcode = np.broadcast_to(np.asarray(b.regime_code), (k,))
     # model assumptions: checked where a rung is valid (False elsewhere: nothing to assume about)
     beam_regime = ok & ~np.isin(rcode, _OUTSIDE_CODES)  # ints, not strings
+    # the blocked strip's own largest rotation (NaN beyond the tracked branch: fails)
+    blocked_ok = ok & (blocked_rotation(np.asarray(b.theta, dtype=float).reshape(-1)) <= 0.5 * np.pi)
     strain_ok = ok & (strain <= material.strain_limit)
     volt_ok = ok & (np.abs(v) <= VALIDATED_VOLTAGE)
     slender = ok & np.broadcast_to(slender_ok(L, wd, th), (k,))
     elec = rows(r.electrochemistry.reshape(-1))
     layer = rows(r.layer_separation.reshape(-1))
-    valid = elec & layer & beam_regime & strain_ok & volt_ok & slender
+    valid = elec & layer & beam_regime & blocked_ok & strain_ok & volt_ok & slender
     mech = {c: masked(np.asarray(getattr(b, c), dtype=float), np.nan)
             for c in ("theta", "w", "w_small", "x_tip", "y_tip", "F_block", "F_block_small", "small_error",
                       "block_error")}
@@ -472,6 +483,8 @@ def forward(length, width, thickness, voltage, *, modulus=None, c_moy=None, mate
             message = strain_reason(strain[j], material.strain_limit)
         elif not beam_regime[j]:
             message = regime_reason(reg[j], mech["theta"][j])
+        elif not blocked_ok[j]:
+            message = blocked_reason(mech["theta"][j])
         elif not volt_ok[j]:
             message = voltage_reason(v[j])
         else:
@@ -484,7 +497,8 @@ def forward(length, width, thickness, voltage, *, modulus=None, c_moy=None, mate
         I=rs(I), M_A=rs(masked(Mok, np.nan)), regime=rs(reg), regime_code=rs(rcode),
         max_strain=rs(masked(strain, np.nan)), B1=rs(rows(r.B1.reshape(-1))), error=rs(rows(r.error.reshape(-1))),
         fidelity_used=rs(used), escalated=rs((used != fidelity) & (used != "")),
-        electrochemistry=rs(elec), layer_separation=rs(layer), beam_regime=rs(beam_regime), strain=rs(strain_ok),
+        electrochemistry=rs(elec), layer_separation=rs(layer), beam_regime=rs(beam_regime),
+        blocked_regime=rs(blocked_ok), strain=rs(strain_ok),
         voltage=rs(volt_ok), slender=rs(slender), moment_valid=rs(ok), valid=rs(valid), message=message,
         moment_message=r.message, beam_warnings=list(b.warnings), fidelity=fidelity,
         strain_limit=float(material.strain_limit),

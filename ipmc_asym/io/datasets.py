@@ -30,7 +30,8 @@ __all__ = ["VARIABLES", "sweep_dataset", "uq_dataset", "netcdf_engine", "availab
 VARIABLES = {name: (q.unit, q.long_name) for name, q in BY_NAME.items()}
 _SWEEP_OUT = ("I", "M_A", "theta", "w", "w_small", "F_block", "F_block_small", "B1", "error", "max_strain",
               "fidelity_used", "escalated", "regime", "check_electrochemistry", "check_layer_separation",
-              "check_beam_regime", "check_strain", "check_voltage", "check_slender", "valid")
+              "check_beam_regime", "check_blocked_regime", "check_strain", "check_voltage", "check_slender",
+              "valid")
 
 
 def _label(da, name):

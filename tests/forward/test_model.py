@@ -7,7 +7,14 @@ import pytest
 
 from ipmc_asym.beam.statics import solve_beam
 from ipmc_asym.forward.estimate import evaluate
-from ipmc_asym.forward.model import CHECKS, MECHANICAL_KEYS, MOMENT_KEYS, TIP_POSITION_KEYS, forward
+from ipmc_asym.forward.model import (
+    CHECKS,
+    MECHANICAL_KEYS,
+    MOMENT_KEYS,
+    TIP_POSITION_KEYS,
+    assumption_warnings,
+    forward,
+)
 from ipmc_asym.integral.api import moment
 from ipmc_asym.model.params import NAFION_LI, Strip
 from ipmc_asym.studies import calibrate, uq
@@ -74,7 +81,7 @@ def test_withholding_and_flags():
     assert r.withheld(0) == () and r.flagged(0) == []
     # a failed model assumption keeps every number; past a full turn the tip position is withheld
     assert not r.strain[1] and not r.voltage[1] and r.regime[1] == "multi-turn"
-    assert r.withheld(1) == TIP_POSITION_KEYS and set(r.flagged(1)) == {"beam_regime", "strain", "voltage"}
+    assert r.withheld(1) == TIP_POSITION_KEYS and set(r.flagged(1)) == {"beam_regime", "blocked_regime", "strain", "voltage"}
     assert r.strain[2] and not r.beam_regime[2] and r.withheld(2) == () and r.flagged(2) == ["beam_regime"]
     assert r.withheld(3) == MOMENT_KEYS + MECHANICAL_KEYS and np.isnan(r.I[3]) and r.regime[3] == ""
     w = r.withhold()
@@ -87,7 +94,13 @@ def test_withholding_and_flags():
     assert list(r.flag_mask("F_block")) == [False, True, False, False]
     assert "strain" in r.message  # the first invalid point is 1
     assert r.checks(2) == {"electrochemistry": True, "layer_separation": True, "beam_regime": False,
-                           "strain": True, "voltage": True, "slender": True}
+                           "blocked_regime": True, "strain": True, "voltage": True, "slender": True}
+    # the nominal strip at 5 V (kappa L = 7.4): the blocked strip itself passes a quarter turn,
+    # F_block kept and flagged by its own check; at 3 V (kappa L = 3.6) only the free strip does
+    b = forward(0.02, 5e-3, 200e-6, np.array([3.0, 5.0]), fidelity="leading")
+    assert list(b.blocked_regime) == [True, False] and not np.any(b.beam_regime)
+    assert np.all(np.isfinite(b.F_block)) and list(b.flag_mask("F_block")) == [True, True]  # strain too
+    assert any("blocked strip past a quarter turn" in w for w in assumption_warnings(b))
     # the blocked strip's largest rotation |m| (1 - psi/2) against a direct evaluation of
     # theta_b(t) = m [psi (t - t^2/2) - t] on a fine grid (independent of the closed form)
     from ipmc_asym.beam.statics import blocking_force_ratio
