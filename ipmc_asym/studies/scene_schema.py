@@ -271,6 +271,10 @@ def parse_scene(scene: dict) -> Scene:
         line = bare_number_warning(k, text, base[k], f"strip.{k}") or range_warning(k, base[k], f"strip.{k}")
         if line:
             warns.append(line)
+    for k, a in axes.items():  # swept lengths: the first implausible value
+        line = next((m for m in (range_warning(k, x, f"sweep.{k}") for x in a) if m), None) if k in _STRIP else None
+        if line:
+            warns.append(line)
     warns += material_warnings(material)
     return Scene(name, model, material, pts, swept, outputs, tol, arrays, tuple(warns))
 
