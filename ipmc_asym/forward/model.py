@@ -462,8 +462,13 @@ def forward(length, width, thickness, voltage, *, modulus=None, c_moy=None, mate
     rcode = np.broadcast_to(np.asarray(b.regime_code), (k,))
     # model assumptions: checked where a rung is valid (False elsewhere: nothing to assume about)
     beam_regime = ok & ~np.isin(rcode, _OUTSIDE_CODES)  # ints, not strings
-    # the blocked strip's own largest rotation (NaN beyond the tracked branch: fails)
-    blocked_ok = ok & (blocked_rotation(np.asarray(b.theta, dtype=float).reshape(-1)) <= 0.5 * np.pi)
+    # the blocked strip's own largest rotation |kappa L| (1 - psi/2) (blocked_rotation), with psi
+    # from the beam's block_error = (3/2 - psi)/psi (psi <= 3/2 on the branch): no second
+    # evaluation of psi; NaN beyond the tracked branch fails
+    with np.errstate(all="ignore"):
+        psi = 1.5 / (1.0 + np.asarray(b.block_error, dtype=float).reshape(-1))
+        tb = np.abs(np.asarray(b.theta, dtype=float).reshape(-1)) * (1.0 - 0.5 * psi)
+    blocked_ok = ok & (tb <= 0.5 * np.pi)
     strain_ok = ok & (strain <= material.strain_limit)
     volt_ok = ok & (np.abs(v) <= VALIDATED_VOLTAGE)
     slender = ok & np.broadcast_to(slender_ok(L, wd, th), (k,))
