@@ -29,7 +29,7 @@ SLENDER_LIMITS = {
               "band ~e wide at each edge, a fraction 2e/2l of the width, <= 10 % from 2l/2e = 10"),
     "2l/L": (None, 1.0,
              "a strip, not a plate: the beam bends along L only; wider than long, bending across the "
-             "width and the clamp's edge effects are no longer small"),
+             "width and the clamp's edge effects are not small"),
 }
 
 #: parameter -> (low, high, unit, reason): outside, a one-line warning (the value is used)

@@ -99,6 +99,11 @@ def test_withholding_and_flags():
     # F_block kept and flagged by its own check; at 3 V (kappa L = 3.6) only the free strip does
     b = forward(0.02, 5e-3, 200e-6, np.array([3.0, 5.0]), fidelity="leading")
     assert list(b.blocked_regime) == [True, False] and not np.any(b.beam_regime)
+    from ipmc_asym.forward.model import blocked_rotation
+
+    r2 = forward(PTS["length"] * 4, PTS["width"], PTS["thickness"], PTS["voltage"] * 4, fidelity="leading")
+    assert r2.blocked_regime.any() and not r2.blocked_regime.all()
+    assert np.array_equal(r2.blocked_regime, blocked_rotation(r2.theta) <= np.pi / 2)
     assert np.all(np.isfinite(b.F_block)) and list(b.flag_mask("F_block")) == [True, True]  # strain too
     assert any("blocked strip past a quarter turn" in w for w in assumption_warnings(b))
     # the blocked strip's largest rotation |m| (1 - psi/2) against a direct evaluation of
