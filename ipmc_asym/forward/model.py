@@ -281,18 +281,18 @@ def assumption_warnings(r: "ForwardResult", index=None) -> list:
 
     ``index`` given: the lines of that point; None: over every point, each line at the first
     point that fails it, with the count (step time points, uq samples, sweep rows)."""
-    flat = {c: np.asarray(getattr(r, c), bool).reshape(-1) & np.asarray(r.moment_valid, bool).reshape(-1)
-            for c in ASSUMPTION_CHECKS}
-    size = next(iter(flat.values())).size
-    pts = range(size) if index is None else [int(np.ravel_multi_index(index, np.shape(r.valid)))
-                                             if np.shape(r.valid) else 0]
     ok_m = np.asarray(r.moment_valid, bool).reshape(-1)
+    size = ok_m.size
+    sel = np.ones(size, bool)
+    if index is not None:  # one point
+        sel[:] = False
+        sel[int(np.ravel_multi_index(index, np.shape(r.valid))) if np.shape(r.valid) else 0] = True
     out = []
     for c in ASSUMPTION_CHECKS:
-        bad = [i for i in pts if ok_m[i] and not np.asarray(getattr(r, c)).reshape(-1)[i]]
-        if not bad:
+        bad = np.flatnonzero(sel & ok_m & ~np.asarray(getattr(r, c), bool).reshape(-1))
+        if bad.size == 0:
             continue
-        j = bad[0]
+        j = int(bad[0])
         count = "" if index is not None or size == 1 else f" [{len(bad)} of {size} points; first shown]"
         if c == "strain":
             line = strain_reason(np.asarray(r.max_strain).reshape(-1)[j], r.strain_limit)
