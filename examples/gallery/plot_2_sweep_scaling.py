@@ -5,8 +5,8 @@ Thickness and voltage sweep, and scaling
 :func:`ipmc_asym.sweep` evaluates the grid spanned by ``vary`` (name -> 1-D values, SI) and
 returns one row per point (a NumPy structured array).  Here: tip deflection against voltage for
 four total thicknesses, and the local power-law exponent of the deflection in the thickness.
-Only the rows whose checks all passed (``valid``) are drawn: past a quarter turn the free
-strip is outside the beam model.
+Only the rows inside every model assumption (``valid``) are drawn: the others are kept in
+``rows``, flagged (``check_*``; past a quarter turn the free strip curls back).
 """
 
 import matplotlib.pyplot as plt

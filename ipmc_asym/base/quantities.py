@@ -65,8 +65,11 @@ QUANTITIES = (
     Quantity("escalated", "1", "escalated above the requested fidelity (1) or not (0)"),
     Quantity("check_electrochemistry", "1", "check: a valid rung of the fidelity ladder (1) or none (0)"),
     Quantity("check_layer_separation", "1", "check: electrode layers separated by a neutral core"),
-    Quantity("check_beam_regime", "1", "check: free strip within a quarter turn"),
-    Quantity("check_strain", "1", "check: bending strain within the small-strain limit"),
+    Quantity("check_beam_regime", "1", "assumption: free strip within a quarter turn (values kept either way)"),
+    Quantity("check_blocked_regime", "1", "assumption: blocked strip within a quarter turn (values kept either way)"),
+    Quantity("check_strain", "1", "assumption: face strain within Material.strain_limit (values kept either way)"),
+    Quantity("check_voltage", "1", "assumption: voltage magnitude within settings.VALIDATED_VOLTAGE (values kept either way)"),
+    Quantity("check_slender", "1", "assumption: slender strip, model.limits.SLENDER_LIMITS (values kept either way)"),
 )
 
 #: every name (result-row name and scene name) -> its quantity

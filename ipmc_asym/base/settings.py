@@ -45,8 +45,15 @@ ROUNDING_ERROR = 1e-11
 
 DEFAULT_SCENE_TOL = 1e-3
 
-#: a strain above this at the faces is outside linear elasticity (beam check)
+#: default face strain ``e|kappa|`` above which the small-strain (linear elastic) beam model is
+#: not assumed to hold (``Material.strain_limit``, a model assumption: rows above it are kept
+#: and flagged).  No source read states hydrated Nafion's proportional limit or yield strain
+#: as a number (searched: tensile studies of hydrated Nafion 117/212 describe a linear region
+#: that shrinks with water uptake, without a value we could read); 1 % is a stated default,
+#: settable per material (``--strain-limit``, scene ``[material] strain_limit``)
 STRAIN_LIMIT = 1e-2
+STRAIN_LIMIT_SOURCE = ("stated default, no measured proportional limit of hydrated Nafion read; "
+                       "set Material.strain_limit / --strain-limit from your own tensile data")
 
 #: a scaling law "holds" where the local exponent is within this of the law's exponent
 LAW_HOLD_TOL = 0.05

@@ -734,7 +734,7 @@ def _where_msg(mask, values, n):
     return f"up to {float(np.max(values[mask])):.3g} ({k} of {n} points)"
 
 
-def solve_beam(M, L, EI, *, tol=None, e=None) -> BeamResult:
+def solve_beam(M, L, EI, *, tol=None, e=None, strain_limit=0.01) -> BeamResult:
     """All mechanical outputs of the strip for end moment(s) ``M``.
 
     Parameters
@@ -749,6 +749,9 @@ def solve_beam(M, L, EI, *, tol=None, e=None) -> BeamResult:
         Tolerance for the ``"small"`` regime (default 1 %).
     e : array_like, optional
         HALF thickness (m), to report the maximum bending strain.
+    strain_limit : float
+        Face strain above which the small-strain assumption is said to fail in ``warnings``
+        (``Material.strain_limit``; default 1 %).
 
     Returns
     -------
@@ -778,12 +781,12 @@ def solve_beam(M, L, EI, *, tol=None, e=None) -> BeamResult:
     if np.any(quarter):
         warns.append(
             f"rotation |theta| = {_where_msg(quarter, flat_th, n)} rad > pi/2: arc past a "
-            "quarter turn (w not monotone in M), outside the small-strain beam model"
+            "quarter turn (w not monotone in M); the arc formula still holds"
         )
     if np.any(multi):
         warns.append(
             f"rotation |theta| = {_where_msg(multi, flat_th, n)} rad > 2 pi: the strip winds "
-            "more than a full turn; w is periodic in M and physically meaningless"
+            "more than a full turn; the arc passes through itself, its tip position (w) is meaningless"
         )
     beyond = flat_th > KL_BLOCK_MAX  # (M, L, EI are checked finite: the only NaN of F_block)
     if np.any(beyond):
@@ -795,10 +798,10 @@ def solve_beam(M, L, EI, *, tol=None, e=None) -> BeamResult:
     if e is not None:
         eps = np.asarray(max_strain(M, EI, e))
         fe = eps.reshape(-1)
-        big = fe > 0.01
+        big = fe > strain_limit
         if np.any(big):
             warns.append(
-                f"max bending strain e|kappa| = {_where_msg(big, fe, max(1, fe.size))} > 1 %: "
+                f"max bending strain e|kappa| = {_where_msg(big, fe, max(1, fe.size))} > {strain_limit:g}: "
                 "small-strain assumption questionable"
             )
         eps = _out(eps)

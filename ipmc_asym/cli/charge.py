@@ -13,7 +13,7 @@ from ipmc_asym.io.jsonio import dumps
 
 def register(sub):
     p = sub.add_parser("charge", help=SUMMARIES["charge"])
-    add_strip_options(p)
+    add_strip_options(p, mechanics=False)
     p.add_argument("--model", default="all", choices=model_choices(), help="permittivity model (default all three)")
     p.add_argument("--fidelity", default="corrected", choices=fidelity_names(),
                    help="rung of the fidelity ladder (default corrected)")

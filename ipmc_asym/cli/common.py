@@ -11,7 +11,10 @@ import os
 import re
 import sys
 
+from ipmc_asym.base.settings import MIN_THICKNESS
 from ipmc_asym.base.units import parse_diffusion, parse_length, parse_pressure, parse_voltage
+from ipmc_asym.integral.api import check_min_thickness
+from ipmc_asym.model.limits import bare_number_warning, material_warnings, range_warning
 from ipmc_asym.model.params import Strip, material_from_spec
 
 __all__ = ["UsageError", "Parser", "add_strip_options", "add_material_options", "print_citations", "material_comments",
@@ -46,26 +49,51 @@ def arg_type(conv, name="value"):
     return f
 
 
-def _positive(name, parse, example):
+def warn(line):
+    """One line of warning on stderr (the command goes on)."""
+    sys.stderr.write(f"ipmc-asym: warning: {line}\n")
+
+
+def _positive(name, parse, example, check=None):
     def conv(text):
         v = parse(name, text)
         if v <= 0:
             raise ValueError(f"{name} must be > 0 (e.g. {example}); got {text!r}")
+        if check is not None:
+            check(text, v)
         return v
 
     return arg_type(conv, name)
 
 
+def _plausible_length(name):
+    def check(text, v):
+        if name == "thickness" and v < MIN_THICKNESS:
+            return  # refused by strip_from_args, the one floor every command shares
+        line = bare_number_warning(name, text, v, f"--{name}") or range_warning(name, v, f"--{name}")
+        if line:
+            warn(line)
+
+    return check
+
+
 def length_type(name):
-    return _positive(name, parse_length, "200um, 2cm")
+    return _positive(name, parse_length, "200um, 2cm", _plausible_length(name) if name in ("length", "width",
+                                                                                           "thickness") else None)
 
 
 def pressure_type(name):
     return _positive(name, parse_pressure, "130MPa")
 
 
+def _plausible_diffusion(text, v):
+    line = range_warning("D", v, "--diffusion")
+    if line:
+        warn(line)
+
+
 def diffusion_type(name="--diffusion"):
-    return _positive(name, parse_diffusion, "1e-10m2/s")
+    return _positive(name, parse_diffusion, "1e-10m2/s", _plausible_diffusion)
 
 
 def voltage_type(name="voltage"):
@@ -148,8 +176,9 @@ def c_moy_label(material) -> str:
     return f"{material.C_moy:.6g} mol/m^3 ({how})"
 
 
-def add_strip_options(p, *, voltage=True):
-    """The strip/material options shared by several commands (SI or with units)."""
+def add_strip_options(p, *, voltage=True, mechanics=True):
+    """The strip/material options shared by several commands (SI or with units); ``mechanics``:
+    the command reports beam outputs (``--strain-limit``)."""
     p.add_argument("--length", type=length_type("length"), default=0.02, help="strip length L (default 2cm)")
     p.add_argument("--width", type=length_type("width"), default=5e-3, help="TOTAL width 2l (default 5mm)")
     p.add_argument("--thickness", type=length_type("thickness"), default=200e-6,
@@ -163,6 +192,12 @@ def add_strip_options(p, *, voltage=True):
                    help="mean cation concentration C_moy: paper (3082), formula (~3162) or a value in mol/m^3 "
                         "(default: the material set's, paper for nafion-li)")
     add_material_options(p)
+    if not mechanics:
+        return
+    p.add_argument("--strain-limit", type=arg_type(_strain_limit, "strain-limit"), default=None,
+                   help="face strain e|kappa| up to which the small-strain beam model is assumed (a model assumption: "
+                        "rows above it are kept and flagged), e.g. 0.02 or 2%%; default the material's (1%%, "
+                        "settings.STRAIN_LIMIT)")
 
 
 def add_material_options(p):
@@ -172,6 +207,18 @@ def add_material_options(p):
     p.add_argument("--cite", action="store_true", help="print the bibliography of the run (material set and its sources)")
 
 
+def _strain_limit(text):
+    t = str(text).strip()
+    scale = 0.01 if t.endswith("%") else 1.0
+    try:
+        v = float(t.rstrip("%")) * scale
+    except ValueError:
+        v = float("nan")
+    if not 0.0 < v < 1.0:
+        raise ValueError(f"--strain-limit must be a strain in (0, 1), e.g. 0.01 or 1%; got {text!r}")
+    return v
+
+
 def material_from_args(args):
     """The material of the options, through the library's one parser (params.material_from_spec)."""
     spec = {"preset": getattr(args, "material", "nafion-li")}
@@ -179,7 +226,11 @@ def material_from_args(args):
         spec["E"] = args.modulus
     if getattr(args, "c_moy", None) is not None:
         spec["c_moy"] = args.c_moy
+    if getattr(args, "strain_limit", None) is not None:
+        spec["strain_limit"] = args.strain_limit
     material = material_from_spec(spec, labels=_MATERIAL_OPTIONS)
+    for line in material_warnings(material):
+        warn(line)
     if getattr(args, "cite", False):
         print_citations(material, json_mode=bool(getattr(args, "json", False)))
     return material
@@ -209,10 +260,13 @@ def print_citations(material, json_mode=False):
     (sys.stderr if json_mode else sys.stdout).write(bibliography(material) + "\n")
 
 
-_MATERIAL_OPTIONS = {"preset": "--material", "E": "--modulus", "c_moy": "--c-moy"}
+_MATERIAL_OPTIONS = {"preset": "--material", "E": "--modulus", "c_moy": "--c-moy", "strain_limit": "--strain-limit"}
 
 
 def strip_from_args(args):
+    """The strip of the options; a thickness below ``settings.MIN_THICKNESS`` is refused here, the
+    one check every command with strip options shares (integral.api.check_min_thickness)."""
+    check_min_thickness(args.thickness)
     return Strip(length=args.length, width=args.width, thickness=args.thickness,
                  voltage=getattr(args, "voltage", 1.0))
 

@@ -86,5 +86,7 @@ def run(args):
             print(f"warning [{r['model']}]: {w}")
         if not r["valid"]:
             failed = ", ".join(k for k, ok in r["checks"].items() if not ok)
-            print(f"not valid [{r['model']}]: failed check(s) {failed}; withheld (n/a): {', '.join(r['withheld'])}")
+            held = ", ".join(r["withheld"]) or "none"
+            print(f"not valid [{r['model']}]: failed check(s) {failed} (model assumptions: numbers kept, flagged); "
+                  f"withheld (n/a): {held}")
     return 0

@@ -35,7 +35,7 @@ def _freq(name):
 
 def register(sub):
     p = sub.add_parser("freq", help=SUMMARIES["freq"])
-    add_strip_options(p, voltage=False)
+    add_strip_options(p, voltage=False, mechanics=False)
     p.add_argument("--from", dest="f1", type=_freq("--from"), required=True, help="first frequency (e.g. 0.01Hz)")
     p.add_argument("--to", dest="f2", type=_freq("--to"), required=True, help="last frequency (e.g. 1kHz)")
     p.add_argument("--points", type=count_type("--points", 2), default=50, help="log-spaced points (default 50)")

@@ -12,7 +12,7 @@ from ipmc_asym.studies.profiles import PAPER_LAYERS
 
 def register(sub):
     p = sub.add_parser("profiles", help=SUMMARIES["profiles"])
-    add_strip_options(p)
+    add_strip_options(p, mechanics=False)
     p.add_argument("--model", default="all", choices=model_choices(), help="permittivity model (default all)")
     p.add_argument("--out", default="figures", help="output directory for CSV and PNG (default figures/)")
     p.add_argument("--json", action="store_true", help="print the layer summary as JSON")

@@ -7,8 +7,12 @@ import sys
 from ipmc_asym.base.units import fmt_length
 from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import add_material_options, fmt_num, scene_with_material
+from ipmc_asym.forward.model import FLAGS
 from ipmc_asym.io.jsonio import dumps
 from ipmc_asym.studies.scenes import run_scene
+
+#: scene output -> the forward model's output name (which model assumptions concern it: FLAGS)
+_KEY = {"I": "I", "moment": "M_A", "rotation": "theta", "tip_deflection": "w", "blocking_force": "F_block"}
 
 
 def register(sub):
@@ -58,12 +62,15 @@ def run(args) -> int:
         for i, v in enumerate(o["values"]):
             beam = f", beam {o['beam'][i]}" if "beam" in o else ""
             unit = "" if o["unit"] == "dimensionless" else o["unit"]
+            c = res.get("checks", [{}] * (i + 1))[i]
             if v is None:
-                c = res.get("checks", [{}] * (i + 1))[i]
-                failed = ", ".join(n for n in ("beam_regime", "strain") if not c.get(n, True))
-                print(f"  {k}[{where(i) or i}] = n/a (withheld: check {failed} failed)")
+                print(f"  {k}[{where(i) or i}] = n/a (withheld: the free strip winds past a full turn)")
                 continue
+            failed = [n for n, keys in FLAGS.items() if _KEY.get(k) in keys and not c.get(n, True)]
+            flag = f"; flagged: {', '.join(failed)}" if failed else ""
             print(f"  {k}[{where(i) or i}] = {fmt_num(v, '.6g')} {unit}  ({o['fidelity'][i]}, rel. err <= "
-                  f"{o['error_estimate'][i]:.2g}{beam})")
+                  f"{o['error_estimate'][i]:.2g}{beam}{flag})")
+    for w in res.get("warnings", []):
+        print(f"  warning: {w}")
     sys.stdout.flush()
     return 0

@@ -16,16 +16,20 @@ from ipmc_asym.cli.common import (
     count_type,
     diffusion_type,
     first_run_notice,
+    fmt_num,
     material_from_args,
     strip_from_args,
 )
 from ipmc_asym.cli.drive import add_beam_options
 from ipmc_asym.dynamics.circuit import STEP_FIDELITIES, step_response
 from ipmc_asym.dynamics.waveforms import parse_waveform
+from ipmc_asym.forward.model import CHECKS
 from ipmc_asym.io.fileio import atomic_write, check_output_path
 from ipmc_asym.io.jsonio import dumps
 
 COLUMNS = ("t", "phi0", "sigma", "current_density", "M_A", "theta", "w")
+#: per time point: the forward model's checks (forward.model.CHECKS), as in estimate and sweep
+CHECK_COLUMNS = tuple(f"check_{c}" for c in CHECKS) + ("valid",)
 
 
 def _duration(text):
@@ -33,6 +37,11 @@ def _duration(text):
     if v <= 0:
         raise ValueError(f"--duration must be > 0 (e.g. 0.5s, 200ms); got {text!r}")
     return v
+
+
+def _num(x, scale):
+    """A withheld (NaN) value as n/a, like estimate."""
+    return fmt_num(x * scale if np.isfinite(x) else None, ".4g")
 
 
 def register(sub):
@@ -51,8 +60,8 @@ def register(sub):
                    help="instead of the step of --voltage: a SPEC such as 'sine:1V@10Hz' or 'step:1V+square:0.1V@5Hz' "
                         "(see ipmc-asym drive --help)")
     add_beam_options(p, "quasi-static")
-    p.add_argument("--out", default=None, help="CSV file (columns t, phi0, sigma, current_density, M_A, theta, w; "
-                                               "a first column model with --model all)")
+    p.add_argument("--out", default=None, help="CSV file (columns t, phi0, sigma, current_density, M_A, theta, w, "
+                                               "check_* and valid per time point; a first column model with --model all)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
 
 
@@ -76,6 +85,11 @@ def run(args):
         return {"t": r.t, "phi0": r.phi0, "sigma": r.sigma, "current_density": r.current_density, "M_A": r.M_A,
                 "theta": r.theta, "w": r.w}
 
+    def flags_of(r):
+        flags = {f"check_{c}": r.checks[c] for c in CHECKS}
+        flags["valid"] = r.valid
+        return flags
+
     r0 = results[models[0]]
     drive = "step" if args.waveform is None else args.waveform.spec
     if args.out:
@@ -85,26 +99,32 @@ def run(args):
             taus = ", ".join(f"{m}: {results[m].tau!r}" for m in models)
             wr.writerow([f"# tau = {taus} s; thickness_total = {strip.thickness!r} m; model = {args.model}; "
                          f"fidelity = {r0.fidelity}; drive = {drive}; beam = {args.beam}; SI units; {r0.notes[0]}"])
-            wr.writerow((("model",) if many else ()) + COLUMNS)
+            wr.writerow((("model",) if many else ()) + COLUMNS + CHECK_COLUMNS)
             for mname in models:
-                cols = cols_of(results[mname])
+                cols, flags = cols_of(results[mname]), flags_of(results[mname])
                 for i in range(results[mname].t.size):
-                    wr.writerow(([mname] if many else []) + [repr(float(cols[c][i])) for c in COLUMNS])
+                    wr.writerow(([mname] if many else []) + [repr(float(cols[c][i])) for c in COLUMNS]
+                                + [str(bool(flags[c][i])) for c in CHECK_COLUMNS])
         sys.stderr.write(f"step: {sum(r.t.size for r in results.values())} rows -> {args.out}\n")
 
     def head_of(r):
         return {"tau": r.tau, "R": r.R, "C_d0": r.C_d0, "model": r.model, "fidelity": r.fidelity,
                 "voltage": strip.voltage, "thickness_total": strip.thickness, "half_thickness_e": strip.e,
                 "diffusion_coefficient": material.D, "seconds": r.seconds, "notes": r.notes, "message": r.message,
-                "waveform": drive, "beam": args.beam}
+                "waveform": drive, "beam": args.beam, "warnings": r.warnings}
+
+    for mname in models:  # the forward model's flags, one line each (also in --json's "warnings")
+        for w in results[mname].warnings:
+            sys.stderr.write(f"step: warning: {mname}: {w}\n" if len(models) > 1 else f"step: warning: {w}\n")
 
     if args.json:
         if len(models) == 1:
             out = head_of(r0)
             out.update(cols_of(r0))
+            out.update(flags_of(r0))
         else:
             out = {"model": "all", "notes": r0.notes, "thickness_total": strip.thickness,
-                   "models": {m: dict(head_of(results[m]), **cols_of(results[m])) for m in models}}
+                   "models": {m: dict(head_of(results[m]), **cols_of(results[m]), **flags_of(results[m])) for m in models}}
         print(dumps(out, indent=1))
         return 0
     if not args.out:
@@ -116,10 +136,10 @@ def run(args):
                   f"C_d(0) = {r.C_d0:.4g} F/m^2, D = {material.D:.3g} m^2/s)")
             idx = np.unique(np.linspace(0, r.t.size - 1, min(r.t.size, 11)).astype(int))
             print(f"{'t [s]':>11s} {'sigma [C/m^2]':>14s} {'J [A/m^2]':>11s} {'M_A [N m]':>11s} {'theta':>9s} "
-                  f"{'w [mm]':>9s}")
+                  f"{'w [mm]':>9s} valid")
             for i in idx:
                 print(f"{r.t[i]:11.4g} {r.sigma[i]:14.6g} {r.current_density[i]:11.4g} {r.M_A[i]:11.4g} "
-                      f"{r.theta[i]:9.4g} {r.w[i] * 1e3:9.4g}")
+                      f"{_num(r.theta[i], 1.0):>9s} {_num(r.w[i], 1e3):>9s} {'yes' if r.valid[i] else 'no'}")
         for n in r0.notes:
             print(f"note: {n}")
     return 0

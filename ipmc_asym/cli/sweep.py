@@ -23,6 +23,7 @@ from ipmc_asym.cli.common import (
     strip_from_args,
     tol_type,
 )
+from ipmc_asym.forward.model import ASSUMPTION_CHECKS, ASSUMPTION_LIMITS
 from ipmc_asym.io.datasets import sweep_dataset, write_netcdf
 from ipmc_asym.io.fileio import atomic_write, check_output_path
 from ipmc_asym.io.jsonio import dumps
@@ -131,6 +132,13 @@ def run(args) -> int:
     mat = material_from_args(args)
     t0 = time.perf_counter()
     failures: list = []
+    outside = dict.fromkeys(ASSUMPTION_CHECKS, 0)
+
+    def counted(c):  # rows outside each model assumption (kept and flagged), for one summary line each
+        for k in outside:
+            outside[k] += int(np.count_nonzero(~c["check_" + k] & c["check_electrochemistry"]))
+        return c
+
     bar = progress(n, "sweep", enabled=False if args.no_progress else None, unit="row")
     with warnings.catch_warnings(), np.errstate(all="ignore"):
         # no NumPy RuntimeWarning with internal paths: non-finite results are columns/notes
@@ -146,10 +154,10 @@ def run(args) -> int:
             bad = ~arr["check_electrochemistry"]
             if np.any(bad):
                 failures.append(f"{int(bad.sum())} row(s) with no valid rung of the fidelity ladder")
-            chunks = [withhold(arr, copy=False)]
+            chunks = [counted(withhold(arr, copy=False))]
         else:
             # computed one chunk ahead of the formatting and writing: one core each
-            chunks = prefetched((withhold(c, copy=False) for c in iter_sweep(
+            chunks = prefetched((counted(withhold(c, copy=False)) for c in iter_sweep(
                 vary, args.model, args.fidelity, base, mat, args.tol, escalate=not args.no_escalate,
                 progress=bar, failures=failures)), threads=1)
             # meanwhile, the formatter loads from the cache (serial code: no second parallel
@@ -190,6 +198,10 @@ def run(args) -> int:
         if args.json and not to_json_file:
             print(dumps({"out": args.out, "n_rows": rows, "fits": fits, "fit_notes": notes, "seconds": dt},
                         indent=1))
+    for k, cnt in outside.items():
+        if cnt:
+            sys.stderr.write(f"sweep: warning: {cnt} row(s) outside the model assumption {ASSUMPTION_LIMITS[k]}; "
+                             f"numbers kept, check_{k} = false\n")
     if failures:
         sys.stderr.write(f"sweep: rows with no valid fidelity are kept with valid=False and empty "
                          f"results; first: {failures[0]}\n")

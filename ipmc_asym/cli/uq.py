@@ -28,6 +28,10 @@ def register(sub):
                    help="run the chunks on dask.distributed (default: in this process)")
     p.add_argument("--out", default=None, metavar="F.nc", help="NetCDF file of samples, outputs and indices")
     p.add_argument("--plot", default=None, metavar="F.png", help="histograms of the outputs")
+    p.add_argument("--keep-invalid", action="store_true",
+                   help="keep the samples outside a model assumption (past a quarter turn, above the strain limit, "
+                        "beyond the validated voltage, not slender) in the statistics; by default they are counted "
+                        "and left out (their check_* variables are in the NetCDF either way)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     add_material_options(p)
     p.set_defaults(material=None)  # default: the scene's [material]
@@ -42,9 +46,16 @@ def run(args) -> int:
 
         check_scheduler(args.scheduler)
     res = run_uq(scene_with_material(args.scene, args), args.samples, seed=args.seed, fidelity=args.fidelity,
-                 scheduler=args.scheduler)
+                 scheduler=args.scheduler, keep_invalid=args.keep_invalid)
     if args.cite and res.material is not None:
         print_citations(res.material, json_mode=args.json)
+    if res.n_outside:
+        how = "kept in the statistics (--keep-invalid)" if res.keep_invalid else \
+            f"left out of the statistics ({res.n_used} samples used; Sobol' indices on {res.n_sobol} of {res.base_n} " \
+            "base points; --keep-invalid keeps them)"
+        sys.stderr.write(f"uq: {res.n_outside} of {res.n_samples} samples outside a model assumption, {how}\n")
+        for w in res.warnings:
+            sys.stderr.write(f"uq: warning: {w}\n")
     if args.out:
 
         eng = write_netcdf(uq_dataset(res), args.out)

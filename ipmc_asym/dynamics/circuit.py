@@ -41,6 +41,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ipmc_asym.base.registry import check_choice
+from ipmc_asym.base.settings import VALIDATED_VOLTAGE
 from ipmc_asym.beam.dynamics import (
     DEFAULT_MODES,
     VISCOUS_MODULUS_SOURCE,
@@ -61,7 +62,7 @@ from ipmc_asym.dynamics.electrode import (
     time_constant,
 )
 from ipmc_asym.dynamics.transient import solve_transient
-from ipmc_asym.forward.model import forward
+from ipmc_asym.forward.model import CHECKS, assumption_warnings, forward, voltage_reason
 from ipmc_asym.kernels import _generated_charge as GC
 from ipmc_asym.kernels.jit import jit
 from ipmc_asym.model import groups
@@ -77,7 +78,7 @@ from ipmc_asym.model.permittivity import Permittivity, get_model
 
 __all__ = ["DYNAMIC_NOTES", "StepResult", "FrequencyResult", "core_resistance", "time_constant",
            "waveform", "step_response", "frequency_response", "circuit_response", "quasi_static_mechanics",
-           "circuit_impedance_error", "circuit_band"]
+           "circuit_impedance_error", "circuit_band", "quasi_static_forward"]
 
 #: stated in every dynamic output
 WATER_NOTE = ("water transport (the paper's Darcy law) and the back-relaxation it causes are outside this model: "
@@ -198,6 +199,10 @@ class StepResult:
     success : bool ; message : str
     extra : dict                  solver details (pnp: mesh, energy balance, charge error)
     seconds : float
+    checks : dict                 check name (``forward.model.CHECKS``) -> bool array (n,): the
+                                  forward model's checks at each time point (a failed model
+                                  assumption keeps the numbers; :attr:`warnings` says which)
+    warnings : list of str        one line per failed model assumption (count of time points)
     """
 
     t: np.ndarray
@@ -219,6 +224,16 @@ class StepResult:
     message: str
     extra: dict = field(default_factory=dict)
     seconds: float = 0.0
+    checks: dict = field(default_factory=dict)
+    warnings: list = field(default_factory=list)
+
+    @property
+    def valid(self) -> np.ndarray:
+        """Bool array (n,): every check passed at each time point."""
+        out = np.ones(self.t.shape, bool)
+        for v in self.checks.values():
+            out &= v
+        return out
 
 
 @jit
@@ -293,6 +308,15 @@ def _integrate(tt, ps, rho, mid, X, Wt, A_out, s_out, state):
     state[4] = h_prev
 
 
+def quasi_static_forward(u, strip: Strip, perm: Permittivity, material: Material):
+    """The forward model (:class:`ipmc_asym.forward.model.ForwardResult`, withheld outputs NaN)
+    of the static strip at the layer voltage(s) ``u`` (V); see :func:`quasi_static_mechanics`."""
+    fid = "corrected" if _model_id(perm, "corrected") >= 0 else "quadrature"
+    with np.errstate(all="ignore"):
+        return forward(strip.length, strip.width, strip.thickness, np.asarray(u, dtype=float), material=material,
+                       model=perm, fidelity=fid).withhold()
+
+
 def quasi_static_mechanics(u, strip: Strip, perm: Permittivity, material: Material):
     """``(M_A, theta, w, F_block)`` of the static strip at the layer voltage(s) ``u`` (V).
 
@@ -302,9 +326,7 @@ def quasi_static_mechanics(u, strip: Strip, perm: Permittivity, material: Materi
     first valid rung, then the beam (no inertia).  Arrays of the shape of ``u``: moment (N m),
     rotation (rad), arc tip deflection (m), large-displacement blocking force (N).
     """
-    fid = "corrected" if _model_id(perm, "corrected") >= 0 else "quadrature"
-    r = forward(strip.length, strip.width, strip.thickness, np.asarray(u, dtype=float), material=material,
-                model=perm, fidelity=fid)
+    r = quasi_static_forward(u, strip, perm, material)
     return (np.asarray(r.M_A, dtype=float), np.asarray(r.theta, dtype=float), np.asarray(r.w, dtype=float),
             np.asarray(r.F_block, dtype=float))
 
@@ -459,18 +481,31 @@ def step_response(voltage=1.0, duration=None, *, strip: Strip | None = None, mod
                      "profiles (p' = (C + A3) E, which adds the pressure gradient of the ohmic core field) is in "
                      "extra['M_A_profiles']")
         extra = dict(extra, M_A_profiles=r.M_A_profiles)
-    M, th, w, Fb = quasi_static_mechanics(u, s, perm, m)
+    # every time point through the forward model and its checks (the same as estimate's)
+    fr = quasi_static_forward(u, s, perm, m)
+    checks = {c: np.asarray(getattr(fr, c), bool).reshape(-1) for c in CHECKS}
+    warns = assumption_warnings(fr)
+    applied = fun(tgrid)
+    # the voltage check concerns the applied voltage too (the layers' one lags behind it)
+    over = np.abs(applied) > VALIDATED_VOLTAGE
+    if np.any(over & checks["voltage"]):
+        checks["voltage"] = checks["voltage"] & ~over
+        bad = ~checks["voltage"]
+        warns = [w for w in warns if "VALIDATED_VOLTAGE" not in w]
+        warns.append(voltage_reason(np.max(np.abs(applied))) + f" [{int(bad.sum())} of {bad.size} points]")
+    M, th, w, Fb = (np.asarray(getattr(fr, k), dtype=float) for k in ("M_A", "theta", "w", "F_block"))
     if dyn is not None:
         thd, wd, Fd = dyn.advance(tgrid, M, th, w, Fb)
         extra = dict(extra, theta_quasi_static=th[keep], w_quasi_static=w[keep], F_block_quasi_static=Fb[keep],
                      beam_frequencies={"clamped-free": natural_frequencies("clamped-free", dyn.beam, 3).tolist(),
                                        "clamped-pinned": natural_frequencies("clamped-pinned", dyn.beam, 3).tolist()})
-        sigma, J, u, M, th, w, Fb = (a[keep] for a in (sigma, J, u, M, thd, wd, Fd))
+        sigma, J, u, M, th, w, Fb, applied = (a[keep] for a in (sigma, J, u, M, thd, wd, Fd, applied))
+        checks = {c: v[keep] for c, v in checks.items()}
         tgrid = tout
-    return StepResult(t=tgrid, phi0=fun(tgrid), sigma=sigma, current_density=J, layer_voltage=u, M_A=M,
+    return StepResult(t=tgrid, phi0=applied, sigma=sigma, current_density=J, layer_voltage=u, M_A=M,
                       theta=th, w=w, F_block=Fb, tau=tau, R=R, C_d0=0.5 * capacitance_scale(perm, m),
                       fidelity=fidelity, model=perm.name, notes=notes, success=success, message=message,
-                      extra=extra, seconds=time.perf_counter() - t0)
+                      extra=extra, seconds=time.perf_counter() - t0, checks=checks, warnings=warns)
 
 
 def circuit_impedance_error(f, thickness, perm: Permittivity, material: Material):

@@ -4,10 +4,12 @@ One strip through :func:`ipmc_asym.forward.model.forward` (``M_A = A5 I``, paper
 3-4, then the beam of :mod:`ipmc_asym.beam.statics`), formatted as one result row.  Signs as
 in the paper: a positive voltage gives ``M_A > 0``, ``theta < 0`` and ``w < 0``.
 
-No number whose validity check failed is returned as a result: :func:`moment_escalating`
+No number whose numerical check failed is returned as a result: :func:`moment_escalating`
 climbs the fidelity ladder (``registry.FIDELITIES``, cheapest first) point by point to the
-cheapest rung valid there; the four checks (:data:`CHECKS`) and what each withholds are
-defined once, in :mod:`ipmc_asym.forward.model`.
+cheapest rung valid there.  A failed model assumption (beam regime, strain, voltage, slender
+strip) keeps the numbers and flags the row (``checks``, ``warnings``).  The checks
+(:data:`CHECKS`) and what each withholds or flags are defined once, in
+:mod:`ipmc_asym.forward.model`.
 """
 
 from __future__ import annotations
@@ -17,9 +19,8 @@ import time
 import numpy as np
 
 from ipmc_asym.base.registry import check_choice
-from ipmc_asym.base.settings import VALIDATED_VOLTAGE
 from ipmc_asym.forward.escalation import Escalated, check_tol, moment_escalating
-from ipmc_asym.forward.model import CHECKS, FREE_STRIP_KEYS, MECHANICAL_KEYS, forward
+from ipmc_asym.forward.model import CHECKS, FREE_STRIP_KEYS, MECHANICAL_KEYS, assumption_warnings, forward
 from ipmc_asym.integral.api import check_fidelity
 from ipmc_asym.model.params import NAFION_LI, Material, Strip, debye_length
 from ipmc_asym.model.permittivity import MODELS, get_model
@@ -55,15 +56,18 @@ def evaluate(strip: Strip, model="constant", fidelity="quadrature", material: Ma
         as "small" (``regime``).
     escalate : bool
     on_invalid : {"raise", "nan"}
-        A failed check: one-line ``ValueError`` (default), or the row with the affected
-        outputs set to ``None`` (NaN) and ``valid = False``.
+        No valid rung (a numerical check failed at every rung tried): one-line ``ValueError``
+        (default), or the row with the moment and mechanical outputs ``None`` and
+        ``valid = False``.  A failed model assumption never raises: the row keeps its numbers,
+        ``valid = False``, the failed ``checks`` and one warning line each.
 
     Returns
     -------
     dict
         The keys of :data:`RESULT_KEYS` plus ``regime``, ``warnings``, ``x_tip``, ``y_tip``,
         ``debye_length`` (m), ``max_strain``, ``checks`` (each of :data:`CHECKS` -> bool),
-        ``valid`` (all checks), ``withheld`` (outputs set to ``None`` by a failed check);
+        ``valid`` (all checks), ``flagged`` (the model assumptions that failed), ``withheld``
+        (outputs set to ``None``: no valid rung, or the tip position past a full turn);
         ``error_estimate`` bounds the relative error of ``I`` (hence of ``M_A``, ``theta``,
         ``w_small``, ``F_block_small``).
     """
@@ -80,21 +84,16 @@ def evaluate(strip: Strip, model="constant", fidelity="quadrature", material: Ma
         raise ValueError(r.moment_message)
     used = str(r.fidelity_used)
     checks = r.checks()
-    failed = r.failed()
     withheld = list(r.withheld())
-    # the beam's own lines where its outputs are kept; where a check withholds them, ours say why
-    warnings = list(r.beam_warnings) if failed is None else []
-    if failed is not None:
+    # one line per failed model assumption (limit and source); the beam's own line where the
+    # large-displacement blocking force is not tracked
+    warnings = [] if not settled else assumption_warnings(r, ())
+    warnings += [w for w in r.beam_warnings if w.startswith("F_block")]
+    if not settled:
         warnings.append(r.message)
     if settled and used != fidelity:
         warnings.append(f"escalated from {fidelity!r} to {used!r} (first rung valid here)")
-    if abs(strip.voltage) > VALIDATED_VOLTAGE:
-        warnings.append(f"|voltage| {abs(strip.voltage):g} V > {VALIDATED_VOLTAGE:g} V: beyond the range the toolkit "
-                        "is validated on, and far beyond water electrolysis (~1.23 V), which this "
-                        "blocking-electrode model leaves out; the numbers solve the equations, not the device")
     valid = all(checks.values())
-    if not valid and on_invalid == "raise":
-        raise ValueError(f"model {perm.name}: " + next(w for w in warnings[::-1] if "withheld" in w))
     row = {
         "model": perm.name,
         "fidelity": fidelity,
@@ -124,6 +123,7 @@ def evaluate(strip: Strip, model="constant", fidelity="quadrature", material: Ma
         "max_strain": _f(r.max_strain) if settled else None,
         "checks": checks,
         "valid": valid,
+        "flagged": r.flagged(),
         "withheld": withheld,
         "warnings": warnings,
     }

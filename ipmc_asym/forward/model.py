@@ -10,8 +10,16 @@ quasi-static mechanics).  The chain (paper sections 3-4):
 * the cantilever (:func:`ipmc_asym.beam.statics.solve_beam`): ``theta = -M_A L/EI`` (eq. 12),
   the arc deflection and ``w_small = -M_A L^2/(2 EI)`` (eq. 13), ``F_small = 3 M_A/(2L)``
   (eq. 14) and the large-displacement blocking force;
-* the four checks of :data:`CHECKS` and the withholding rule (:data:`WITHHOLD`): no number
-  whose check failed is returned as a result.
+* the checks of :data:`CHECKS`, of two kinds.  *Numerical validity*
+  (:data:`NUMERICAL_CHECKS`: the rung's error bound, separate layers) is fixed by escalation;
+  where no rung holds, the outputs are withheld (:data:`WITHHOLD`).  *Model assumptions*
+  (:data:`ASSUMPTION_CHECKS`: the free strip within a quarter turn, the blocked strip within a
+  quarter turn (the lever arm of eq. 15), the face strain within
+  ``Material.strain_limit``, the voltage within ``settings.VALIDATED_VOLTAGE``, a slender
+  strip, :mod:`ipmc_asym.model.limits`) keep the numbers and flag the row
+  (:data:`FLAGS`: which outputs each concerns; :func:`assumption_warnings`: one line each,
+  naming the limit and its source); only a quantity that means nothing is withheld: the free
+  strip's tip position past a full turn (the arc passes through itself).
 
 Signs as in the paper: a positive voltage gives ``M_A > 0``, ``theta < 0`` and ``w < 0``.
 """
@@ -24,47 +32,131 @@ import numpy as np
 
 from ipmc_asym.base.registry import FIDELITIES as _FIDELITY_SPECS
 from ipmc_asym.base.registry import compiled_fidelities, fidelity_names
-from ipmc_asym.base.settings import OUTSIDE_REGIMES, STRAIN_LIMIT, VALIDITY_LIMIT
-from ipmc_asym.beam.statics import REGIMES, solve_beam
+from ipmc_asym.base.settings import OUTSIDE_REGIMES, STRAIN_LIMIT, STRAIN_LIMIT_SOURCE, VALIDATED_VOLTAGE, VALIDITY_LIMIT
+from ipmc_asym.beam.statics import REGIMES, blocking_force_ratio, solve_beam
 from ipmc_asym.forward.escalation import Escalated, check_tol, moment_escalating, rung_checks
 from ipmc_asym.integral.api import check_fidelity, check_min_thickness, closed_model_id, validity_limit
 from ipmc_asym.integral.samples import moment_samples
 from ipmc_asym.model import groups
+from ipmc_asym.model.limits import slender_ok, slender_warnings
 from ipmc_asym.model.params import NAFION_LI, Material, moment_scale, second_moment
 from ipmc_asym.model.permittivity import get_model
 
-__all__ = ["forward", "ForwardResult", "CHECKS", "MOMENT_KEYS", "FREE_STRIP_KEYS", "MECHANICAL_KEYS",
-           "WITHHOLD", "SAMPLING_FIDELITIES", "distinct_pairs", "strain_reason", "regime_reason"]
+__all__ = ["forward", "ForwardResult", "CHECKS", "NUMERICAL_CHECKS", "ASSUMPTION_CHECKS", "FLAGS", "MOMENT_KEYS",
+           "FREE_STRIP_KEYS", "MECHANICAL_KEYS", "TIP_POSITION_KEYS", "WITHHOLD", "SAMPLING_FIDELITIES",
+           "ASSUMPTION_LIMITS", "distinct_pairs", "strain_reason", "regime_reason", "voltage_reason", "blocked_reason",
+           "flag_mask", "assumption_warnings",
+           "blocked_rotation"]
 
+#: numerical validity: the rung's error bound on ``I`` and separate layers (escalation fixes
+#: them; where no rung holds, the outputs are withheld)
+NUMERICAL_CHECKS = ("electrochemistry", "layer_separation")
+#: model assumptions: the free strip within a quarter turn (``beam_regime``), the blocked strip
+#: within a quarter turn (``blocked_regime``: the lever arm ``L - s`` of eq. 15), the face strain
+#: within ``Material.strain_limit``, ``|voltage| <= settings.VALIDATED_VOLTAGE``, a slender
+#: strip (:data:`ipmc_asym.model.limits.SLENDER_LIMITS`); a failed one flags, never withholds
+ASSUMPTION_CHECKS = ("beam_regime", "blocked_regime", "strain", "voltage", "slender")
 #: the validity checks of a result, in the order of the chain (electrochemistry -> beam)
-CHECKS = ("electrochemistry", "layer_separation", "beam_regime", "strain")
+CHECKS = NUMERICAL_CHECKS + ASSUMPTION_CHECKS
 #: outputs of the moment integral (withheld where no rung is valid)
 MOMENT_KEYS = ("I", "M_A", "B1")
-#: outputs of the free strip (outside the model past a quarter turn / above the strain limit)
+#: outputs of the free strip (flagged past a quarter turn)
 FREE_STRIP_KEYS = ("theta", "w", "w_small", "x_tip", "y_tip")
-#: every mechanical output (all withheld where the strain check fails)
+#: every mechanical output
 MECHANICAL_KEYS = FREE_STRIP_KEYS + ("F_block", "F_block_small")
+#: the free strip's tip position: meaningless past a full turn (the arc passes through itself;
+#: ``w`` is periodic in ``M``), withheld there
+TIP_POSITION_KEYS = ("w", "w_small", "x_tip", "y_tip")
+#: model assumption -> its limit and the limit's source, in one line (summaries of many rows)
+ASSUMPTION_LIMITS = {
+    "beam_regime": "free strip within a quarter turn, |theta| <= pi/2 (past it the arc of eq. 12 curls back: w not "
+                   "monotone in M)",
+    "blocked_regime": "blocked strip within a quarter turn, |kappa L| (1 - psi/2) <= pi/2 (the paper's lever arm "
+                      "L - s of eq. 15)",
+    "strain": f"face strain e|kappa| <= Material.strain_limit (default settings.STRAIN_LIMIT = {STRAIN_LIMIT:g}: "
+              f"{STRAIN_LIMIT_SOURCE})",
+    "voltage": f"|voltage| <= settings.VALIDATED_VOLTAGE = {VALIDATED_VOLTAGE:g} V (validated against the BVP; water "
+               "electrolysis, ~1.23 V, is outside this blocking-electrode model)",
+    "slender": "slender strip: L/2e >= 10, 2l/2e >= 10, 2l/L <= 1 (model.limits.SLENDER_LIMITS, each with its reason)",
+}
+#: model assumption -> the outputs it concerns (flagged where it fails, :func:`flag_mask`)
+FLAGS = {"beam_regime": FREE_STRIP_KEYS, "blocked_regime": ("F_block", "F_block_small"), "strain": MECHANICAL_KEYS,
+         "voltage": MOMENT_KEYS + MECHANICAL_KEYS,
+         "slender": MOMENT_KEYS + MECHANICAL_KEYS}
 #: the withholding rule, most severe first: (what failed, outputs withheld).  ``"moment"``: no
-#: rung is valid (electrochemistry or layer separation failed at every rung tried); ``"strain"``:
-#: ``e |kappa| > STRAIN_LIMIT``; ``"beam_regime"``: the free strip is past a quarter turn (the
-#: blocking forces are kept there: the blocked strip is held straight)
-WITHHOLD = (("moment", MOMENT_KEYS + MECHANICAL_KEYS), ("strain", MECHANICAL_KEYS),
-            ("beam_regime", FREE_STRIP_KEYS))
+#: rung is valid (electrochemistry or layer separation failed at every rung tried);
+#: ``"multi-turn"``: the free strip winds more than a full turn (its tip position means nothing).
+#: A failed model assumption withholds nothing (:data:`FLAGS`)
+WITHHOLD = (("moment", MOMENT_KEYS + MECHANICAL_KEYS), ("multi-turn", TIP_POSITION_KEYS))
+_MULTI_TURN = REGIMES.index("multi-turn")
 #: rungs with a compiled point kernel (those :func:`forward` climbs with per-point ``c_moy``)
 SAMPLING_FIDELITIES = compiled_fidelities()
 _OUTSIDE_CODES = [REGIMES.index(o) for o in OUTSIDE_REGIMES]
 
 
-def strain_reason(strain) -> str:
-    """One line: why the strain check withholds the mechanical outputs (``strain`` = ``e|kappa|``)."""
-    return (f"strain at the faces e|kappa| = {float(strain):.3g} > STRAIN_LIMIT {STRAIN_LIMIT:g}: "
-            "outside the small-strain beam model; mechanical outputs withheld")
+def _strain_source(limit) -> str:
+    return (f"settings.STRAIN_LIMIT: {STRAIN_LIMIT_SOURCE}" if float(limit) == STRAIN_LIMIT
+            else "given (Material.strain_limit, --strain-limit)")
 
 
-def regime_reason(regime) -> str:
-    """One line: why the beam-regime check withholds the free-strip outputs."""
-    return (f"free strip {regime} (|theta| > pi/2): outside the beam model; "
-            "free-strip outputs withheld (blocking forces kept: the strip is held straight)")
+def strain_reason(strain, limit=STRAIN_LIMIT) -> str:
+    """One line: the strain assumption fails (``strain`` = ``e|kappa|``, ``limit`` = ``Material.strain_limit``)."""
+    return (f"strain at the faces e|kappa| = {float(strain):.3g} > strain limit {float(limit):g} "
+            f"({_strain_source(limit)}): outside the small-strain beam model; mechanical outputs kept, "
+            "flagged check_strain = false")
+
+
+def blocked_rotation(theta):
+    """Largest rotation (rad) along the BLOCKED strip for free-strip rotation(s) ``theta`` = ``-kappa L``.
+
+    The blocked strip's slope is ``theta_b(t) = m [psi (t - t^2/2) - t]`` (``m = kappa L``,
+    ``t = s/L``, ``F = psi M/L``, paper section 3 with the lever arm ``L - s``); its extremes are
+    at the tip, ``m (psi/2 - 1)``, and at ``t = 1 - 1/psi``, ``m (psi - 1)^2/(2 psi)``, smaller
+    for ``1 <= psi <= 3/2``: ``|theta_b| = |m| (1 - psi/2)``, ``|m|/4`` for small ``m``.
+    """
+    th = np.asarray(theta, dtype=float)
+    with np.errstate(all="ignore"):
+        return np.abs(th) * (1.0 - 0.5 * np.asarray(blocking_force_ratio(th)))
+
+
+def regime_reason(regime, theta=None) -> str:
+    """One line: the free strip is past a quarter turn (what is kept, what holds)."""
+    th = "" if theta is None else f", |theta| = {abs(float(theta)):.3g} rad"
+    if regime == "multi-turn":
+        return (f"free strip {regime}{th} > 2 pi: theta kept, flagged check_beam_regime = false; the arc passes "
+                "through itself past a full turn, so its tip position means nothing: w, w_small, x_tip, y_tip withheld")
+    return (f"free strip {regime}{th} > pi/2: the arc formula (paper eq. 12) still gives theta, w, x_tip, "
+            "y_tip (strips do curl), kept and flagged check_beam_regime = false; w is not monotone in M; "
+            "the blocking force is a separate check (blocked_regime)")
+
+
+def blocked_reason(theta) -> str:
+    """One line: the BLOCKED strip itself turns past a quarter turn (``theta`` = free-strip rotation)."""
+    tb = float(blocked_rotation(theta))
+    what = f"turns up to {tb:.3g} rad along its length" if np.isfinite(tb) else "winds beyond the tracked branch"
+    return (f"blocked strip past a quarter turn: with its tip held on the axis it still {what} (> pi/2), where the "
+            "paper's lever arm L - s of eq. 15 is only an approximation; F_block kept as the root of eq. 15, flagged "
+            "check_blocked_regime = false")
+
+
+def voltage_reason(voltage) -> str:
+    """One line: the voltage is beyond the validated range."""
+    return (f"|voltage| {abs(float(voltage)):g} V > {VALIDATED_VOLTAGE:g} V (settings.VALIDATED_VOLTAGE, the range "
+            "validated against the BVP), and far beyond water electrolysis (~1.23 V), which this blocking-electrode "
+            "model leaves out: the numbers solve the equations, not the device; kept, flagged check_voltage = false")
+
+
+def flag_mask(check_of, key: str) -> np.ndarray:
+    """Bool array: where output ``key`` is flagged by a failed model assumption (:data:`FLAGS`).
+
+    ``check_of(name)`` returns the bool array of check ``name`` (``ForwardResult`` attributes,
+    or the ``check_<name>`` columns of a sweep)."""
+    bad = None
+    for check, keys in FLAGS.items():
+        if key in keys:
+            b = ~np.asarray(check_of(check), bool)
+            bad = b if bad is None else bad | b
+    return np.zeros(np.shape(check_of("beam_regime")), bool) if bad is None else bad
 
 
 @dataclass
@@ -72,9 +164,9 @@ class ForwardResult:
     """Outputs of :func:`forward`; arrays of the broadcast input shape (0-d for scalars), SI.
 
     The values are computed wherever a rung is valid; where no rung is valid the moment and
-    mechanical outputs are NaN (``regime`` ""), whatever the other checks.  The beam checks
-    do not blank anything here: :meth:`withheld_mask` / :meth:`withhold` apply the rule of
-    :data:`WITHHOLD`.
+    mechanical outputs are NaN (``regime`` ""), whatever the other checks.  Nothing else is
+    blanked here: :meth:`withheld_mask` / :meth:`withhold` apply the rule of :data:`WITHHOLD`;
+    :meth:`flag_mask` says where a model assumption flags an output.
 
     Attributes
     ----------
@@ -93,9 +185,11 @@ class ForwardResult:
     error : ndarray  relative error bound of ``I`` (inf where no rung is valid)
     fidelity_used : ndarray of str   rung that produced ``I`` ("" where none)
     escalated : ndarray of bool   ``fidelity_used`` is a rung above the requested one
-    electrochemistry, layer_separation, beam_regime, strain : ndarray of bool   the checks
+    electrochemistry, layer_separation, beam_regime, blocked_regime, strain, voltage, slender : ndarray of bool
+        the checks (:data:`CHECKS`)
     moment_valid : ndarray of bool   a rung is valid (``I`` computed)
-    valid : ndarray of bool   all four checks
+    valid : ndarray of bool   every check
+    strain_limit : float   ``Material.strain_limit`` the strain check used
     message : str    why the first invalid point fails ("" if every point is valid)
     moment_message : str   why the first point without a valid rung has none ("" if none)
     beam_warnings : list of str   :func:`ipmc_asym.beam.statics.solve_beam` warnings
@@ -123,27 +217,40 @@ class ForwardResult:
     electrochemistry: np.ndarray
     layer_separation: np.ndarray
     beam_regime: np.ndarray
+    blocked_regime: np.ndarray
     strain: np.ndarray
+    voltage: np.ndarray
+    slender: np.ndarray
     moment_valid: np.ndarray
     valid: np.ndarray
     message: str = ""
     moment_message: str = ""
     beam_warnings: list = field(default_factory=list)
     fidelity: str = ""
+    strain_limit: float = STRAIN_LIMIT
+    inputs: dict = field(default_factory=dict, repr=False)
 
     def checks(self, index=()) -> dict:
         """``{check: bool}`` of one point (``index`` into the arrays; ``()`` for 0-d results)."""
         return {c: bool(getattr(self, c)[index]) for c in CHECKS}
 
     def failed(self, index=()) -> str | None:
-        """The most severe failure of :data:`WITHHOLD` at one point (None if every check passed)."""
+        """The most severe failure of :data:`WITHHOLD` at one point (None if nothing is withheld)."""
         if not bool(self.moment_valid[index]):
             return "moment"
-        if not bool(self.strain[index]):
-            return "strain"
-        if not bool(self.beam_regime[index]):
-            return "beam_regime"
+        if int(self.regime_code[index]) == _MULTI_TURN:
+            return "multi-turn"
         return None
+
+    def flagged(self, index=()) -> list:
+        """Names of the model assumptions (:data:`ASSUMPTION_CHECKS`) failed at one point."""
+        if not bool(self.moment_valid[index]):
+            return []
+        return [c for c in ASSUMPTION_CHECKS if not bool(getattr(self, c)[index])]
+
+    def flag_mask(self, key: str) -> np.ndarray:
+        """Bool array: where output ``key`` is flagged by a failed model assumption (:data:`FLAGS`)."""
+        return flag_mask(lambda c: getattr(self, c), key) & np.asarray(self.moment_valid, bool)
 
     def withheld(self, index=()) -> tuple:
         """Output names withheld at one point, by :data:`WITHHOLD` (empty if none)."""
@@ -152,7 +259,7 @@ class ForwardResult:
 
     def withheld_mask(self, key: str) -> np.ndarray:
         """Bool array: where output ``key`` is withheld (False everywhere for an unaffected key)."""
-        ok = {"moment": self.moment_valid, "strain": self.strain, "beam_regime": self.beam_regime}
+        ok = {"moment": self.moment_valid, "multi-turn": np.asarray(self.regime_code) != _MULTI_TURN}
         bad = np.zeros(np.shape(self.valid), bool)
         for check, keys in WITHHOLD:
             if key in keys:
@@ -167,6 +274,40 @@ class ForwardResult:
             a = getattr(self, k)
             out[k] = np.where(bad, np.nan, a) if np.any(bad) else a
         return replace(self, **out)
+
+
+def assumption_warnings(r: "ForwardResult", index=None) -> list:
+    """One line per failed model assumption, naming the limit and its source.
+
+    ``index`` given: the lines of that point; None: over every point, each line at the first
+    point that fails it, with the count (step time points, uq samples, sweep rows)."""
+    ok_m = np.asarray(r.moment_valid, bool).reshape(-1)
+    size = ok_m.size
+    sel = np.ones(size, bool)
+    if index is not None:  # one point
+        sel[:] = False
+        sel[int(np.ravel_multi_index(index, np.shape(r.valid))) if np.shape(r.valid) else 0] = True
+    out = []
+    for c in ASSUMPTION_CHECKS:
+        bad = np.flatnonzero(sel & ok_m & ~np.asarray(getattr(r, c), bool).reshape(-1))
+        if bad.size == 0:
+            continue
+        j = int(bad[0])
+        count = "" if index is not None or size == 1 else f" [{len(bad)} of {size} points; first shown]"
+        if c == "strain":
+            line = strain_reason(np.asarray(r.max_strain).reshape(-1)[j], r.strain_limit)
+        elif c == "beam_regime":
+            line = regime_reason(str(np.asarray(r.regime).reshape(-1)[j]), np.asarray(r.theta).reshape(-1)[j])
+        elif c == "blocked_regime":
+            line = blocked_reason(np.asarray(r.theta).reshape(-1)[j])
+        elif c == "voltage":
+            line = voltage_reason(np.asarray(r.inputs["voltage"]).reshape(-1)[j])
+        else:
+            q = {k: float(np.asarray(r.inputs[k]).reshape(-1)[j]) for k in ("length", "width", "thickness")}
+            out += [x + count for x in slender_warnings(q["length"], q["width"], q["thickness"])]
+            continue
+        out.append(line + count)
+    return out
 
 
 def distinct_pairs(code):
@@ -311,7 +452,7 @@ def forward(length, width, thickness, voltage, *, modulus=None, c_moy=None, mate
     I = rows(r.I.reshape(-1))
     Mok = A5 * I if all_ok else np.where(ok, A5 * np.where(ok, I, 0.0), 0.0)
     with np.errstate(all="ignore"):
-        b = solve_beam(Mok, L, EI, tol=tol, e=0.5 * th)
+        b = solve_beam(Mok, L, EI, tol=tol, e=0.5 * th, strain_limit=material.strain_limit)
 
     def masked(x, fill):  # outputs only where a rung is valid
         x = np.broadcast_to(np.asarray(x), (k,))
@@ -319,11 +460,21 @@ def forward(length, width, thickness, voltage, *, modulus=None, c_moy=None, mate
 
     strain = np.asarray(b.max_strain, dtype=float).reshape(-1)
     rcode = np.broadcast_to(np.asarray(b.regime_code), (k,))
+    # model assumptions: checked where a rung is valid (False elsewhere: nothing to assume about)
     beam_regime = ok & ~np.isin(rcode, _OUTSIDE_CODES)  # ints, not strings
-    strain_ok = ok & (strain <= STRAIN_LIMIT)
+    # the blocked strip's own largest rotation |kappa L| (1 - psi/2) (blocked_rotation), with psi
+    # from the beam's block_error = (3/2 - psi)/psi (psi <= 3/2 on the branch): no second
+    # evaluation of psi; NaN beyond the tracked branch fails
+    with np.errstate(all="ignore"):
+        psi = 1.5 / (1.0 + np.asarray(b.block_error, dtype=float).reshape(-1))
+        tb = np.abs(np.asarray(b.theta, dtype=float).reshape(-1)) * (1.0 - 0.5 * psi)
+    blocked_ok = ok & (tb <= 0.5 * np.pi)
+    strain_ok = ok & (strain <= material.strain_limit)
+    volt_ok = ok & (np.abs(v) <= VALIDATED_VOLTAGE)
+    slender = ok & np.broadcast_to(slender_ok(L, wd, th), (k,))
     elec = rows(r.electrochemistry.reshape(-1))
     layer = rows(r.layer_separation.reshape(-1))
-    valid = elec & layer & beam_regime & strain_ok
+    valid = elec & layer & beam_regime & blocked_ok & strain_ok & volt_ok & slender
     mech = {c: masked(np.asarray(getattr(b, c), dtype=float), np.nan)
             for c in ("theta", "w", "w_small", "x_tip", "y_tip", "F_block", "F_block_small", "small_error",
                       "block_error")}
@@ -331,8 +482,18 @@ def forward(length, width, thickness, voltage, *, modulus=None, c_moy=None, mate
     message = ""
     if not bool(np.all(valid)):
         j = int(np.argmin(valid))
-        message = (r.message if not ok[j] else strain_reason(strain[j]) if not strain_ok[j]
-                   else regime_reason(reg[j]))
+        if not ok[j]:
+            message = r.message
+        elif not strain_ok[j]:
+            message = strain_reason(strain[j], material.strain_limit)
+        elif not beam_regime[j]:
+            message = regime_reason(reg[j], mech["theta"][j])
+        elif not blocked_ok[j]:
+            message = blocked_reason(mech["theta"][j])
+        elif not volt_ok[j]:
+            message = voltage_reason(v[j])
+        else:
+            message = slender_warnings(L[j], wd[j], th[j])[0]
 
     def rs(a):
         return np.asarray(a).reshape(shape)
@@ -341,6 +502,10 @@ def forward(length, width, thickness, voltage, *, modulus=None, c_moy=None, mate
         I=rs(I), M_A=rs(masked(Mok, np.nan)), regime=rs(reg), regime_code=rs(rcode),
         max_strain=rs(masked(strain, np.nan)), B1=rs(rows(r.B1.reshape(-1))), error=rs(rows(r.error.reshape(-1))),
         fidelity_used=rs(used), escalated=rs((used != fidelity) & (used != "")),
-        electrochemistry=rs(elec), layer_separation=rs(layer), beam_regime=rs(beam_regime), strain=rs(strain_ok),
-        moment_valid=rs(ok), valid=rs(valid), message=message, moment_message=r.message,
-        beam_warnings=list(b.warnings), fidelity=fidelity, **{c: rs(a) for c, a in mech.items()})
+        electrochemistry=rs(elec), layer_separation=rs(layer), beam_regime=rs(beam_regime),
+        blocked_regime=rs(blocked_ok), strain=rs(strain_ok),
+        voltage=rs(volt_ok), slender=rs(slender), moment_valid=rs(ok), valid=rs(valid), message=message,
+        moment_message=r.message, beam_warnings=list(b.warnings), fidelity=fidelity,
+        strain_limit=float(material.strain_limit),
+        inputs={"length": rs(L), "width": rs(wd), "thickness": rs(th), "voltage": rs(v)},
+        **{c: rs(a) for c, a in mech.items()})

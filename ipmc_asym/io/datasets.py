@@ -30,7 +30,8 @@ __all__ = ["VARIABLES", "sweep_dataset", "uq_dataset", "netcdf_engine", "availab
 VARIABLES = {name: (q.unit, q.long_name) for name, q in BY_NAME.items()}
 _SWEEP_OUT = ("I", "M_A", "theta", "w", "w_small", "F_block", "F_block_small", "B1", "error", "max_strain",
               "fidelity_used", "escalated", "regime", "check_electrochemistry", "check_layer_separation",
-              "check_beam_regime", "check_strain", "valid")
+              "check_beam_regime", "check_blocked_regime", "check_strain", "check_voltage", "check_slender",
+              "valid")
 
 
 def _label(da, name):
@@ -124,6 +125,11 @@ def uq_dataset(result):
     dv = {}
     for o, y in result.outputs.items():
         dv[o] = _label(xr.DataArray(y, dims=("sample",)), o)
+    # the forward model's checks per sample (1 passed, 0 failed) and their conjunction
+    for c, ok in getattr(result, "checks", {}).items():
+        dv["check_" + c] = _label(xr.DataArray(np.asarray(ok, np.int8), dims=("sample",)), "check_" + c)
+    if getattr(result, "valid", None) is not None:
+        dv["valid"] = _label(xr.DataArray(np.asarray(result.valid, np.int8), dims=("sample",)), "valid")
     for key in ("S1", "S1_conf", "ST", "ST_conf"):
         a = np.full((len(outs), len(pars)), np.nan)
         for i, o in enumerate(outs):
@@ -144,6 +150,11 @@ def uq_dataset(result):
     ds.attrs.update(_common_attrs(result.model, json.dumps(result.fidelity), None, result.material,
                                   {"kind": "uq", "scene": result.scene, "tolerance": result.tolerance,
                                    "n_samples": result.n_samples, "base_n": result.base_n,
+                                   "n_outside_model": getattr(result, "n_outside", 0),
+                                   "keep_invalid": int(getattr(result, "keep_invalid", False)),
+                                   "n_used": getattr(result, "n_used", result.n_samples),
+                                   "n_sobol_base_points": getattr(result, "n_sobol", result.base_n),
+                                   "seed": getattr(result, "seed", 0),
                                    "nominal": result.base,
                                    "distributions": {k: [d, list(p)] for k, (d, p) in result.inputs.items()}}))
     return ds

@@ -29,6 +29,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from ipmc_asym.base.settings import STRAIN_LIMIT
 from ipmc_asym.base.units import parse_pressure
 from ipmc_asym.model import material_data
 from ipmc_asym.model.groups import Groups, debye_length, make_groups, moment_scale
@@ -108,6 +109,9 @@ class Material:
                  paper, which names it in its Nernst law but gives no value; used only by the
                  dynamic models).  Default :data:`D_CATION_DEFAULT`, source
                  :data:`D_CATION_SOURCE`.
+    strain_limit : float   face strain ``e|kappa|`` up to which the small-strain beam model is
+                 assumed (a model assumption: above it results are kept and flagged), in
+                 (0, 1); default ``settings.STRAIN_LIMIT``, source ``settings.STRAIN_LIMIT_SOURCE``
     """
 
     Z3: float = -9.0e4
@@ -124,6 +128,7 @@ class Material:
     #: full citations of the sources of the values (a material set's; :data:`NAFION_LI` carries
     #: the paper's)
     sources: tuple = ()
+    strain_limit: float = STRAIN_LIMIT
 
     def __post_init__(self):
         z3 = check_finite("Z3", self.Z3, "a finite number < 0 C/kg")
@@ -139,6 +144,9 @@ class Material:
         check_positive("Faraday constant F", self.F, "C/mol")
         check_positive("gas constant R", self.R, "J/(mol K)")
         check_positive("cation diffusion coefficient D", self.D, "m^2/s")
+        sl = check_finite("strain_limit", self.strain_limit, "in the open interval (0, 1)")
+        if not 0.0 < sl < 1.0:
+            raise ValueError(f"strain_limit must be in the open interval (0, 1), e.g. 0.01; got {self.strain_limit!r}")
         if isinstance(self.c_moy, str):
             if self.c_moy not in ("paper", "formula"):
                 raise ValueError(
@@ -209,7 +217,7 @@ _PAPER_SETS = ("nafion-li", "nafion-li-formula")
 MATERIALS = {"nafion-li": NAFION_LI}
 
 #: keys of a material specification (scene ``[material]`` table, CLI options)
-MATERIAL_KEYS = ("preset", "E", "modulus", "c_moy", "phi4", "Z3", "rho3", "rho2", "T")
+MATERIAL_KEYS = ("preset", "E", "modulus", "c_moy", "phi4", "Z3", "rho3", "rho2", "T", "strain_limit")
 
 
 def material_from_spec(spec=None, labels=None) -> Material:
@@ -221,7 +229,7 @@ def material_from_spec(spec=None, labels=None) -> Material:
         Any of :data:`MATERIAL_KEYS`: ``preset`` (a built-in set name, default ``nafion-li``,
         or a user's material file ``FILE.toml``: :func:`named_material`); ``E`` or ``modulus`` (Pa, number or string with units such as
         ``"130MPa"``); ``c_moy`` (``"paper"``, ``"formula"``, or a number > 0 in mol/m^3,
-        also as a string); ``phi4``, ``Z3``, ``rho3``, ``rho2``, ``T`` (numbers, SI).
+        also as a string); ``phi4``, ``Z3``, ``rho3``, ``rho2``, ``T``, ``strain_limit`` (numbers, SI).
     labels : dict, optional
         How to name each key in error messages (e.g. ``{"c_moy": "--c-moy"}``); default
         ``material.<key>``.
@@ -266,7 +274,7 @@ def material_from_spec(spec=None, labels=None) -> Material:
             if E <= 0:
                 raise ValueError(f"{name(k)} must be > 0 Pa (e.g. 130MPa); got {v!r}")
             kw["E"] = E
-    for k in ("phi4", "Z3", "rho3", "rho2", "T"):
+    for k in ("phi4", "Z3", "rho3", "rho2", "T", "strain_limit"):
         if k in spec:
             v = spec[k]
             if isinstance(v, bool) or not isinstance(v, (int, float)):

@@ -4,7 +4,9 @@
   full thickness + log zooms at each electrode (:mod:`ipmc_asym.studies.profiles`);
 * ``influence_length.png`` (Fig 8), ``influence_thickness.png`` (Fig 9),
   ``influence_voltage.png`` (Fig 10), ``influence_width.png``: deflection, blocking force and
-  rotation, three models overlaid; points past a quarter turn drawn dotted (outside the model);
+  rotation, three models overlaid; each curve dotted where a model assumption that concerns it
+  fails (the rule of ``forward.model.FLAGS``, as in ``estimate``: the free strip past a quarter
+  turn for w and theta, the strain limit for every mechanical output), empty only where withheld;
 * ``speed_accuracy.png`` from a bench result (:func:`ipmc_asym.plotting.speed.plot_speed_accuracy`)
   when one is given or can be measured.
 
@@ -18,13 +20,13 @@ import os
 import numpy as np
 
 from ipmc_asym.base.registry import model_names
-from ipmc_asym.base.settings import OUTSIDE_REGIMES
+from ipmc_asym.forward.model import flag_mask
 from ipmc_asym.model.params import NAFION_LI, Material, Strip
 from ipmc_asym.plotting import MODEL_COLOURS, model_style, pyplot, savefig
 from ipmc_asym.plotting.profiles import write_all
 from ipmc_asym.plotting.speed import plot_speed_accuracy
 from ipmc_asym.studies.profiles import compute_all
-from ipmc_asym.studies.sweeps import sweep
+from ipmc_asym.studies.sweeps import sweep, withhold
 
 __all__ = ["influence_figure", "make_all", "INFLUENCE"]
 
@@ -73,7 +75,7 @@ def influence_figure(var, path, base: Strip | None = None, material: Material = 
     vals, sc, xlabel, _stem, fig_no = INFLUENCE[var]
     vals = vals if values is None else np.asarray(values, float)
     base = Strip() if base is None else base
-    arr = sweep({var: vals}, list(MODELS3), "quadrature", base, material)
+    arr = withhold(sweep({var: vals}, list(MODELS3), "quadrature", base, material))
     rows = 2 if var == "voltage" else 1
     fig, axs = plt.subplots(rows, 3, figsize=(13, 3.6 * rows + 0.6), dpi=dpi, squeeze=False)
     ymax = [0.0, 0.0, 0.0]
@@ -83,11 +85,11 @@ def influence_figure(var, path, base: Strip | None = None, material: Material = 
         order = np.argsort(a[var])
         a = a[order]
         x = a[var] * sc
-        strain_ok = a["check_strain"].astype(bool)
-        free_ok = a["check_beam_regime"].astype(bool) & ~np.isin(a["regime"], OUTSIDE_REGIMES)
+        free_ok = a["check_beam_regime"].astype(bool)
         for k, (q, qs, fac, _lab, _t) in enumerate(_PANELS):
             y = np.abs(a[q]) * fac
-            ok = strain_ok & (free_ok if q != "F_block" else True)
+            # the estimate's rule (forward.model.flag_mask): dotted where an assumption concerning q fails
+            ok = ~flag_mask(lambda c: a["check_" + c], q)
             # the dotted part joins the solid one: it starts at the last point inside
             edge = ok & (np.roll(~ok, 1) | np.roll(~ok, -1))
             for ax in axs[:, k]:
@@ -122,7 +124,7 @@ def influence_figure(var, path, base: Strip | None = None, material: Material = 
     handles = [Line2D([], [], label=m, **model_style(m, line=False, marker=True)) for m in MODELS3]
     handles += [Line2D([], [], color="0.35", ls="--", lw=0.8, label="small displacement, eq. (13)"),
                 Line2D([], [], color="0.35", ls=":", lw=1.3,
-                       label="outside the model: past a quarter turn (w, θ) or strain above the limit"),
+                       label="a model assumption fails (e.g. past a quarter turn, strain above the limit): kept, dotted"),
                 Line2D([], [], color="0.35", ls=":", lw=0.7, marker="|", ms=10,
                        label="free strip reaches a quarter turn"),
                 Line2D([], [], color="k", ls="--", lw=0.6, label="θ = π/2")]

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import numpy as np
+
 from ipmc_asym.base.quantities import axis_label
 from ipmc_asym.plotting import pyplot, savefig
 
@@ -32,6 +34,11 @@ def plot_uq(result, path) -> str:
         s = result.summary[o]
         f, u = _SCALE.get(s["unit"], (1.0, s["unit"]))
         y = result.outputs[o] * f
+        # the samples of the statistics: inside every model assumption unless kept (keep_invalid)
+        valid = getattr(result, "valid", None)
+        if valid is not None and not getattr(result, "keep_invalid", True):
+            y = y[valid]
+        y = y[np.isfinite(y)]
         ax.hist(y, bins=80, density=True, color="C0", alpha=0.75)
         for q in ("q2.5", "q50", "q97.5"):
             ax.axvline(s[q] * f, color="k", ls="--" if q != "q50" else "-", lw=0.9)
@@ -47,7 +54,10 @@ def plot_uq(result, path) -> str:
                 va="top", fontsize=8)
     for ax in list(axes.flat)[n:]:
         ax.set_visible(False)
-    fig.suptitle(f"UQ of scene {result.scene!r} [{result.model}]: {result.n_samples} runs; "
-                 f"dashed: 2.5 / 97.5 %, solid: median (thickness = total 2e)", fontsize=10)
+    outside = getattr(result, "n_outside", 0)
+    note = (f" ({outside} outside a model assumption, " + ("kept)" if getattr(result, "keep_invalid", False)
+                                                             else "left out)")) if outside else ""
+    fig.suptitle(f"UQ of scene {result.scene!r} [{result.model}]: {result.n_samples} runs{note}"
+                 "\ndashed: 2.5 / 97.5 %, solid: median (thickness = total 2e)", fontsize=10)
     fig.tight_layout()
     return savefig(fig, path, dpi=110)

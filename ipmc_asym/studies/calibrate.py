@@ -282,7 +282,7 @@ def _material(material: Material, values) -> Material:
 
 
 def predict(values: dict, geometry: dict, model="constant", fidelity="leading",
-            material: Material = NAFION_LI):
+            material: Material = NAFION_LI, *, with_checks: bool = False):
     """Model predictions at the data's geometry for parameter ``values`` (SI).
 
     Returns
@@ -297,8 +297,11 @@ def predict(values: dict, geometry: dict, model="constant", fidelity="leading",
         strip curls back and ``w`` stops growing with ``M``); for the force
         ``1 + d ln psi / d ln(kappa L)`` (by a central difference).
     valid : ndarray of bool (n_rows,)
+    checks : dict, only with ``with_checks``
+        The forward model's model assumptions at each row (``forward.model.ASSUMPTION_CHECKS``
+        -> bool array, False where the row's state fails it).
     """
-    from ipmc_asym.forward.model import forward  # deferred: heavy import (Numba kernels), start-up
+    from ipmc_asym.forward.model import ASSUMPTION_CHECKS, forward  # deferred: heavy import (Numba kernels)
 
     mat = _material(material, values)
     perm = _perm(model, values)
@@ -319,6 +322,9 @@ def predict(values: dict, geometry: dict, model="constant", fidelity="leading",
         sF = 1.0 + dpsi / np.asarray(blocking_force_ratio(m), float)
         errors = {"deflection": np.abs(sw) * err, "blocking_force": np.abs(sF) * err}
     errors = {k: np.where(np.isfinite(v), v, np.inf) for k, v in errors.items()}
+    if with_checks:
+        checks = {c: np.asarray(getattr(r, c), bool) for c in ASSUMPTION_CHECKS}
+        return {"deflection": w, "blocking_force": F}, errors, np.asarray(r.moment_valid, bool), checks
     return {"deflection": w, "blocking_force": F}, errors, np.asarray(r.moment_valid, bool)
 
 
@@ -344,6 +350,8 @@ class CalibrationResult:
     names : list of str
     predictions : dict   model at the optimum (for plots)
     data : CalibrationData
+    flagged_rows : dict   model assumption -> indices of the data rows whose fitted state fails
+        it (the forward model's checks, as ``evaluate`` flags them); empty if none
     """
 
     parameters: dict
@@ -357,6 +365,7 @@ class CalibrationResult:
     names: list = field(default_factory=list)
     predictions: dict = field(default_factory=dict, repr=False)
     data: CalibrationData | None = field(default=None, repr=False)
+    flagged_rows: dict = field(default_factory=dict)
 
     def as_dict(self) -> dict:
         """Exactly the keys of ``--json``."""
@@ -569,15 +578,19 @@ def fit(data: CalibrationData, free, model="constant", material: Material = NAFI
             else:
                 row.append(None)
         corr.append(row)
-    out, _, _ = predict(prob.values(res.x), data.geometry, model, chosen, material)
+    out, _, _, chk = predict(prob.values(res.x), data.geometry, model, chosen, material, with_checks=True)
+    flagged = {c: [int(i) for i in np.flatnonzero(~ok)] for c, ok in chk.items() if not np.all(ok)}
     msg = (f"fidelity {chosen} (cheapest with error estimate < 1/10 of the data's relative error and a model-error "
            f"shift < 0.1 standard error on every estimate)")
     if notes:
         msg += "; " + "; ".join(notes)
+    if flagged:  # the rows' fitted states outside a model assumption (kept in the fit, said here)
+        msg += "; at the fit, data rows outside a model assumption: " + "; ".join(
+            f"{c}: rows {', '.join(map(str, rows[:10]))}{' ...' if len(rows) > 10 else ''}" for c, rows in flagged.items())
 
     return CalibrationResult(parameters=params, correlation=corr, chi2_red=chi2_red, n_points=n,
                              fidelity=chosen, model=get_model(model).name, success=bool(res.success),
-                             message=msg, names=names, predictions=out, data=data)
+                             message=msg, names=names, predictions=out, data=data, flagged_rows=flagged)
 
 
 def _bias_check(prob, res, out, errs, chi2, n, p, has_sigma):

@@ -11,7 +11,7 @@ File format::
     voltage = "1V"                   # or voltages = [0.5, 1, "2V"], or a [sweep] of voltage
     outputs = ["I", "moment", "tip_deflection", "rotation", "blocking_force",
                "profiles", "scaling_fit"]
-    tolerance = 1e-3                 # relative, > 0 (default settings.DEFAULT_SCENE_TOL)
+    tolerance = 1e-3                 # relative, in (0, 1) like --tol (default settings.DEFAULT_SCENE_TOL)
     profile_arrays = false           # "profiles": also return z, C, phi, E, D, p arrays
 
     [strip]                          # SI numbers or strings with units
@@ -23,7 +23,7 @@ File format::
     preset = "nafion-li"
     E = 1.3e8                        # or modulus = "130MPa"
     c_moy = "paper"                  # "paper" | "formula" | number (mol/m^3)
-    phi4 = 0.38                      # also Z3, rho3, rho2, T
+    phi4 = 0.38                      # also Z3, rho3, rho2, T, strain_limit
 
     [sweep]                          # grid (outer product) over any of thickness, voltage,
     thickness = {start = "50um", stop = "1mm", n = 8, log = true}    # length, width;
@@ -42,9 +42,8 @@ if sys.version_info >= (3, 11):
 else:  # pragma: no cover - Python 3.10
     import tomli as tomllib
 
-import math
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Callable, Union
 
 import numpy as np
@@ -52,6 +51,8 @@ import numpy as np
 from ipmc_asym.base.registry import model_names
 from ipmc_asym.base.settings import DEFAULT_SCENE_TOL, MAX_ROWS
 from ipmc_asym.base.units import parse_length, parse_voltage
+from ipmc_asym.forward.escalation import check_tol
+from ipmc_asym.model.limits import bare_number_warning, material_warnings, range_warning
 from ipmc_asym.model.params import NOMINAL_STRIP, Material, Strip, material_from_spec
 
 __all__ = ["Scene", "OUTPUTS", "AXES", "load_scene", "parse_scene", "read_scene"]
@@ -87,8 +88,12 @@ class Scene:
     outputs : tuple of str
         Subset of :data:`OUTPUTS`, in the order asked.
     tolerance : float
-        Relative tolerance, > 0.
+        Relative tolerance, in (0, 1).
     profile_arrays : bool
+    warnings : tuple of str
+        One line per implausible input (:mod:`ipmc_asym.model.limits`: a bare number implausible
+        in SI, a length or material parameter outside its plausible range); the same rules as
+        the command line.
     """
 
     name: str
@@ -99,6 +104,7 @@ class Scene:
     outputs: tuple
     tolerance: float
     profile_arrays: bool
+    warnings: tuple = field(default=())
 
     @property
     def n(self) -> int:
@@ -196,9 +202,8 @@ def _model(model):
 
 
 def _tolerance(tol):
-    if isinstance(tol, bool) or not isinstance(tol, (int, float)) or not math.isfinite(tol) or tol <= 0:
-        raise ValueError(f"tolerance must be a number > 0 (relative); got {tol!r}")
-    return float(tol)
+    # the rule of --tol (forward.escalation.check_tol): a relative tolerance in (0, 1)
+    return check_tol(tol, "tolerance")
 
 
 def _outputs(outputs):
@@ -260,7 +265,18 @@ def parse_scene(scene: dict) -> Scene:
     shape = grids[0].shape if names else ()
     pts = {k: (grids[names.index(k)] if k in names else np.full(shape, base[k])).reshape(-1) for k in AXES}
     swept = tuple(k for k in names if axes[k].size > 1)
-    return Scene(name, model, material, pts, swept, outputs, tol, arrays)
+    warns = []
+    for k, v in strip.items():  # the rules of the command line's length options (model.limits)
+        text = v if isinstance(v, str) else str(v) if isinstance(v, int) else repr(float(v))
+        line = bare_number_warning(k, text, base[k], f"strip.{k}") or range_warning(k, base[k], f"strip.{k}")
+        if line:
+            warns.append(line)
+    for k, a in axes.items():  # swept lengths: the first implausible value
+        line = next((m for m in (range_warning(k, x, f"sweep.{k}") for x in a) if m), None) if k in _STRIP else None
+        if line:
+            warns.append(line)
+    warns += material_warnings(material)
+    return Scene(name, model, material, pts, swept, outputs, tol, arrays, tuple(warns))
 
 
 def read_scene(scene) -> Scene:

@@ -42,7 +42,7 @@ import numpy as np
 
 from ipmc_asym.base.registry import fidelity_names
 from ipmc_asym.base.settings import BVP_STATED_ERROR
-from ipmc_asym.forward.model import forward
+from ipmc_asym.forward.model import assumption_warnings, forward
 from ipmc_asym.studies.fits import fit_power_law
 from ipmc_asym.studies.profiles import LAYER_WIDTHS, layer_widths
 from ipmc_asym.studies.scene_schema import OUTPUTS, Scene, load_scene, read_scene
@@ -72,7 +72,7 @@ def _plan(sc: Scene):
 def _scaling_fit(x, y, what):
     """Power-law fit of one output over the swept variable (fits.fit_power_law)."""
     x, y = np.asarray(x, float), np.asarray(y, float)
-    keep = np.isfinite(y)  # points withheld by a beam check are left out
+    keep = np.isfinite(y)  # points withheld, or outside a model assumption, are left out of the fit
     x, y = x[keep], y[keep]
     if x.size < 2 or np.unique(x).size < 2:
         raise ValueError("scaling_fit needs a [sweep] (or voltages) over at least 2 distinct values")
@@ -154,6 +154,7 @@ def run_scene(scene) -> dict:
            "defaults_used": {k: float(pts[k][0]) for k in defaults},
            "notes": (["the [uncertain] table is for `ipmc-asym uq`; this scene is evaluated at the "
                       "nominal values"] if isinstance(raw, dict) and "uncertain" in raw else []),
+           "warnings": list(sc.warnings),
            "point_units": {"length": "m", "width": "m, TOTAL width 2l", "thickness": "m, TOTAL thickness 2e",
                            "voltage": "V"},
            "points": [{k: float(pts[k][i]) for k in ("length", "width", "thickness", "voltage")}
@@ -174,30 +175,33 @@ def run_scene(scene) -> dict:
         vals["moment"] = M
         if "moment" in outputs:
             out["moment"] = {"values": M.tolist(), "unit": "N m", "fidelity": fl, "error_estimate": el}
-        # beam checks (forward.model.WITHHOLD): free-strip outputs past a quarter turn, and every
-        # mechanical output above the strain limit, are outside the model and withheld (None)
-        free_ok = ~np.atleast_1d(r.withheld_mask("theta"))
-        mech_ok = ~np.atleast_1d(r.withheld_mask("F_block"))
-        reg_ok, strain = np.atleast_1d(r.beam_regime), np.atleast_1d(r.max_strain)
-        res["checks"] = [{"electrochemistry": True, "layer_separation": True,
-                          "beam_regime": bool(reg_ok[i]), "strain": bool(mech_ok[i]),
-                          "max_strain": float(strain[i])} for i in range(n)]
-        res["valid"] = bool(np.all(free_ok))
+        # the forward model's checks (forward.model.CHECKS): a failed model assumption keeps the
+        # value and flags the point (left out of scaling fits); the free strip's tip position past
+        # a full turn is withheld (None)
+        strain = np.atleast_1d(r.max_strain)
+        res["checks"] = [dict(r.checks(i if np.ndim(r.valid) else ()), max_strain=float(strain[i]))
+                         for i in range(n)]
+        res["valid"] = bool(np.all(r.valid))
+        res["warnings"] += assumption_warnings(r)
+        tip_ok = ~np.atleast_1d(r.withheld_mask("w"))
+
+        def _fit_vals(a, key):  # NaN where the point is outside a model assumption concerning key
+            return np.where(np.atleast_1d(r.flag_mask(key)), np.nan, np.atleast_1d(a))
 
         def _kept(a, ok):
             return [float(x) if o else None for x, o in zip(np.atleast_1d(a), ok)]
         if "rotation" in outputs:
             th = np.atleast_1d(r.theta)  # -M L/EI, paper eq. 12
-            vals["rotation"] = np.where(free_ok, th, np.nan)
-            out["rotation"] = {"values": _kept(th, free_ok), "unit": "rad", "fidelity": fl, "error_estimate": el,
+            vals["rotation"] = _fit_vals(th, "theta")
+            out["rotation"] = {"values": th.tolist(), "unit": "rad", "fidelity": fl, "error_estimate": el,
                                "beam": ["exact"] * n}
         if "tip_deflection" in outputs:
             # the small-displacement formula (eq. 13) where its deviation from the arc is within tol
             serr = np.atleast_1d(r.small_error)
             small = serr <= tol
             w = np.where(small, np.atleast_1d(r.w_small), np.atleast_1d(r.w))
-            vals["tip_deflection"] = np.where(free_ok, w, np.nan)
-            out["tip_deflection"] = {"values": _kept(w, free_ok), "unit": "m", "fidelity": fl,
+            vals["tip_deflection"] = np.where(tip_ok, _fit_vals(w, "w"), np.nan)
+            out["tip_deflection"] = {"values": _kept(w, tip_ok), "unit": "m", "fidelity": fl,
                                      "error_estimate": (err + np.where(small, serr, 0.0)).tolist(),
                                      "beam": ["small" if s else "large" for s in small]}
         if "blocking_force" in outputs:
@@ -205,12 +209,12 @@ def run_scene(scene) -> dict:
             berr = np.atleast_1d(r.block_error)
             small = berr <= tol
             F = np.where(small, np.atleast_1d(r.F_block_small), np.atleast_1d(r.F_block))
-            if not np.all(np.isfinite(F) | ~mech_ok):
-                k = int(np.flatnonzero(~np.isfinite(F) & mech_ok)[0])
+            if not np.all(np.isfinite(F)):
+                k = int(np.flatnonzero(~np.isfinite(F))[0])
                 raise ValueError(f"blocking_force: no large-displacement blocking force at point {k} "
                                  f"({res['points'][k]}); the strip bends too far (|kappa L| too large)")
-            vals["blocking_force"] = np.where(mech_ok, F, np.nan)
-            out["blocking_force"] = {"values": _kept(F, mech_ok), "unit": "N", "fidelity": fl,
+            vals["blocking_force"] = _fit_vals(F, "F_block")
+            out["blocking_force"] = {"values": F.tolist(), "unit": "N", "fidelity": fl,
                                      "error_estimate": (err + np.where(small, berr, 0.0)).tolist(),
                                      "beam": ["small" if s else "large" for s in small]}
     if "profiles" in outputs:

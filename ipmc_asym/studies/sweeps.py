@@ -282,16 +282,16 @@ def sweep(vary: dict, model="constant", fidelity="quadrature", base: Strip | Non
 
 
 def withhold(arr: np.ndarray, copy: bool = True) -> np.ndarray:
-    """``arr`` (a copy unless ``copy=False``) with the outputs whose check failed set to NaN
-    (what the CLI prints).
+    """``arr`` (a copy unless ``copy=False``) with the withheld outputs set to NaN (what the CLI prints).
 
-    Free-strip outputs (``theta, w, w_small``) past a quarter turn; every mechanical output
-    above the strain limit; everything computed where no rung is valid (already NaN).
+    The rule of :data:`ipmc_asym.forward.model.WITHHOLD`: everything computed where no rung is
+    valid (already NaN); the free strip's tip position past a full turn.  A failed model
+    assumption withholds nothing (its ``check_*`` column says so).
     """
     out = arr.copy() if copy else arr
-    # the rule of forward.model.WITHHOLD; rows with no valid rung are NaN already
-    for check, keys in WITHHOLD[1:]:
-        bad = ~out["check_" + check]
+    # rows with no valid rung are NaN already
+    for regime, keys in WITHHOLD[1:]:
+        bad = out["regime"] == regime
         if bad.any():  # only the rows concerned are written (strided fields are slow to sweep)
             idx = np.flatnonzero(bad)
             for c in keys:

@@ -30,7 +30,12 @@ blocking force uses the small-displacement ``3M/(2L)`` where its relative deviat
 ``(kappa L)^2/3360`` (times 1.05 to cover the next terms for ``|kappa L| <= 2``) is within
 the tolerance, the large-displacement root otherwise; the tip deflection is always the arc.
 
-Every sample goes through the forward model :func:`ipmc_asym.forward.model.forward`.
+Every sample goes through the forward model :func:`ipmc_asym.forward.model.forward` and its
+checks (``forward.model.CHECKS``, per sample in :attr:`UQResult.checks`).  A sample outside a
+model assumption (past a quarter turn, above the strain limit, beyond the validated voltage, not
+slender) is counted (:attr:`UQResult.n_outside`) and left out of the quantiles, moments and
+Sobol' indices unless ``keep_invalid`` (for the Sobol' indices a whole Saltelli group of
+``D + 2`` rows is left out with any of its rows, so that the design stays paired).
 ``C_moy`` per sample changes ``A3`` per sample, which the shared sweep driver takes as a
 scalar: ``forward`` given ``c_moy`` per point uses
 :func:`ipmc_asym.integral.samples.moment_samples`, the same loop with ``A3`` an array (it
@@ -51,7 +56,7 @@ import numpy as np
 
 from ipmc_asym.base.settings import CHUNK_ROWS
 from ipmc_asym.base.units import parse_length, parse_pressure, parse_voltage
-from ipmc_asym.forward.model import SAMPLING_FIDELITIES, forward
+from ipmc_asym.forward.model import CHECKS, SAMPLING_FIDELITIES, assumption_warnings, forward
 from ipmc_asym.io.datasets import VARIABLES
 from ipmc_asym.model.permittivity import get_model
 from ipmc_asym.parallel.executors import chunk_slices, run_chunks
@@ -165,7 +170,8 @@ def _transform(u, dist, vals):
 
 # ---- evaluation ------------------------------------------------------------------------------
 def evaluate_samples(cols: dict, outputs, model, material, tol, fidelity=None):
-    """Outputs at sample columns (SI arrays of one length); returns (dict of arrays, fidelity counts).
+    """Outputs at sample columns (SI arrays of one length); returns (dict of arrays, fidelity
+    counts, checks: dict check name -> bool array, warnings: list of str).
 
     The forward model :func:`ipmc_asym.forward.model.forward` with ``modulus`` and ``c_moy``
     per sample.  ``fidelity`` forces one rung (no escalation; samples outside its validity or
@@ -184,6 +190,7 @@ def evaluate_samples(cols: dict, outputs, model, material, tol, fidelity=None):
                     tol=min(float(tol), 0.5), escalate=not fidelity)
     if not np.all(r.moment_valid):
         raise ValueError(f"uq: {r.moment_message}; narrow the distributions or loosen the tolerance")
+    checks = {c: np.asarray(getattr(r, c), bool) for c in CHECKS}
     counts = {}
     left = n
     for fid in ladder:  # samples settled at each rung climbed
@@ -199,7 +206,8 @@ def evaluate_samples(cols: dict, outputs, model, material, tol, fidelity=None):
     if "rotation" in outputs:
         out["rotation"] = r.theta  # -M L/EI, paper eq. 12
     if "tip_deflection" in outputs:
-        out["tip_deflection"] = r.w  # the arc, -(kappa L^2/2) sinc^2(kappa L/2)
+        # the arc, -(kappa L^2/2) sinc^2(kappa L/2); NaN past a full turn (withheld, forward.model.WITHHOLD)
+        out["tip_deflection"] = np.where(r.withheld_mask("w"), np.nan, r.w)
     if "blocking_force" in outputs:
         kL = r.theta
         big = ~((np.abs(kL) <= 2.0) & (1.05 * kL * kL / 3360.0 <= tol))
@@ -209,7 +217,7 @@ def evaluate_samples(cols: dict, outputs, model, material, tol, fidelity=None):
             raise ValueError(f"uq: large-displacement blocking force undefined for {bad} sample(s) "
                              f"(|kappa L| beyond the tracked branch); narrow the distributions")
         out["blocking_force"] = F
-    return out, counts
+    return out, counts, checks, assumption_warnings(r)
 
 
 def uq_chunk(task):
@@ -236,6 +244,13 @@ class UQResult:
     outputs : dict  name -> array (n_samples,)
     n_samples, base_n : int
     fidelity : dict  rung -> number of samples settled there
+    checks : dict  check name (``forward.model.CHECKS``) -> bool array (n_samples,)
+    valid : ndarray of bool (n_samples,)   every check passed
+    n_outside : int   samples outside a model assumption (``~valid``)
+    keep_invalid : bool   the statistics include the samples outside (else they are left out)
+    n_used : int   samples in the quantiles and moments
+    n_sobol : int  Saltelli base points (groups of D + 2 rows) in the Sobol' indices
+    warnings : list of str   one line per failed model assumption (with its count)
     """
 
     summary: dict
@@ -253,10 +268,22 @@ class UQResult:
     base: dict = field(default_factory=dict)
     material: object = None
     timings: dict = field(default_factory=dict)
+    checks: dict = field(default_factory=dict, repr=False)
+    valid: np.ndarray = field(default=None, repr=False)
+    n_outside: int = 0
+    keep_invalid: bool = False
+    n_used: int = 0
+    n_sobol: int = 0
+    warnings: list = field(default_factory=list)
+    seed: int = 0
 
     def as_dict(self) -> dict:
         return {"scene": self.scene, "model": self.model, "tolerance": self.tolerance,
                 "n_samples": self.n_samples, "base_n": self.base_n, "fidelity": self.fidelity,
+                "n_outside_model": self.n_outside, "keep_invalid": self.keep_invalid, "n_used": self.n_used,
+                "n_sobol_base_points": self.n_sobol, "seed": self.seed,
+                "outside_by_check": {c: int(np.count_nonzero(~v)) for c, v in self.checks.items()},
+                "warnings": self.warnings,
                 "inputs": {k: {"dist": d, "params": list(p), "unit": UNCERTAIN[k][0]}
                            for k, (d, p) in self.inputs.items()},
                 "summary": self.summary, "sobol": self.sobol, "seconds": self.seconds, "timings": self.timings,
@@ -367,7 +394,7 @@ def _sobol_indices(y, names, N, batches=SOBOL_BATCHES):
 
 
 def run_uq(scene, samples: int = 10**6, *, seed: int = 0, fidelity: str | None = None, scheduler=None,
-           chunk_rows: int | None = None) -> UQResult:
+           chunk_rows: int | None = None, keep_invalid: bool = False) -> UQResult:
     """Quantiles, moments and Sobol' indices of a scene's outputs under its ``[uncertain]`` inputs.
 
     Parameters
@@ -387,6 +414,9 @@ def run_uq(scene, samples: int = 10**6, *, seed: int = 0, fidelity: str | None =
         Samples per chunk.  Default: ``settings.CHUNK_ROWS`` in this process (bounds the
         memory of the temporaries); on a scheduler, chunks of >= 100 ms of work (at most
         4 per worker, at most 2^20 rows) by :func:`ipmc_asym.parallel.executors.chunk_slices`.
+    keep_invalid : bool
+        Keep the samples outside a model assumption in the statistics (default: left out,
+        counted in ``n_outside``; the per-sample checks are in ``checks`` either way).
 
     Returns
     -------
@@ -438,20 +468,41 @@ def run_uq(scene, samples: int = 10**6, *, seed: int = 0, fidelity: str | None =
     for p in parts:
         for k, c in p[1].items():
             counts[k] = counts.get(k, 0) + c
+    checks = {c: np.concatenate([p[2][c] for p in parts]) for c in CHECKS}
+    valid = np.ones(n, bool)
+    for v in checks.values():
+        valid &= v
+    n_out = int(np.count_nonzero(~valid))
+    warns = []
+    for p in parts:  # one line per failed assumption (the first chunk's wording), total counts below
+        for w in p[3]:
+            head = w.split(" [")[0]
+            if not any(x.startswith(head[:40]) for x in warns):
+                warns.append(head)
+    # samples inside every model assumption (unless kept); whole Saltelli groups for the indices
+    use = np.ones(n, bool) if keep_invalid else valid
+    groups_ok = use.reshape(base_n, D + 2).all(axis=1)
+    n_sobol = int(np.count_nonzero(groups_ok))
     summary, sob = {}, {}
     for o in outputs:
-        y = outs[o]
+        y = outs[o][use & np.isfinite(outs[o])]
+        if y.size < 2:
+            raise ValueError(f"uq: {y.size} sample(s) of {o} inside the model ({n_out} of {n} outside a model "
+                             "assumption); narrow the distributions or pass keep_invalid (--keep-invalid)")
         q = np.quantile(y, [0.025, 0.5, 0.975])
         summary[o] = {"unit": OUTPUT_UNITS[o][0], "mean": float(np.mean(y)), "sd": float(np.std(y, ddof=1)),
-                      "q2.5": float(q[0]), "q50": float(q[1]), "q97.5": float(q[2])}
-        if not np.ptp(y) > 0:
+                      "q2.5": float(q[0]), "q50": float(q[1]), "q97.5": float(q[2]), "n": int(y.size)}
+        yg = outs[o].reshape(base_n, D + 2)[groups_ok & np.all(np.isfinite(outs[o].reshape(base_n, D + 2)), axis=1)]
+        if yg.shape[0] < 2 or not np.ptp(yg) > 0:
             sob[o] = None
             continue
-        sob[o] = _sobol_indices(y, names, base_n)
+        sob[o] = _sobol_indices(yg.reshape(-1), names, yg.shape[0])
 
     return UQResult(summary=summary, sobol=sob, inputs=unc, samples={k: cols[k] for k in names}, outputs=outs,
                     n_samples=n, base_n=base_n, fidelity=counts, model=get_model(model).name, tolerance=tol,
                     seconds=time.perf_counter() - t0, scene=name, base=base, material=material,
                     timings={"sampling": t_sample - t0, "evaluation": t_eval1 - t_eval0,
-                             "analysis": time.perf_counter() - t_eval1})
+                             "analysis": time.perf_counter() - t_eval1},
+                    checks=checks, valid=valid, n_outside=n_out, keep_invalid=bool(keep_invalid),
+                    n_used=int(np.count_nonzero(use)), n_sobol=n_sobol, warnings=warns, seed=int(seed))
 

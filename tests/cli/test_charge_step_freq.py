@@ -7,6 +7,7 @@ import pytest
 
 from ipmc_asym.cli import main
 from ipmc_asym.dynamics.electrode import charge
+from ipmc_asym.forward.model import CHECKS
 
 
 def test_charge_json_keys_and_values(capsys):
@@ -33,7 +34,8 @@ def test_step_json_and_csv(tmp_path, capsys):
     assert main(["step", "--voltage", "1V", "--duration", "20ms", "--points", "30", "--out", str(f)]) == 0
     rows = list(csv.reader(f.read_text().splitlines()))
     assert rows[0][0].startswith("# tau =")
-    assert rows[1] == ["t", "phi0", "sigma", "current_density", "M_A", "theta", "w"]
+    assert rows[1][:7] == ["t", "phi0", "sigma", "current_density", "M_A", "theta", "w"]
+    assert rows[1][7:] == [f"check_{c}" for c in CHECKS] + ["valid"]
     assert len(rows) == 32 and float(rows[-1][0]) == pytest.approx(0.02)
 
 

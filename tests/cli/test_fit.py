@@ -64,7 +64,7 @@ def test_uq_json_out_plot(tmp_path, capsys):
     scene = os.path.join(ROOT, "examples", "uq_nominal.toml")
     assert main(["uq", scene, "--samples", "2000", "--json", "--out", str(nc), "--plot", str(png)]) == 0
     out = json.loads(capsys.readouterr().out)
-    assert set(out["summary"]["tip_deflection"]) == {"unit", "mean", "sd", "q2.5", "q50", "q97.5"}
+    assert set(out["summary"]["tip_deflection"]) == {"unit", "mean", "sd", "q2.5", "q50", "q97.5", "n"}
     assert set(out["sobol"]["rotation"]["modulus"]) == {"S1", "S1_conf", "ST", "ST_conf"}
     xr = pytest.importorskip("xarray")
     with xr.open_dataset(nc) as ds:

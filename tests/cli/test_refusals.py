@@ -92,8 +92,8 @@ def test_100nm_escalates_to_a_valid_positive_moment(capsys):
     row = json.loads(capsys.readouterr().out)["results"][0]
     assert row["escalated"] and row["fidelity"] == "quadrature" and row["fidelity_used"] != "quadrature"
     assert row["I"] == pytest.approx(0.1492, rel=1e-3)
-    # the multi-turn strip fails its beam checks: its free-strip outputs are withheld
-    assert row["theta"] is None and not row["valid"] and not row["checks"]["strain"]
+    # the multi-turn strip fails its model assumptions: theta kept and flagged, its tip position withheld
+    assert row["theta"] is not None and row["w"] is None and not row["valid"] and not row["checks"]["strain"]
 
 
 def test_1nm_refused_in_one_line(capsys):
@@ -112,11 +112,9 @@ def test_1nm_refused_in_one_line(capsys):
 # ---------------------------------------------------------------------------------------
 def test_valid_covers_strain_and_beam_regime():
     s = Strip(voltage=1000.0)
-    with pytest.raises(ValueError, match="strain"):
-        evaluate(s, "constant")
-    row = evaluate(s, "constant", on_invalid="nan")
-    assert row["checks"]["electrochemistry"] and not row["checks"]["strain"]
-    assert not row["valid"] and row["w"] is None and row["theta"] is None
+    row = evaluate(s, "constant")  # model assumptions fail: the row is returned, flagged
+    assert row["checks"]["electrochemistry"] and not row["checks"]["strain"] and not row["checks"]["voltage"]
+    assert not row["valid"] and row["w"] is None and row["theta"] is not None
     assert row["max_strain"] > STRAIN_LIMIT
     # the beam's own strain, independently: e |M| / EI
     from ipmc_asym.model.params import NAFION_LI

@@ -7,7 +7,14 @@ import pytest
 
 from ipmc_asym.beam.statics import solve_beam
 from ipmc_asym.forward.estimate import evaluate
-from ipmc_asym.forward.model import CHECKS, FREE_STRIP_KEYS, MECHANICAL_KEYS, MOMENT_KEYS, forward
+from ipmc_asym.forward.model import (
+    CHECKS,
+    MECHANICAL_KEYS,
+    MOMENT_KEYS,
+    TIP_POSITION_KEYS,
+    assumption_warnings,
+    forward,
+)
 from ipmc_asym.integral.api import moment
 from ipmc_asym.model.params import NAFION_LI, Strip
 from ipmc_asym.studies import calibrate, uq
@@ -61,28 +68,71 @@ def test_broadcast_and_pair_code_give_the_same_values():
     assert c.I.shape == (2, 2, 3)
 
 
-def test_withholding_masks():
-    # 0: fine; 1: huge voltage (past a quarter turn, strain above the limit);
+def test_withholding_and_flags():
+    # 0: fine; 1: huge voltage (multi-turn, strain above the limit, beyond the validated voltage);
     # 2: past a quarter turn with a small strain (a long strip);
     # 3: the leading rung invalid, no escalation (no valid rung)
     L = np.array([0.02, 0.02, 0.05, 0.02])
     th = np.array([200e-6, 200e-6, 200e-6, 2e-6])
-    v = np.array([1.0, 20.0, 1.0, 1.0])
+    v = np.array([1.0, 30.0, 1.0, 1.0])
     r = forward(L, 5e-3, th, v, fidelity="leading", escalate=False)
     assert list(r.valid) == [True, False, False, False]
     assert list(r.moment_valid) == [True, True, True, False]
-    assert r.withheld(0) == ()
-    assert not r.strain[1] and r.withheld(1) == MECHANICAL_KEYS
-    assert r.strain[2] and not r.beam_regime[2] and r.withheld(2) == FREE_STRIP_KEYS
+    assert r.withheld(0) == () and r.flagged(0) == []
+    # a failed model assumption keeps every number; past a full turn the tip position is withheld
+    assert not r.strain[1] and not r.voltage[1] and r.regime[1] == "multi-turn"
+    assert r.withheld(1) == TIP_POSITION_KEYS and set(r.flagged(1)) == {"beam_regime", "blocked_regime", "strain", "voltage"}
+    assert r.strain[2] and not r.beam_regime[2] and r.withheld(2) == () and r.flagged(2) == ["beam_regime"]
     assert r.withheld(3) == MOMENT_KEYS + MECHANICAL_KEYS and np.isnan(r.I[3]) and r.regime[3] == ""
     w = r.withhold()
     for k in MOMENT_KEYS + MECHANICAL_KEYS:
         got = np.isnan(getattr(w, k))
         want = np.array([k in r.withheld(i) for i in range(4)])
         assert np.array_equal(got, want | np.isnan(getattr(r, k))), k
+    # what a flag concerns: the free strip past a quarter turn flags theta, not the blocking force
+    assert list(r.flag_mask("theta")) == [False, True, True, False]
+    assert list(r.flag_mask("F_block")) == [False, True, False, False]
     assert "strain" in r.message  # the first invalid point is 1
     assert r.checks(2) == {"electrochemistry": True, "layer_separation": True, "beam_regime": False,
-                           "strain": True}
+                           "blocked_regime": True, "strain": True, "voltage": True, "slender": True}
+    # the nominal strip at 5 V (kappa L = 7.4): the blocked strip itself passes a quarter turn,
+    # F_block kept and flagged by its own check; at 3 V (kappa L = 3.6) only the free strip does
+    b = forward(0.02, 5e-3, 200e-6, np.array([3.0, 5.0]), fidelity="leading")
+    assert list(b.blocked_regime) == [True, False] and not np.any(b.beam_regime)
+    from ipmc_asym.forward.model import blocked_rotation
+
+    r2 = forward(PTS["length"] * 4, PTS["width"], PTS["thickness"], PTS["voltage"] * 4, fidelity="leading")
+    assert r2.blocked_regime.any() and not r2.blocked_regime.all()
+    assert np.array_equal(r2.blocked_regime, blocked_rotation(r2.theta) <= np.pi / 2)
+    assert np.all(np.isfinite(b.F_block)) and list(b.flag_mask("F_block")) == [True, True]  # strain too
+    assert any("blocked strip past a quarter turn" in w for w in assumption_warnings(b))
+    # the blocked strip's largest rotation |m| (1 - psi/2) against a direct evaluation of
+    # theta_b(t) = m [psi (t - t^2/2) - t] on a fine grid (independent of the closed form)
+    from ipmc_asym.beam.statics import blocking_force_ratio
+    from ipmc_asym.forward.model import blocked_rotation
+
+    t = np.linspace(0, 1, 20001)
+    for m in (0.3, 2.0, 6.0, 30.0):
+        psi = float(blocking_force_ratio(m))
+        assert float(blocked_rotation(m)) == pytest.approx(np.max(np.abs(m * (psi * (t - t * t / 2) - t))), rel=1e-9)
+
+
+def test_strain_limit_is_a_material_property():
+    s = Strip(thickness=10e-6)
+    r = forward(s.length, s.width, s.thickness, s.voltage)
+    assert not r.strain and r.max_strain > 0.01
+    r2 = forward(s.length, s.width, s.thickness, s.voltage, material=NAFION_LI.with_(strain_limit=0.5))
+    assert r2.strain and r2.max_strain == r.max_strain
+    with pytest.raises(ValueError, match="strain_limit"):
+        NAFION_LI.with_(strain_limit=5.0)
+
+
+def test_evaluate_at_10um_returns_the_flagged_row():
+    """A failed model assumption never raises: the row, I included, comes back flagged."""
+    row = evaluate(Strip(thickness=10e-6), "constant")
+    assert row["I"] is not None and row["theta"] is not None and row["F_block_small"] is not None
+    assert not row["valid"] and not row["checks"]["strain"] and "strain" in row["flagged"]
+    assert any("strain limit 0.01" in w and "STRAIN_LIMIT" in w for w in row["warnings"])
 
 
 def test_evaluate_agrees_with_forward():
@@ -132,8 +182,8 @@ def test_uq_samples_agree_with_forward():
     cols = {"length": RNG.uniform(0.015, 0.025, n), "width": RNG.uniform(4e-3, 6e-3, n),
             "thickness": RNG.uniform(150e-6, 250e-6, n), "voltage": RNG.uniform(0.5, 1.5, n),
             "modulus": RNG.uniform(1e8, 1.6e8, n), "c_moy": RNG.uniform(2900, 3200, n)}
-    out, counts = uq.evaluate_samples(cols, ["I", "moment", "rotation", "tip_deflection", "blocking_force"],
-                                      "constant", NAFION_LI, 1e-3)
+    out, counts, checks, _ = uq.evaluate_samples(cols, ["I", "moment", "rotation", "tip_deflection", "blocking_force"],
+                                                 "constant", NAFION_LI, 1e-3)
     assert sum(counts.values()) == n
     # per-sample c_moy: each sample against forward with that material
     for i in range(0, n, 97):
@@ -160,3 +210,44 @@ def test_bad_input_is_refused():
         forward(0.02, 5e-3, 200e-6, 1.0, tol=2.0)
     with pytest.raises(ValueError, match="thickness"):
         forward(0.02, 5e-3, 1e-12, 1.0)
+
+
+def test_step_uq_figures_and_estimate_agree_on_every_points_checks():
+    """Random strips, some outside each model assumption: estimate, uq's samples, the sweep rows
+    the figures draw (and their dotted-curve rule) and step's time points report the same checks."""
+    from ipmc_asym.dynamics.circuit import step_response
+    from ipmc_asym.forward.model import ASSUMPTION_CHECKS, FLAGS, flag_mask
+
+    rng = np.random.default_rng(18)
+    n = 24
+    L = np.exp(rng.uniform(np.log(5e-3), np.log(5e-2), n))
+    wd = np.exp(rng.uniform(np.log(1e-3), np.log(2e-2), n))
+    th = np.exp(rng.uniform(np.log(20e-6), np.log(2e-3), n))
+    v = rng.choice([-1, 1], n) * np.where(rng.random(n) < 0.8, rng.uniform(0.05, 15.0, n), rng.uniform(25.0, 40.0, n))
+    rows = [evaluate(Strip(length=L[i], width=wd[i], thickness=th[i], voltage=v[i]), "constant") for i in range(n)]
+    est = {c: np.array([r["checks"][c] for r in rows]) for c in CHECKS}
+    for c in ASSUMPTION_CHECKS:  # the draw reaches both sides of every assumption
+        assert est[c].any() and not est[c].all(), c
+    # uq's per-sample evaluation
+    cols = {"length": L, "width": wd, "thickness": th, "voltage": v, "modulus": np.full(n, NAFION_LI.E),
+            "c_moy": np.full(n, NAFION_LI.C_moy)}
+    _, _, uchk, _ = uq.evaluate_samples(cols, ["rotation"], "constant", NAFION_LI, 1e-3, fidelity="quadrature")
+    for c in CHECKS:
+        assert np.array_equal(uchk[c], est[c]), c
+    # the figures: sweep rows and the dotted-curve rule, one point at a time
+    for i in range(n):
+        a = sweep({"voltage": np.array([v[i]])}, "constant", "quadrature",
+                  Strip(length=L[i], width=wd[i], thickness=th[i], voltage=v[i]))
+        assert {c: bool(a["check_" + c][0]) for c in CHECKS} == rows[i]["checks"]
+        for q in ("w", "F_block", "theta"):
+            want = any(not rows[i]["checks"][c] for c, keys in FLAGS.items() if q in keys)
+            assert bool(flag_mask(lambda c: a["check_" + c], q)[0]) == want
+    # step: each time point against estimate at that point's layer voltage (the voltage check
+    # also sees the applied voltage)
+    for i in range(0, n, 4):
+        s = Strip(length=L[i], width=wd[i], thickness=th[i], voltage=v[i])
+        r = step_response(v[i], strip=s, points=4)
+        for j in range(1, 4):
+            ev = evaluate(s.with_(voltage=float(r.layer_voltage[j])), "constant")["checks"]
+            ev["voltage"] = ev["voltage"] and abs(r.phi0[j]) <= 20.0
+            assert {c: bool(r.checks[c][j]) for c in CHECKS} == ev, (i, j)

@@ -147,3 +147,30 @@ def test_precise_data_escalate_fidelity(truth_rows, tmp_path):
         assert abs(r.parameters[k]["value"] / true - 1) < 1e-3
         lo, hi = r.parameters[k]["ci95"]
         assert lo <= true <= hi
+
+
+def test_rows_outside_a_model_assumption_are_flagged(tmp_path):
+    """Data at large rotation: the fit says which rows' fitted states fail an assumption, as
+    evaluate flags them at the fitted parameters (independent: |theta| = |M| L/(E I_p) > pi/2)."""
+    mat = NAFION_LI.with_(E=TRUE["modulus"], c_moy=TRUE["c_moy"])
+    rows = []
+    for v in (0.3, 0.6, 1.0, 1.5, 2.0, 2.5):
+        r = evaluate(Strip(length=0.03, width=5e-3, thickness=200e-6, voltage=v), "constant", "quadrature", mat)
+        rows.append((200e-6, v, abs(r["theta"]), abs(r["F_block"])))
+    p = tmp_path / "big.csv"
+    rng = np.random.default_rng(5)
+    lines = ["length,thickness,voltage,blocking_force,sigma_blocking_force"] + [
+        f"3cm,{t * 1e6:g}um,{v}V,{f * (1 + 0.01 * rng.standard_normal())!r},{0.01 * f!r}" for t, v, _, f in rows]
+    p.write_text("\n".join(lines) + "\n")
+    res = fit(read_data(p, Strip(width=5e-3)), ["c_moy"], material=mat)
+    E, Ip = mat.E, Strip(width=5e-3).I_p
+    c_fit = res.parameters["c_moy"]["value"]
+    want = []
+    for i, (t, v, _, _) in enumerate(rows):
+        e = evaluate(Strip(length=0.03, width=5e-3, thickness=t, voltage=v), "constant", "quadrature",
+                     mat.with_(c_moy=c_fit))
+        assert (abs(e["M_A"]) * 0.03 / (E * Ip) > math.pi / 2) == (not e["checks"]["beam_regime"])
+        if not e["checks"]["beam_regime"]:
+            want.append(i)
+    assert want and res.flagged_rows.get("beam_regime") == want
+    assert "outside a model assumption" in res.message and "beam_regime" in res.message

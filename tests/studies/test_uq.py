@@ -23,7 +23,8 @@ def test_output_of_one_input_has_exact_indices_within_ci():
                  "length": {"dist": "uniform", "low": "1.5cm", "high": "2.5cm"},
                  "modulus": {"dist": "lognormal", "median": "130MPa", "sigma": 0.2}},
                 ["I", "moment"], strip={"width": "5mm"})
-    r = run_uq(sc, 2**14 * 5, fidelity="leading")
+    # the closed form is over the whole distribution: samples past a quarter turn kept
+    r = run_uq(sc, 2**14 * 5, fidelity="leading", keep_invalid=True)
     for out in ("I", "moment"):
         for k, exact in (("thickness", 1.0), ("length", 0.0), ("modulus", 0.0)):
             s = r.sobol[out][k]
@@ -41,7 +42,8 @@ def test_product_of_lognormals_indices():
     sL, sE = 0.1, 0.25
     sc = _scene({"length": {"dist": "lognormal", "median": "2cm", "sigma": sL},
                  "modulus": {"dist": "lognormal", "median": "130MPa", "sigma": sE}}, ["rotation"])
-    r = run_uq(sc, 2**15 * 4, fidelity="leading")
+    # the closed form is over the whole distribution: samples past a quarter turn kept
+    r = run_uq(sc, 2**15 * 4, fidelity="leading", keep_invalid=True)
 
     def mv(s):
         return math.exp(s * s / 2), math.exp(s * s) * (math.exp(s * s) - 1)
@@ -59,7 +61,7 @@ def test_quantiles_of_lognormal_modulus_are_exact():
     """Only E uncertain (lognormal): theta = theta_nominal * E_med / E, quantiles in closed form."""
     s = 0.2
     sc = _scene({"modulus": {"dist": "lognormal", "median": "130MPa", "sigma": s}}, ["rotation"])
-    r = run_uq(sc, 2**14 * 3, fidelity="quadrature")
+    r = run_uq(sc, 2**14 * 3, fidelity="quadrature", keep_invalid=True)
     th0 = evaluate(Strip(length=0.02, width=5e-3), "constant", "quadrature", NAFION_LI)["theta"]
     z = 1.959963984540054
     q = r.summary["rotation"]
@@ -111,3 +113,24 @@ def test_estimators_equal_salib():
     for j, k in enumerate("abc"):
         assert ours[k]["S1"] == pytest.approx(float(first_order(A, AB[:, j], B)), rel=1e-12, abs=1e-14)
         assert ours[k]["ST"] == pytest.approx(float(total_order(A, AB[:, j], B)), rel=1e-12, abs=1e-14)
+
+
+def test_samples_outside_the_model_are_counted_and_left_out():
+    """A wide modulus puts some samples past a quarter turn: counted, checked per sample like
+    the forward model, out of the quantiles unless kept."""
+    from ipmc_asym.forward.model import CHECKS, forward
+
+    sc = _scene({"modulus": {"dist": "lognormal", "median": "130MPa", "sigma": 0.4}}, ["rotation"])
+    r = run_uq(sc, 3000, fidelity="leading")
+    E = r.samples["modulus"]
+    f = forward(0.02, 5e-3, 200e-6, 1.0, modulus=E, fidelity="leading", escalate=False, tol=1e-2)
+    for c in CHECKS:
+        assert np.array_equal(r.checks[c], getattr(f, c)), c
+    outside = ~f.valid
+    assert r.n_outside == int(outside.sum()) > 0
+    # independent: past a quarter turn is |theta| = |M| L / (E I_p) > pi/2
+    assert np.array_equal(outside, np.abs(r.outputs["rotation"]) > math.pi / 2)
+    assert r.summary["rotation"]["n"] == r.n_samples - r.n_outside
+    assert r.summary["rotation"]["q2.5"] >= -math.pi / 2  # the statistics hold inside samples only
+    k = run_uq(sc, 3000, fidelity="leading", keep_invalid=True)
+    assert k.summary["rotation"]["n"] == k.n_samples and k.summary["rotation"]["q2.5"] < r.summary["rotation"]["q2.5"]
