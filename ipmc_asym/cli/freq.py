@@ -5,10 +5,11 @@ from __future__ import annotations
 import numpy as np
 
 from ipmc_asym.base.registry import model_names
-from ipmc_asym.base.units import parse_quantity
+from ipmc_asym.base.units import parse_quantity, parse_sheet_resistance
 from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import add_strip_options, arg_type, count_type, diffusion_type, material_from_args, strip_from_args
 from ipmc_asym.dynamics.circuit import FREQ_METHODS, frequency_response
+from ipmc_asym.dynamics.line import line_response
 from ipmc_asym.io.jsonio import dumps
 
 
@@ -22,6 +23,16 @@ def _freq(name):
     return arg_type(conv, name)
 
 
+def _sheet_conv(text):
+    v = parse_sheet_resistance("--sheet-resistance", text)
+    if v < 0:
+        raise ValueError(f"--sheet-resistance must be >= 0 Ohm/sq (e.g. 2.5ohm/sq); got {text!r}")
+    return v
+
+
+_sheet = arg_type(_sheet_conv, "--sheet-resistance")
+
+
 def register(sub):
     p = sub.add_parser("freq", help=SUMMARIES["freq"])
     add_strip_options(p, voltage=False)
@@ -33,6 +44,9 @@ def register(sub):
                    help="pnp-linear (exact linearised PNP, closed form) or circuit (R + 1/(i w C_d))")
     p.add_argument("--diffusion", type=diffusion_type(), default=None,
                    help="cation diffusion coefficient D (1e-10m2/s, 1e-6cm2/s; a bare number is m^2/s)")
+    p.add_argument("--sheet-resistance", dest="sheet_resistance", type=_sheet, default=None,
+                   help="sheet resistance of each electrode (2.5ohm/sq; a bare number is Ohm/sq; default 0 = ideal): "
+                        "Z and w of the RC line along the strip, driven at the clamp")
     p.add_argument("--json", action="store_true", help="print one JSON object")
 
 
@@ -44,12 +58,19 @@ def run(args):
         material = material.with_(D=args.diffusion)
     strip = strip_from_args(args)
     f = np.geomspace(args.f1, args.f2, args.points)
-    r = frequency_response(f, strip=strip, model=args.model, material=material, method=args.method)
+    if args.sheet_resistance is None:
+        r = frequency_response(f, strip=strip, model=args.model, material=material, method=args.method)
+    else:
+        r = line_response(f, strip=strip, model=args.model, material=material, method=args.method,
+                          sheet_resistance=args.sheet_resistance)
     cols = {"f": r.f, "Z_re": r.Z.real, "Z_im": r.Z.imag, "w_amp": r.w_amp, "w_phase": r.w_phase}
     head = {"tau": r.tau, "model": r.model, "method": r.method, "thickness_total": strip.thickness,
             "electrode_area": strip.width * strip.length, "diffusion_coefficient": material.D,
             "units": {"f": "Hz", "Z": "Ohm (strip, electrode area 2l L)", "w_amp": "m/V", "w_phase": "rad"},
             "notes": r.notes + ["about phi0 = 0; w from the layers' charge, small displacements"]}
+    if args.sheet_resistance is not None:
+        head["sheet_resistance"] = args.sheet_resistance
+        head["units"]["sheet_resistance"] = "Ohm/sq (each electrode)"
     if args.json:
         out = dict(head)
         out.update(cols)

@@ -36,6 +36,7 @@ __all__ = [
     "C_MOY_PAPER",
     "D_CATION_DEFAULT",
     "D_CATION_SOURCE",
+    "SHEET_RESISTANCE_SOURCE",
     "Material",
     "Strip",
     "Groups",
@@ -60,6 +61,15 @@ D_CATION_SOURCE = (
     "9196; Li+ taken equal to Na+ within that order) and of the values used in PNP models of "
     "Nafion IPMCs (S. Nemat-Nasser, J. Y. Li, J. Appl. Phys. 87 (2000) 3321); uncertain by a "
     "factor ~3 either way: every dynamic time scales as 1/D"
+)
+
+#: What is known of the electrodes' sheet resistance R_s (Ohm/sq); the default is 0 (ideal
+#: electrodes, the paper's assumption: the same voltage along the whole strip).
+SHEET_RESISTANCE_SOURCE = (
+    "R_s is not in the paper (default 0: ideal electrodes). Measured: about 2.5 Ohm/sq for Pt electrolessly "
+    "plated on Nafion-117 after one round of NaBH4 reduction (four-point probe, 10 x 50 mm samples; E. Manaf et "
+    "al., Polymers 16 (2024) 2338, abstract); the same group reports that R_s depends strongly on the plating "
+    "conditions (Actuators 13 (2024) 350). No range is given here: one measured value was read"
 )
 
 #: The value the paper states (section 4) and uses; the formula with the quoted data gives
@@ -105,6 +115,10 @@ class Material:
                  paper, which names it in its Nernst law but gives no value; used only by the
                  dynamic models).  Default :data:`D_CATION_DEFAULT`, source
                  :data:`D_CATION_SOURCE`.
+    sheet_resistance : float  sheet (surface) resistance of each electrode, Ohm/sq, >= 0 (not in
+                 the paper; 0 = ideal electrodes; used only by
+                 :func:`ipmc_asym.dynamics.line.line_response`; source
+                 :data:`SHEET_RESISTANCE_SOURCE`).
     """
 
     Z3: float = -9.0e4
@@ -117,6 +131,7 @@ class Material:
     R: float = 8.31
     D: float = D_CATION_DEFAULT
     c_moy: object = "paper"
+    sheet_resistance: float = 0.0
     name: str = "nafion-li"
 
     def __post_init__(self):
@@ -133,6 +148,8 @@ class Material:
         check_positive("Faraday constant F", self.F, "C/mol")
         check_positive("gas constant R", self.R, "J/(mol K)")
         check_positive("cation diffusion coefficient D", self.D, "m^2/s")
+        if check_finite("sheet_resistance", self.sheet_resistance, "a finite number >= 0 Ohm/sq") < 0.0:
+            raise ValueError(f"sheet_resistance must be a finite number >= 0 Ohm/sq; got {self.sheet_resistance!r}")
         if isinstance(self.c_moy, str):
             if self.c_moy not in ("paper", "formula"):
                 raise ValueError(
