@@ -16,6 +16,10 @@ then decays along the strip, a first-order effect on the speed of IPMCs.  Along 
   ``Z_in = Z0 coth(g)`` with ``Z0 = sqrt(r/y)``, i.e. ``Z_in = Z_u g coth g`` for the uniform
   strip's ``Z_u = Z_area/(2l L)``.
 
+The through-thickness problem is local in ``x`` (the strip is long against its thickness) and
+the polymer's own conduction along the length is neglected: its sheet resistance ``1/(kappa 2e)``
+(~1.1e4 Ohm/sq at the nominal strip) is four orders above measured electrode values.
+
 The layers' moment follows the local voltage, ``M(x, s) = H_M(s) V(x, s)``; ``H_M`` is read off
 the uniform strip's tip transfer ``H_w = -L^2 H_M/(2 E I_p)`` (no electrochemistry recomputed).
 Small-displacement quasi-static beam with a distributed moment: curvature ``M(x)/(E I_p)``,
@@ -160,7 +164,7 @@ class LineResult:
     H_theta : ndarray complex   tip rotation per volt, rad/V
     H_M : ndarray complex       layers' moment per volt of local voltage, N m/V (``M(x) = H_M V(x)``)
     gamma_L : ndarray complex   ``g = gamma L = L sqrt(2 R_s/Z_area)``
-    Z0 : ndarray complex        characteristic impedance ``sqrt(r/y)``, Ohm
+    Z0 : ndarray complex        characteristic impedance ``sqrt(r/y)``, Ohm (0 for ideal electrodes)
     sheet_resistance : float    ``R_s``, Ohm/sq (each electrode)
     length : float              ``L``, m
     x : ndarray or None         positions of the profile, m
