@@ -148,9 +148,10 @@ def test_derivation_checks():
     assert DL.check_all()
 
 
-def test_modal_integral_against_independent_quadrature():
+@pytest.mark.parametrize("betaL", [4.694091, 30.0])  # second cantilever root; a mode of order ~10
+def test_modal_integral_against_independent_quadrature(betaL):
     L = 0.02
-    beta = 4.694091 / L  # second cantilever root: a curvature with a sign change
+    beta = betaL / L
 
     def curv(x):
         return np.cos(beta * x) + 0.3 * np.sinh(beta * x) / np.sinh(beta * L)
@@ -165,7 +166,8 @@ def test_modal_integral_against_independent_quadrature():
             xi = x / L
             return mp.cosh(gm * (1 - xi)) / mp.cosh(gm) * (mp.cos(beta * x) + 0.3 * mp.sinh(beta * x) / mp.sinh(beta * L))
 
-        pts = [0] + ([L / abs(gv) * c for c in (1, 5, 20) if L / abs(gv) * c < L] if abs(gv) > 1 else []) + [L]
+        decay = [L / abs(gv) * c for c in (1, 5, 20)] if abs(gv) > 1 else []
+        pts = sorted(set([p for p in decay if p < L] + list(np.linspace(0, L, 9))))
         ref = complex(mp.quad(f, pts))
         scale = complex(mp.quad(lambda x, gm=gm: abs(f(x, gm)), pts)).real
         assert abs(val[k] - ref) <= 1e-12 * scale
@@ -173,9 +175,14 @@ def test_modal_integral_against_independent_quadrature():
     # g = 0: the uniform moment, int phi'' dx = phi'(L) - phi'(0)
     exact = np.sin(beta * L) / beta + 0.3 * (np.cosh(beta * L) - 1) / (beta * np.sinh(beta * L))
     assert val[0].real == pytest.approx(exact, rel=1e-13)
+    # several modes at once: (k, n) curvatures give (len(g), k)
+    both = moment_modal_integral(lambda x: np.vstack([curv(x), np.cos(x / L)]), g, L)
+    assert both.shape == (g.size, 2) and np.allclose(both[:, 0], val, rtol=1e-14, atol=0)
     # LineResult.modal_forcing = H_M times the same integral
     r = line_response(F[:3], sheet_resistance=2.5)
     assert np.allclose(r.modal_forcing(curv), r.H_M * moment_modal_integral(curv, r.gamma_L, L), rtol=1e-15, atol=0)
+    two = r.modal_forcing(lambda x: np.vstack([curv(x), 2 * curv(x)]))
+    assert two.shape == (3, 2) and np.allclose(two[:, 1], 2 * r.modal_forcing(curv), rtol=1e-15, atol=0)
 
 
 def test_bad_inputs():
