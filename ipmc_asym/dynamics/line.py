@@ -1,7 +1,7 @@
 """Electrode surface resistance: the strip as an RC transmission line along its length.
 
 Each plated electrode has a sheet resistance ``R_s`` (Ohm/sq); the voltage across the thickness
-then decays along the strip, a first-order effect on the speed of IPMCs.  Along ``x`` in
+then decays along the strip, and more so the faster the drive.  Along ``x`` in
 ``[0, L]`` (drive at the clamp ``x = 0``, open far end) the strip is a distributed line
 (``derivations/line.py``):
 
@@ -18,7 +18,8 @@ then decays along the strip, a first-order effect on the speed of IPMCs.  Along 
 
 The through-thickness problem is local in ``x`` (the strip is long against its thickness) and
 the polymer's own conduction along the length is neglected: its sheet resistance ``1/(kappa 2e)``
-(~1.1e4 Ohm/sq at the nominal strip) is four orders above measured electrode values.
+(~1.1e4 Ohm/sq at the nominal strip) is ~4500 times the measured electrode value of
+:data:`ipmc_asym.model.params.SHEET_RESISTANCE_SOURCE` (2.5 Ohm/sq).
 
 The layers' moment follows the local voltage, ``M(x, s) = H_M(s) V(x, s)``; ``H_M`` is read off
 the uniform strip's tip transfer ``H_w = -L^2 H_M/(2 E I_p)`` (no electrochemistry recomputed).
