@@ -11,7 +11,7 @@ import re
 import numpy as np
 
 __all__ = ["parse_length", "parse_voltage", "parse_pressure", "parse_force", "parse_time", "parse_diffusion",
-           "parse_quantity", "fmt_length", "SWEEP_VARIABLES",
+           "parse_sheet_resistance", "parse_quantity", "fmt_length", "SWEEP_VARIABLES",
            "parse_vary_spec", "parse_vary", "vary_values"]
 
 _LENGTH = {
@@ -24,6 +24,8 @@ _FORCE = {"N": 1.0, "mN": 1e-3, "uN": 1e-6, "µN": 1e-6, "μN": 1e-6, "kN": 1e3}
 _TIME = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6, "μs": 1e-6, "min": 60.0, "h": 3600.0}
 _DIFFUSION = {"m2/s": 1.0, "m^2/s": 1.0, "cm2/s": 1e-4, "cm^2/s": 1e-4, "mm2/s": 1e-6, "mm^2/s": 1e-6,
               "um2/s": 1e-12, "µm2/s": 1e-12, "um^2/s": 1e-12, "µm^2/s": 1e-12}
+# sheet (surface) resistance of a film, Ohm per square (matched case-insensitively: "ohm/sq", "Ohm/sq")
+_SHEET = {"ohm/sq": 1.0, "ohm/square": 1.0, "ohm/□": 1.0, "ω/sq": 1.0, "ω/□": 1.0, "kohm/sq": 1e3}
 
 _NUM = re.compile(r"^\s*([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)\s*([^\s\d].*?)?\s*$")
 
@@ -82,6 +84,11 @@ def parse_time(name: str, text) -> float:
 def parse_diffusion(name: str, text) -> float:
     """``'1e-10m2/s'``, ``'1e-6 cm2/s'``, ``'1e-10'`` -> m^2/s."""
     return parse_quantity(name, text, _DIFFUSION, "diffusion coefficient")
+
+
+def parse_sheet_resistance(name: str, text) -> float:
+    """``'2.5ohm/sq'``, ``'2.5 Ω/sq'``, ``'2.5'`` -> Ohm per square."""
+    return parse_quantity(name, text, _SHEET, "sheet resistance", case_sensitive=False)
 
 
 def fmt_length(x: float) -> str:

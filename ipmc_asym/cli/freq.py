@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ipmc_asym.base.registry import model_names
-from ipmc_asym.base.units import parse_quantity
+from ipmc_asym.base.units import parse_quantity, parse_sheet_resistance
 from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import (
     add_strip_options,
@@ -18,6 +18,7 @@ from ipmc_asym.cli.common import (
 )
 from ipmc_asym.cli.drive import add_beam_options
 from ipmc_asym.dynamics.circuit import FREQ_METHODS, frequency_response
+from ipmc_asym.dynamics.line import line_response
 from ipmc_asym.dynamics.reduction import transfer_function
 from ipmc_asym.io.fileio import atomic_write, check_output_path
 from ipmc_asym.io.jsonio import dumps
@@ -31,6 +32,16 @@ def _freq(name):
         return v
 
     return arg_type(conv, name)
+
+
+def _sheet_conv(text):
+    v = parse_sheet_resistance("--sheet-resistance", text)
+    if v < 0:
+        raise ValueError(f"--sheet-resistance must be >= 0 Ohm/sq (e.g. 2.5ohm/sq); got {text!r}")
+    return v
+
+
+_sheet = arg_type(_sheet_conv, "--sheet-resistance")
 
 
 def register(sub):
@@ -47,6 +58,9 @@ def register(sub):
     p.add_argument("--voltage", type=voltage_type("--voltage"), default=0.0,
                    help="DC bias (e.g. 0.5V): small signal about the biased static state (method circuit)")
     add_beam_options(p, "dynamic")
+    p.add_argument("--sheet-resistance", dest="sheet_resistance", type=_sheet, default=None,
+                   help="sheet resistance of each electrode (2.5ohm/sq; a bare number is Ohm/sq; default 0 = ideal): "
+                        "Z and w of the RC line along the strip, driven at the clamp")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--export", metavar="F.json", default=None,
                    help="write reduced-order models of V -> w and V -> charge over [--from, --to] (poles, residues, "
@@ -79,6 +93,12 @@ def run(args):
     f = np.geomspace(args.f1, args.f2, args.points)
     if args.voltage != 0.0 and args.method != "circuit":
         raise ValueError("--voltage (a DC bias) needs --method circuit: pnp-linear is the linearisation about 0 V")
+    if args.sheet_resistance is not None and args.export is not None:
+        raise ValueError("--export with --sheet-resistance: the reduced-order models are of the ideal-electrode strip "
+                         "for now; export without --sheet-resistance")
+    if args.sheet_resistance is not None and (args.beam != "quasi-static" or args.voltage != 0.0):
+        raise ValueError("--sheet-resistance needs --beam quasi-static and no --voltage bias: the distributed moment "
+                         "of the electrode line is not yet wired to the modal beam or the biased circuit")
     r = frequency_response(f, strip=strip, model=args.model, material=material, method=args.method, beam=args.beam,
                            viscous_modulus=args.viscous_modulus, voltage=args.voltage)
     cols = {"f": r.f, "Z_re": r.Z.real, "Z_im": r.Z.imag, "w_amp": r.w_amp, "w_phase": r.w_phase,
@@ -86,15 +106,30 @@ def run(args):
             "F_amp": np.abs(r.H_F), "F_phase": np.angle(r.H_F)}
     if r.error is not None:
         cols["error"] = r.error
+    if args.sheet_resistance is not None:
+        # the electrode line: Z at the clamp, w and theta of the distributed moment (no blocked-tip
+        # force for a distributed moment yet, and the circuit's error is that of the uniform strip)
+        ln = line_response(f, strip=strip, model=args.model, material=material, method=args.method,
+                           sheet_resistance=args.sheet_resistance)
+        cols.update({"Z_re": ln.Z.real, "Z_im": ln.Z.imag, "w_amp": ln.w_amp, "w_phase": ln.w_phase,
+                     "theta_amp": np.abs(ln.H_theta), "theta_phase": np.angle(ln.H_theta)})
+        for k in ("F_amp", "F_phase", "error"):
+            cols.pop(k, None)
+        r = ln
     head = {"tau": r.tau, "model": r.model, "method": r.method, "thickness_total": strip.thickness,
-            "f_d": r.f_d, "voltage": r.voltage, "beam": r.beam, "viscous_modulus": args.viscous_modulus,
-            "resonances": r.resonances, "error_max": None if r.error is None else r.error_max,
+            "f_d": getattr(r, "f_d", None), "voltage": args.voltage, "beam": args.beam,
+            "viscous_modulus": args.viscous_modulus,
+            "resonances": getattr(r, "resonances", None),
+            "error_max": None if getattr(r, "error", None) is None else r.error_max,
             "reference": "pnp-linear (exact linearised Nernst-Planck/Gauss)",
             "electrode_area": strip.width * strip.length, "diffusion_coefficient": material.D,
             "units": {"f": "Hz", "Z": "Ohm (strip, electrode area 2l L)", "w_amp": "m/V", "w_phase": "rad",
                       "theta_amp": "rad/V (free tip)", "theta_phase": "rad", "F_amp": "N/V (blocked tip)",
                       "F_phase": "rad", "error": "relative, of Z and w against pnp-linear"},
             "notes": r.notes + [f"about phi0 = {r.voltage:g} V; w from the layers' charge, small displacements"]}
+    if args.sheet_resistance is not None:
+        head["sheet_resistance"] = args.sheet_resistance
+        head["units"]["sheet_resistance"] = "Ohm/sq (each electrode)"
     if args.export is not None:
         fits = {o: transfer_function(args.f1, args.f2, strip=strip, model=args.model, material=material, output=o,
                                      method=args.method, tol=args.export_tol, beam=args.beam,
@@ -112,17 +147,18 @@ def run(args):
         out.update(cols)
         print(dumps(out, indent=1))
         return 0
-    print(f"small signal about {r.voltage:g} V, model {r.model}, method {r.method}, beam {r.beam}, total thickness 2e = "
-          f"{strip.thickness * 1e6:.4g} um: tau = {r.tau:.4g} s, D = {material.D:.3g} m^2/s")
-    if r.beam == "dynamic":
-        print(f"resonances: free tip {', '.join(f'{v:.4g}' for v in r.resonances['clamped-free'])} Hz; "
-              f"blocked tip {', '.join(f'{v:.4g}' for v in r.resonances['clamped-pinned'])} Hz")
-    ecol = r.error is not None
+    line = "" if args.sheet_resistance is None else f", electrode sheet resistance {args.sheet_resistance:g} Ohm/sq"
+    print(f"small signal about {args.voltage:g} V, model {r.model}, method {r.method}, beam {args.beam}, total "
+          f"thickness 2e = {strip.thickness * 1e6:.4g} um{line}: tau = {r.tau:.4g} s, D = {material.D:.3g} m^2/s")
+    if head["resonances"]:
+        print(f"resonances: free tip {', '.join(f'{v:.4g}' for v in head['resonances']['clamped-free'])} Hz; "
+              f"blocked tip {', '.join(f'{v:.4g}' for v in head['resonances']['clamped-pinned'])} Hz")
+    ecol = "error" in cols
     print(f"{'f [Hz]':>11s} {'Z_re [Ohm]':>12s} {'Z_im [Ohm]':>12s} {'|w|/V [mm/V]':>13s} {'phase [rad]':>11s}"
           + (f" {'error':>9s}" if ecol else ""))
     for i in range(f.size):
-        print(f"{f[i]:11.4g} {r.Z.real[i]:12.5g} {r.Z.imag[i]:12.5g} {r.w_amp[i] * 1e3:13.5g} {r.w_phase[i]:11.4g}"
-              + (f" {r.error[i]:9.2g}" if ecol else ""))
+        print(f"{f[i]:11.4g} {cols['Z_re'][i]:12.5g} {cols['Z_im'][i]:12.5g} {cols['w_amp'][i] * 1e3:13.5g} "
+              f"{cols['w_phase'][i]:11.4g}" + (f" {cols['error'][i]:9.2g}" if ecol else ""))
     for n in head["notes"]:
         print(f"note: {n}")
     if args.export is not None:

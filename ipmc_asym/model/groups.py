@@ -22,7 +22,7 @@ import numpy as np
 
 __all__ = ["Groups", "make_groups", "A0", "A1", "A2", "A3", "A5", "inverse_thermal_voltage",
            "thermal_voltage", "debye_length", "debye_length_m", "kappa", "geometric_capacitance",
-           "b1_neutral", "moment_scale"]
+           "b1_neutral", "moment_scale", "electrode_line_resistance", "line_propagation"]
 
 
 def _cm(material: Material, C_moy):
@@ -141,6 +141,26 @@ def geometric_capacitance(thickness, eps_core):
     (2 lambda_D)`` of the two electrodes in series.
     """
     return eps_core / np.asarray(thickness, dtype=float)
+
+
+def electrode_line_resistance(width, sheet_resistance):
+    """Series resistance per unit length of the two electrodes, ``r = 2 R_s/(2l)`` (Ohm/m).
+
+    The current that crosses the thickness beyond ``x`` flows out along one electrode and
+    back along the other: both sheets (width ``2l``, TOTAL, m; ``R_s`` in Ohm/sq) are in
+    series (``derivations/line.py``).
+    """
+    return 2.0 * np.asarray(sheet_resistance, dtype=float) / np.asarray(width, dtype=float)
+
+
+def line_propagation(length, sheet_resistance, Z_area):
+    """``g = gamma L = L sqrt(2 R_s/Z_area)`` (dimensionless, complex, ``Re g >= 0``).
+
+    ``gamma^2 = r y`` with ``r = 2 R_s/(2l)`` and the shunt admittance per length
+    ``y = 2l/Z_area`` (``Z_area`` in Ohm m^2): the width cancels (``derivations/line.py``).
+    """
+    z = np.asarray(Z_area, dtype=complex)
+    return np.asarray(length, dtype=float) * np.sqrt(2.0 * np.asarray(sheet_resistance, dtype=float) / z)
 
 
 def b1_neutral(A2, rho):

@@ -38,6 +38,7 @@ __all__ = [
     "C_MOY_PAPER",
     "D_CATION_DEFAULT",
     "D_CATION_SOURCE",
+    "SHEET_RESISTANCE_SOURCE",
     "Material",
     "Strip",
     "Groups",
@@ -64,6 +65,15 @@ D_CATION_SOURCE = (
     "K+, Cs+ and Ag+ (and divalent ions), not Li+, and no diffusion coefficient of Li+ in Nafion was "
     "found in the sources read; every dynamic time scales as 1/D (ipmc-asym validate reports the D "
     "that gives the paper's ~1 s)"
+)
+
+#: What is known of the electrodes' sheet resistance R_s (Ohm/sq); the default is 0 (ideal
+#: electrodes, the paper's assumption: the same voltage along the whole strip).
+SHEET_RESISTANCE_SOURCE = (
+    "R_s is not in the paper (default 0: ideal electrodes). Measured: about 2.5 Ohm/sq for Pt electrolessly "
+    "plated on Nafion-117 after one round of NaBH4 reduction (four-point probe, 10 x 50 mm samples; E. Manaf et "
+    "al., Polymers 16 (2024) 2338, abstract); the same group reports that R_s depends strongly on the plating "
+    "conditions (Actuators 13 (2024) 350). No range is given here: one measured value was read"
 )
 
 #: The value the paper states (section 4) and uses; the formula with the quoted data gives
@@ -112,6 +122,10 @@ class Material:
     strain_limit : float   face strain ``e|kappa|`` up to which the small-strain beam model is
                  assumed (a model assumption: above it results are kept and flagged), in
                  (0, 1); default ``settings.STRAIN_LIMIT``, source ``settings.STRAIN_LIMIT_SOURCE``
+    sheet_resistance : float  sheet (surface) resistance of each electrode, Ohm/sq, >= 0 (not in
+                 the paper; 0 = ideal electrodes; used only by
+                 :func:`ipmc_asym.dynamics.line.line_response`; source
+                 :data:`SHEET_RESISTANCE_SOURCE`).
     """
 
     Z3: float = -9.0e4
@@ -124,6 +138,7 @@ class Material:
     R: float = 8.31
     D: float = D_CATION_DEFAULT
     c_moy: object = "paper"
+    sheet_resistance: float = 0.0
     name: str = "nafion-li"
     #: full citations of the sources of the values (a material set's; :data:`NAFION_LI` carries
     #: the paper's)
@@ -147,6 +162,8 @@ class Material:
         sl = check_finite("strain_limit", self.strain_limit, "in the open interval (0, 1)")
         if not 0.0 < sl < 1.0:
             raise ValueError(f"strain_limit must be in the open interval (0, 1), e.g. 0.01; got {self.strain_limit!r}")
+        if check_finite("sheet_resistance", self.sheet_resistance, "a finite number >= 0 Ohm/sq") < 0.0:
+            raise ValueError(f"sheet_resistance must be a finite number >= 0 Ohm/sq; got {self.sheet_resistance!r}")
         if isinstance(self.c_moy, str):
             if self.c_moy not in ("paper", "formula"):
                 raise ValueError(

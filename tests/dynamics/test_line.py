@@ -1,0 +1,216 @@
+"""The strip with resistive electrodes: RC line along the length vs a discretised ladder, limits,
+the SymPy closed forms, the modal forcing integral and the command line."""
+
+import json
+
+import mpmath as mp
+import numpy as np
+import pytest
+import sympy as sp
+
+from derivations import line as DL
+from ipmc_asym.cli import main
+from ipmc_asym.dynamics.circuit import frequency_response
+from ipmc_asym.dynamics.line import line_factors, line_response, moment_modal_integral, voltage_profile
+from ipmc_asym.model.params import NAFION_LI, Strip
+
+F = np.geomspace(1e-3, 1e5, 25)
+
+
+def ladder(f, strip, Rs, N, method="pnp-linear", model="constant"):
+    """Discretised line: N segments of series r h between nodes x_j = j h, shunt y h at the interior
+    nodes and y h/2 at the two ends (second order in h), V(0) = 1.  Returns (Z_in, H_w, H_theta, V).
+
+    r = 2 R_s/(2l) (both electrodes in series), y = 2l/Z_area (the through-thickness impedance per
+    area of the uniform strip is the input); the tip deflection and rotation are trapezoidal sums of
+    the beam's -(L - x) M/(E I_p) and -M/(E I_p) with M = H_M V, H_M = -2 E I_p H_w^u/L^2.
+    """
+    u = frequency_response(f, strip=strip, model=model, method=method)
+    L, w2 = strip.length, strip.width
+    r = 2.0 * Rs / w2
+    y = w2 / u.Z_area
+    h = L / N
+    a = r * y * h * h  # (nf,)
+    # unknowns V_1..V_N: V_{j-1} - (2 + a) V_j + V_{j+1} = 0 (j < N), V_{N-1} - (1 + a/2) V_N = 0
+    nf = a.size
+    diag = np.empty((N, nf), complex)
+    diag[:] = -(2.0 + a)
+    diag[-1] = -(1.0 + 0.5 * a)
+    rhs = np.zeros((N, nf), complex)
+    rhs[0] = -1.0  # V_0 = 1 moved to the right-hand side
+    # Thomas algorithm (sub- and super-diagonals are 1), vectorised over the frequencies
+    cp = np.empty((N, nf), complex)
+    dp = np.empty((N, nf), complex)
+    cp[0] = 1.0 / diag[0]
+    dp[0] = rhs[0] / diag[0]
+    for j in range(1, N):
+        m = diag[j] - cp[j - 1]
+        cp[j] = 1.0 / m
+        dp[j] = (rhs[j] - dp[j - 1]) / m
+    V = np.empty((N + 1, nf), complex)
+    V[0] = 1.0
+    V[N] = dp[N - 1]
+    for j in range(N - 1, 0, -1):
+        V[j] = dp[j - 1] - cp[j - 1] * V[j + 1]
+    x = np.linspace(0.0, L, N + 1)
+    wt = np.full(N + 1, h)
+    wt[[0, -1]] = 0.5 * h
+    # the input current is the sum of the shunt currents (KCL over the open-ended ladder); the
+    # same as (V_0 - V_1)/(r h) + y h V_0/2 without its cancellation where r y h^2 is tiny
+    I0 = y * (wt @ V)
+    EI = NAFION_LI.E * strip.I_p
+    HM = -2.0 * EI * u.H_w / L**2
+    Hw = -(HM / EI) * ((wt * (L - x)) @ V)
+    Hth = -(HM / EI) * (wt @ V)
+    return 1.0 / I0, Hw, Hth, V
+
+
+def rel(a, b):
+    return np.abs(a - b) / np.abs(b)
+
+
+@pytest.mark.parametrize("method", ["pnp-linear", "circuit"])
+@pytest.mark.parametrize("Rs", [0.5, 2.5, 25.0])
+def test_against_discretised_ladder(Rs, method):
+    s = Strip()
+    r = line_response(F, strip=s, sheet_resistance=Rs, method=method, x=np.linspace(0, s.length, 1001))
+    z1, w1, t1, v1 = ladder(F, s, Rs, 1000, method)
+    z2, w2, t2, v2 = ladder(F, s, Rs, 2000, method)
+    # the ladder's error is even in h (derivations/line.py: ladder_profile_check): Richardson 1000/2000
+    zr, wr, tr = (4 * z2 - z1) / 3, (4 * w2 - w1) / 3, (4 * t2 - t1) / 3
+    assert np.max(rel(r.Z, zr)) <= 1e-6
+    assert np.max(rel(r.H_w, wr)) <= 1e-6
+    assert np.max(rel(r.H_theta, tr)) <= 1e-6
+    # the raw 2000-segment ladder is off at second order, and Richardson does improve on it
+    assert np.max(rel(r.Z, z2)) > 10 * np.max(rel(r.Z, zr))
+    # the profile at the nodes of the 1000-segment ladder (second order: |g h|^2 / 24)
+    vr = (4 * v2[::2] - v1) / 3
+    assert np.max(np.abs(r.V_profile - vr.T)) <= 1e-6
+
+
+def test_zero_sheet_resistance_is_the_uniform_strip_exactly():
+    for method in ("pnp-linear", "circuit"):
+        u = frequency_response(F, method=method, model="affine")
+        r = line_response(F, method=method, model="affine")  # material default: 0 Ohm/sq
+        assert np.array_equal(r.Z, u.Z) and np.array_equal(r.H_w, u.H_w) and np.array_equal(r.Z_area, u.Z_area)
+        r0 = line_response(F, method=method, model="affine", sheet_resistance=0.0, x=[0.0, 0.01, 0.02])
+        assert np.array_equal(r0.Z, u.Z) and np.array_equal(r0.w_amp, u.w_amp)
+        assert np.array_equal(r0.V_profile, np.ones_like(r0.V_profile))
+    # the material parameter is the default of the keyword
+    m = NAFION_LI.with_(sheet_resistance=2.5)
+    assert np.array_equal(line_response(F, material=m).Z, line_response(F, sheet_resistance=2.5).Z)
+
+
+def test_small_sheet_resistance_tends_to_uniform():
+    u = frequency_response(F)
+    for Rs in (1e-4, 1e-8, 1e-12):
+        r = line_response(F, sheet_resistance=Rs)
+        g2 = np.abs(r.gamma_L) ** 2
+        # derived series: Z_in/Z_u = 1 + g^2/3 + ..., w/w_u = 1 - g^2/4 + ...
+        assert np.all(rel(r.Z, u.Z) <= g2 / 3 * 1.01 + 1e-15)
+        assert np.all(rel(r.H_w, u.H_w) <= g2 / 4 * 1.01 + 1e-15)
+    assert np.max(rel(r.Z, u.Z)) < 1e-11
+
+
+def test_large_sheet_resistance_high_frequency_is_the_characteristic_impedance():
+    f = np.geomspace(1e2, 1e5, 7)
+    r = line_response(f, sheet_resistance=1e3)
+    assert np.all(r.gamma_L.real > 40)
+    Z0 = np.sqrt((2 * 1e3 / 5e-3) * r.Z_area / 5e-3)  # sqrt(r / y) from r = 2 R_s/(2l), y = 2l/Z_area
+    assert np.max(rel(r.Z, Z0)) < 1e-13
+    assert np.max(rel(r.Z0, Z0)) < 1e-13
+    # beyond a few decay lengths the strip is not driven: the tip moves as if only ~L/g were active
+    assert np.all(np.abs(r.H_w) < 2.1 / np.abs(r.gamma_L) * np.abs(r.uniform.H_w))
+
+
+def _mp_eval(expr, gv, xv=None):
+    mp.mp.dps = 40
+    fn = sp.lambdify((DL.g, DL.xi), expr, "mpmath")
+    return complex(fn(mp.mpc(gv.real, gv.imag), mp.mpf(0.3) if xv is None else mp.mpf(xv)))
+
+
+@pytest.mark.parametrize("gv", [1e-90 + 1e-90j, 1e-6 + 2e-7j, 3e-3 + 3e-3j, 0.4 + 0.1j, 2.5 + 2j, 30 + 29j, 700 + 700j, 5.0])
+def test_factors_equal_the_sympy_closed_forms(gv):
+    fz, fth, fw = line_factors(np.array([gv]))
+    cf = DL.closed_forms()
+    for got, key in ((fz, "impedance"), (fth, "rotation"), (fw, "deflection")):
+        ref = _mp_eval(cf[key], gv)
+        assert abs(got[0] - ref) <= 4e-15 * abs(ref), key
+    for xv in (0.0, 0.3, 0.999, 1.0):
+        ref = _mp_eval(cf["profile"], gv, xv)
+        got = voltage_profile(np.array([gv]), xv)[0]
+        # g xi is rounded once: a phase error of eps |g xi| is inherent to double-precision input
+        assert abs(got - ref) <= 4e-15 * (1 + abs(gv)) * abs(ref)
+
+
+@pytest.mark.slow
+def test_derivation_checks():
+    assert DL.check_all()
+
+
+@pytest.mark.parametrize("betaL", [4.694091, 30.0])  # second cantilever root; a mode of order ~10
+def test_modal_integral_against_independent_quadrature(betaL):
+    L = 0.02
+    beta = betaL / L
+
+    def curv(x):
+        return np.cos(beta * x) + 0.3 * np.sinh(beta * x) / np.sinh(beta * L)
+
+    g = np.array([0.0, 0.5 + 0.2j, 3 + 2j, 60 + 55j, 900 + 900j])
+    val, err = moment_modal_integral(curv, g, L, error=True)
+    mp.mp.dps = 30
+    for k, gv in enumerate(g):
+        gm = mp.mpc(gv.real, gv.imag)
+
+        def f(x, gm=gm):
+            xi = x / L
+            return mp.cosh(gm * (1 - xi)) / mp.cosh(gm) * (mp.cos(beta * x) + 0.3 * mp.sinh(beta * x) / mp.sinh(beta * L))
+
+        decay = [L / abs(gv) * c for c in (1, 5, 20)] if abs(gv) > 1 else []
+        pts = sorted(set([p for p in decay if p < L] + list(np.linspace(0, L, 9))))
+        ref = complex(mp.quad(f, pts))
+        scale = complex(mp.quad(lambda x, gm=gm: abs(f(x, gm)), pts)).real
+        assert abs(val[k] - ref) <= 1e-12 * scale
+        assert err[k] <= 1e-8 * scale
+    # g = 0: the uniform moment, int phi'' dx = phi'(L) - phi'(0)
+    exact = np.sin(beta * L) / beta + 0.3 * (np.cosh(beta * L) - 1) / (beta * np.sinh(beta * L))
+    assert val[0].real == pytest.approx(exact, rel=1e-13)
+    # several modes at once: (k, n) curvatures give (len(g), k)
+    both = moment_modal_integral(lambda x: np.vstack([curv(x), np.cos(x / L)]), g, L)
+    assert both.shape == (g.size, 2) and np.allclose(both[:, 0], val, rtol=1e-14, atol=0)
+    # LineResult.modal_forcing = H_M times the same integral
+    r = line_response(F[:3], sheet_resistance=2.5)
+    assert np.allclose(r.modal_forcing(curv), r.H_M * moment_modal_integral(curv, r.gamma_L, L), rtol=1e-15, atol=0)
+    two = r.modal_forcing(lambda x: np.vstack([curv(x), 2 * curv(x)]))
+    assert two.shape == (3, 2) and np.allclose(two[:, 1], 2 * r.modal_forcing(curv), rtol=1e-15, atol=0)
+
+
+def test_bad_inputs():
+    with pytest.raises(ValueError, match="sheet_resistance"):
+        line_response(F, sheet_resistance=-1.0)
+    with pytest.raises(ValueError, match="sheet_resistance"):
+        line_response(F, sheet_resistance=float("nan"))
+    with pytest.raises(ValueError, match="sheet_resistance"):
+        NAFION_LI.with_(sheet_resistance=-2.0)
+    with pytest.raises(ValueError, match="x must be"):
+        line_response(F, sheet_resistance=1.0, x=[0.0, 1.0])
+    with pytest.raises(ValueError, match="uniform_panels"):
+        moment_modal_integral(np.cos, np.array([1.0]), 0.02, uniform_panels=0)
+
+
+def test_cli_sheet_resistance(capsys):
+    assert main(["freq", "--from", "0.1Hz", "--to", "1kHz", "--points", "5", "--sheet-resistance", "2.5ohm/sq", "--beam",
+                 "quasi-static", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    r = line_response(np.geomspace(0.1, 1e3, 5), sheet_resistance=2.5)
+    assert out["sheet_resistance"] == 2.5
+    assert np.allclose(out["Z_re"], r.Z.real, rtol=1e-15) and np.allclose(out["w_amp"], r.w_amp, rtol=1e-15)
+    assert any("sheet resistance" in n for n in out["notes"])
+    assert main(["freq", "--from", "0.1Hz", "--to", "1kHz", "--points", "5", "--json"]) == 0
+    base = json.loads(capsys.readouterr().out)
+    assert base["Z_re"] == list(frequency_response(np.geomspace(0.1, 1e3, 5)).Z.real)
+    for bad in ("-1ohm/sq", "2V", "x"):
+        with pytest.raises(SystemExit) as e:
+            main(["freq", "--from", "1Hz", "--to", "2Hz", "--sheet-resistance", bad])
+        assert e.value.code == 2
+        assert "--sheet-resistance" in capsys.readouterr().err
