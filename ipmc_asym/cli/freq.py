@@ -126,7 +126,7 @@ def run(args):
             "units": {"f": "Hz", "Z": "Ohm (strip, electrode area 2l L)", "w_amp": "m/V", "w_phase": "rad",
                       "theta_amp": "rad/V (free tip)", "theta_phase": "rad", "F_amp": "N/V (blocked tip)",
                       "F_phase": "rad", "error": "relative, of Z and w against pnp-linear"},
-            "notes": r.notes + [f"about phi0 = {r.voltage:g} V; w from the layers' charge, small displacements"]}
+            "notes": r.notes + [f"about phi0 = {args.voltage:g} V; w from the layers' charge, small displacements"]}
     if args.sheet_resistance is not None:
         head["sheet_resistance"] = args.sheet_resistance
         head["units"]["sheet_resistance"] = "Ohm/sq (each electrode)"
