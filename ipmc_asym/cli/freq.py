@@ -5,11 +5,24 @@ from __future__ import annotations
 import numpy as np
 
 from ipmc_asym.base.registry import model_names
-from ipmc_asym.base.units import parse_quantity
+from ipmc_asym.base.units import fmt_length, parse_quantity
 from ipmc_asym.cli import SUMMARIES
-from ipmc_asym.cli.common import add_strip_options, arg_type, count_type, diffusion_type, material_from_args, strip_from_args
+from ipmc_asym.cli.common import (
+    add_size_option,
+    add_strip_options,
+    arg_type,
+    diffusion_type,
+    fmt_num,
+    material_from_args,
+    model_help,
+    strip_from_args,
+)
 from ipmc_asym.dynamics.circuit import FREQ_METHODS, frequency_response
 from ipmc_asym.io.jsonio import dumps
+
+#: frequencies of one run (log-spaced: 1e5 points resolve any spectrum; the --json text stays ~10 MB);
+#: settable with --max-points
+MAX_POINTS = 10**5
 
 
 def _freq(name):
@@ -27,8 +40,8 @@ def register(sub):
     add_strip_options(p, voltage=False)
     p.add_argument("--from", dest="f1", type=_freq("--from"), required=True, help="first frequency (e.g. 0.01Hz)")
     p.add_argument("--to", dest="f2", type=_freq("--to"), required=True, help="last frequency (e.g. 1kHz)")
-    p.add_argument("--points", type=count_type("--points", 2), default=50, help="log-spaced points (default 50)")
-    p.add_argument("--model", default="constant", choices=list(model_names()), help="permittivity model")
+    add_size_option(p, "--points", default=50, maximum=MAX_POINTS, minimum=2, help="log-spaced points")
+    p.add_argument("--model", default="constant", choices=list(model_names()), help=model_help("constant"))
     p.add_argument("--method", default="pnp-linear", choices=FREQ_METHODS,
                    help="pnp-linear (exact linearised PNP, closed form) or circuit (R + 1/(i w C_d))")
     p.add_argument("--diffusion", type=diffusion_type(), default=None,
@@ -56,10 +69,11 @@ def run(args):
         print(dumps(out, indent=1))
         return 0
     print(f"small signal about 0 V, model {r.model}, method {r.method}, total thickness 2e = "
-          f"{strip.thickness * 1e6:.4g} um: tau = {r.tau:.4g} s, D = {material.D:.3g} m^2/s")
+          f"{fmt_length(strip.thickness)}: tau = {r.tau:.4g} s, D = {material.D:.3g} m^2/s")
     print(f"{'f [Hz]':>11s} {'Z_re [Ohm]':>12s} {'Z_im [Ohm]':>12s} {'|w|/V [mm/V]':>13s} {'phase [rad]':>11s}")
     for i in range(f.size):
-        print(f"{f[i]:11.4g} {r.Z.real[i]:12.5g} {r.Z.imag[i]:12.5g} {r.w_amp[i] * 1e3:13.5g} {r.w_phase[i]:11.4g}")
+        print(f"{fmt_num(f[i], '11.4g')} {fmt_num(r.Z.real[i], '12.5g')} {fmt_num(r.Z.imag[i], '12.5g')} "
+              f"{fmt_num(r.w_amp[i] * 1e3, '13.5g')} {fmt_num(r.w_phase[i], '11.4g')}")
     for n in head["notes"]:
         print(f"note: {n}")
     return 0

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import csv
+import json
+import os
 import sys
 
 import numpy as np
@@ -11,12 +13,14 @@ from ipmc_asym.base.registry import model_names
 from ipmc_asym.base.units import fmt_length, parse_time
 from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import (
+    add_size_option,
     add_strip_options,
     arg_type,
-    count_type,
     diffusion_type,
     first_run_notice,
+    fmt_num,
     material_from_args,
+    model_help,
     strip_from_args,
 )
 from ipmc_asym.dynamics.circuit import STEP_FIDELITIES, step_response
@@ -24,6 +28,14 @@ from ipmc_asym.io.fileio import atomic_write, check_output_path
 from ipmc_asym.io.jsonio import dumps
 
 COLUMNS = ("t", "phi0", "sigma", "current_density", "M_A", "theta", "w")
+#: output times of one run: the arrays of the integrator (~2 substeps per interval) and of the
+#: forward model stay ~100 MB; settable with --max-points
+MAX_POINTS = 10**5
+
+
+def sidecar_path(out: str) -> str:
+    """The metadata file beside a step CSV: ``x.csv`` -> ``x.csv.json`` (tau, thickness, model, units)."""
+    return out + ".json"
 
 
 def _duration(text):
@@ -40,17 +52,20 @@ def register(sub):
                    help="end time (e.g. 0.2s, 50ms; default 5 tau)")
     p.add_argument("--fidelity", default="circuit", choices=STEP_FIDELITIES,
                    help="circuit (reduced nonlinear capacitor) or pnp (transient Nernst-Planck/Gauss)")
-    p.add_argument("--model", default="constant", choices=list(model_names()), help="permittivity model")
+    p.add_argument("--model", default="constant", choices=list(model_names()), help=model_help("constant"))
     p.add_argument("--diffusion", type=diffusion_type(), default=None,
                    help="cation diffusion coefficient D (1e-10m2/s, 1e-6cm2/s; a bare number is m^2/s)")
-    p.add_argument("--points", type=count_type("--points", 2), default=1000, help="output times (default 1000)")
-    p.add_argument("--out", default=None, help="CSV file (columns t, phi0, sigma, current_density, M_A, theta, w)")
+    add_size_option(p, "--points", default=1000, maximum=MAX_POINTS, minimum=2, help="output times")
+    p.add_argument("--out", default=None, metavar="F.csv",
+                   help="CSV file (header row t, phi0, sigma, current_density, M_A, theta, w; SI), with the "
+                        "metadata (tau, total thickness, model, units) in the sidecar F.csv.json")
     p.add_argument("--json", action="store_true", help="print one JSON object")
 
 
 def run(args):
     if args.out:
-        check_output_path(args.out, "file")
+        check_output_path(args.out, "file", formats=(".csv",))
+        check_output_path(sidecar_path(args.out), "file")
     material = material_from_args(args)
     if args.diffusion is not None:
         material = material.with_(D=args.diffusion)
@@ -61,14 +76,20 @@ def run(args):
     cols = {"t": r.t, "phi0": r.phi0, "sigma": r.sigma, "current_density": r.current_density, "M_A": r.M_A,
             "theta": r.theta, "w": r.w}
     if args.out:
+        # the CSV has one header row (pandas.read_csv reads it as is); the metadata goes to a
+        # sidecar JSON file beside it
+        meta = {"csv": os.path.basename(args.out), "tau": r.tau, "thickness_total": strip.thickness,
+                "half_thickness_e": strip.e, "voltage": strip.voltage, "model": r.model, "fidelity": r.fidelity,
+                "units": {"t": "s", "phi0": "V", "sigma": "C/m^2", "current_density": "A/m^2", "M_A": "N m",
+                          "theta": "rad", "w": "m"}}
         with atomic_write(args.out) as fh:
             wr = csv.writer(fh)
-            wr.writerow([f"# tau = {r.tau!r} s; thickness_total = {strip.thickness!r} m; model = {r.model}; "
-                         f"fidelity = {r.fidelity}; SI units"])
             wr.writerow(COLUMNS)
             for i in range(r.t.size):
-                wr.writerow([repr(float(cols[c][i])) for c in COLUMNS])
-        sys.stderr.write(f"step: {r.t.size} rows -> {args.out}\n")
+                wr.writerow([repr(float(cols[c][i]) + 0.0) for c in COLUMNS])
+        with atomic_write(sidecar_path(args.out)) as fh:
+            fh.write(json.dumps(meta, indent=1) + "\n")
+        sys.stderr.write(f"step: {r.t.size} rows -> {args.out} (metadata: {sidecar_path(args.out)})\n")
     head = {"tau": r.tau, "R": r.R, "C_d0": r.C_d0, "model": r.model, "fidelity": r.fidelity,
             "voltage": strip.voltage, "thickness_total": strip.thickness, "half_thickness_e": strip.e,
             "diffusion_coefficient": material.D, "seconds": r.seconds, "notes": r.notes, "message": r.message}
@@ -84,8 +105,8 @@ def run(args):
         idx = np.unique(np.linspace(0, r.t.size - 1, min(r.t.size, 11)).astype(int))
         print(f"{'t [s]':>11s} {'sigma [C/m^2]':>14s} {'J [A/m^2]':>11s} {'M_A [N m]':>11s} {'theta':>9s} {'w [mm]':>9s}")
         for i in idx:
-            print(f"{r.t[i]:11.4g} {r.sigma[i]:14.6g} {r.current_density[i]:11.4g} {r.M_A[i]:11.4g} "
-                  f"{r.theta[i]:9.4g} {r.w[i] * 1e3:9.4g}")
+            print(f"{fmt_num(r.t[i], '11.4g')} {fmt_num(r.sigma[i], '14.6g')} {fmt_num(r.current_density[i], '11.4g')} "
+                  f"{fmt_num(r.M_A[i], '11.4g')} {fmt_num(r.theta[i], '9.4g')} {fmt_num(r.w[i] * 1e3, '9.4g')}")
         for n in r.notes:
             print(f"note: {n}")
     return 0
