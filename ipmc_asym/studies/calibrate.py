@@ -614,8 +614,8 @@ def _fit(data, bounds, names, p, n, lo, hi, x0, ladder, starts, model, material,
                      f"{rel:.2g}" + ("" if np.all(valid[rows]) else " (outside validity)"))
     if chosen is None:
         if fidelity is not None:
-            raise ValueError(f"fidelity {fidelity!r}: error estimate {worst:.2g} is not below a tenth of the data's "
-                             f"relative error {rel:.2g}; leave --fidelity unset to escalate")
+            why = notes[-1].split(": ", 1)[-1] if notes else "not accurate enough"
+            raise ValueError(f"fidelity {fidelity!r}: {why}; leave --fidelity unset to escalate")
         raise ValueError(f"no fidelity is accurate enough for data this precise ({'; '.join(notes)})")
     prob = _Problem(data, names, model, material, chosen)
     prob.bar = bar
@@ -728,7 +728,8 @@ def _outlier_warning(prob, x, chi2_red, pval, dof) -> str:
     rows = _row_of_residual(prob)
     worst = np.argsort(-np.abs(r))[:3]
     which = ", ".join(f"row {int(rows[i]) + 2} ({r[i]:+.1f} sigma)" for i in worst)
-    return (f"chi2_red = {chi2_red:.3g} with the given sigma (p = {pval:.1g}, {dof} degrees of freedom): outliers "
+    pv = f"= {pval:.1g}" if pval > 0 else "< 1e-300"
+    return (f"chi2_red = {chi2_red:.3g} with the given sigma (p {pv}, {dof} degrees of freedom): outliers "
             f"or underestimated sigma; largest standardised residuals: {which}; the intervals assume the model "
             f"and the sigma are right")
 
