@@ -629,3 +629,14 @@ def test_first_compile_is_announced(monkeypatch, tmp_path, capsys):
     assert "compiling" in capsys.readouterr().err
     src = {c: Path(ROOT, "ipmc_asym", "cli", f"{c}.py").read_text() for c in ("sweep", "uq")}
     assert all("first_run_notice()" in s for s in src.values())
+
+
+def test_scene_and_uq_toml_with_a_bom_accepted(tmp_path, capsys):
+    scene = tmp_path / "bom.toml"
+    text = Path(UQ_SCENE).read_text(encoding="utf-8")
+    scene.write_bytes(("\ufeff" + text).encode("utf-8"))
+    assert main(["uq", str(scene), "--samples", "100", "--fidelity", "leading", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["n_samples"] >= 100
+    plain = tmp_path / "nominal.toml"
+    plain.write_bytes(("\ufeff" + Path(ROOT, "examples", "nominal.toml").read_text(encoding="utf-8")).encode("utf-8"))
+    assert main(["scene", str(plain), "--json"]) == 0
