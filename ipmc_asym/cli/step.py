@@ -31,6 +31,9 @@ COLUMNS = ("t", "phi0", "sigma", "current_density", "M_A", "theta", "w")
 #: output times of one run: the arrays of the integrator (~2 substeps per interval) and of the
 #: forward model stay ~100 MB; settable with --max-points
 MAX_POINTS = 10**5
+#: the same with --fidelity pnp, whose solver keeps the profiles of every output time (~10 kB each:
+#: 1e5 points reach 1 GB); applies where --max-points is left at its default
+MAX_POINTS_PNP = 10**4
 
 
 def sidecar_path(out: str) -> str:
@@ -55,7 +58,8 @@ def register(sub):
     p.add_argument("--model", default="constant", choices=list(model_names()), help=model_help("constant"))
     p.add_argument("--diffusion", type=diffusion_type(), default=None,
                    help="cation diffusion coefficient D (1e-10m2/s, 1e-6cm2/s; a bare number is m^2/s)")
-    add_size_option(p, "--points", default=1000, maximum=MAX_POINTS, minimum=2, help="output times")
+    add_size_option(p, "--points", default=1000, maximum=MAX_POINTS, minimum=2,
+                    help=f"output times (with --fidelity pnp at most {MAX_POINTS_PNP:.0e} unless --max-points is given)")
     p.add_argument("--out", default=None, metavar="F.csv",
                    help="CSV file (header row t, phi0, sigma, current_density, M_A, theta, w; SI), with the "
                         "metadata (tau, total thickness, model, units) in the sidecar F.csv.json")
@@ -63,6 +67,9 @@ def register(sub):
 
 
 def run(args):
+    if args.fidelity == "pnp" and args.max_points == MAX_POINTS and args.points > MAX_POINTS_PNP:
+        raise ValueError(f"--points {args.points:g} with --fidelity pnp is above {MAX_POINTS_PNP:g} (the pnp solver keeps "
+                         f"every output time's profiles: ~10 kB each); lower --points or set --max-points")
     if args.out:
         check_output_path(args.out, "file", formats=(".csv",))
         check_output_path(sidecar_path(args.out), "file")

@@ -640,3 +640,11 @@ def test_scene_and_uq_toml_with_a_bom_accepted(tmp_path, capsys):
     plain = tmp_path / "nominal.toml"
     plain.write_bytes(("\ufeff" + Path(ROOT, "examples", "nominal.toml").read_text(encoding="utf-8")).encode("utf-8"))
     assert main(["scene", str(plain), "--json"]) == 0
+
+
+def test_step_pnp_has_its_own_default_cap(capsys):
+    """The pnp solver keeps every output time's profiles: its default cap is lower (1e4)."""
+    assert main(["step", "--fidelity", "pnp", "--points", "2e4"]) == 2
+    err = capsys.readouterr().err
+    _one_line_error(err)
+    assert "pnp" in err and "--max-points" in err
