@@ -185,13 +185,20 @@ def join_negative_values(argv):
 
 
 def fmt_num(x, spec="g"):
-    """``format(x, spec)`` with ``-0`` printed as ``0`` and ``None`` as ``n/a``."""
+    """``format(x, spec)`` with a zero never signed (``-0``, ``-0.000`` of a tiny negative) and
+    ``None`` as ``n/a``."""
     if x is None:
         return "n/a"
     x = float(x)
     if x == 0.0:
         x = 0.0  # drops the sign of -0.0
-    return format(x, spec)
+    text = format(x, spec)
+    mant = text.split("e")[0].split("E")[0]
+    if "-" in mant and not any(c in "123456789" for c in mant):
+        # rounds to zero: no sign (the spec's width kept)
+        width = re.match(r"[<>=^]?[-+ ]?#?0?(\d*)", spec).group(1)
+        text = text.replace("-", "", 1).rjust(int(width) if width else 0)
+    return text
 
 
 def c_moy_label(material) -> str:

@@ -6,7 +6,7 @@ import sys
 
 from ipmc_asym.base.registry import compiled_fidelities
 from ipmc_asym.cli import SUMMARIES
-from ipmc_asym.cli.common import add_size_option, first_run_notice, seed_type
+from ipmc_asym.cli.common import add_size_option, first_run_notice, fmt_num, seed_type
 from ipmc_asym.io.datasets import uq_dataset, write_netcdf
 from ipmc_asym.io.fileio import FIGURE_FORMATS, check_output_path
 from ipmc_asym.io.jsonio import dumps
@@ -77,7 +77,8 @@ def run(args) -> int:
         if sob is None:
             print(f"  {o}: constant output, no indices")
             continue
-        print(f"  {o}: " + "; ".join(f"{k} S1={v['S1']:.3f}±{v['S1_conf']:.1g} ST={v['ST']:.3f}±{v['ST_conf']:.1g}"
+        print(f"  {o}: " + "; ".join(f"{k} S1={fmt_num(v['S1'], '.3f')}±{fmt_num(v['S1_conf'], '.1g')} "
+                                      f"ST={fmt_num(v['ST'], '.3f')}±{fmt_num(v['ST_conf'], '.1g')}"
                                       for k, v in sob.items()))
     if args.plot:
         print(f"figure: {args.plot}")

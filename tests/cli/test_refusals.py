@@ -648,3 +648,12 @@ def test_step_pnp_has_its_own_default_cap(capsys):
     err = capsys.readouterr().err
     _one_line_error(err)
     assert "pnp" in err and "--max-points" in err
+
+
+def test_no_signed_zero_in_printed_numbers():
+    """A value that rounds to zero prints unsigned (uq's Sobol' S1 = -0.000 of a -4e-8 estimate)."""
+    from ipmc_asym.cli.common import fmt_num
+
+    assert fmt_num(-4e-8, ".3f") == "0.000" and fmt_num(-1e-9, "9.3f") == "    0.000"
+    assert fmt_num(-0.0, "11.4g").strip() == "0" and fmt_num(-0.5, ".3f") == "-0.500"
+    assert fmt_num(-1e-20, ".3g") == "-1e-20"  # a small number is not zero
