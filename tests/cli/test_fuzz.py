@@ -203,7 +203,7 @@ def _write(tmp_path, name, text):
 def test_every_command_is_covered():
     """The fuzz covers every command ``ipmc-asym --help`` lists."""
     listed = set(COMMANDS) | set(plugin_commands())
-    covered = set(CHEAP) | {"fit", "uq", "scene", "profiles", "figures", "validate", "derive", "bench"}
+    covered = set(CHEAP) | set(WRITERS) | {"fit", "uq", "scene"}
     assert listed <= covered, listed - covered
     assert len(listed) >= 14
 
@@ -266,6 +266,46 @@ def test_writers_and_long_commands_refuse_in_one_line(argv, tmp_path, monkeypatc
     check_outcome(argv, rc, out, err)
     assert rc == (0 if "--help" in argv else 2)
     assert os.listdir(tmp_path) == []
+
+
+#: the writers and long commands with random options and a target that cannot be written: a
+#: one-line refusal (or a --help), never the work itself
+BAD_DIRS = ["/nonexistent/a/b", "/proc/x/y", "a\0b"]
+BAD_FILES = BAD_DIRS + ["out.xlsx", "/nonexistent/x.png", "/proc/r.md"]
+WRITERS = {
+    "profiles": ({**STRIP, "--voltage": VOLTS, "--model": MODELS, "--json": None}, "--out"),
+    "figures": ({"--dpi": COUNTS, "--quick": None, "--bench": ["/nonexistent.json"]}, "--out"),
+    "validate": ({"--json": None}, "--out"),
+    "bench": ({"--points": COUNTS, "--bvp-points": COUNTS, "--layout": ["grid", "random", "spiral"],
+               "--no-compile": None, "--quick": None}, "--figure"),
+    "derive": ({"--print": ["--check"], "--nope": None}, None),
+}
+
+
+@st.composite
+def writer_argv(draw):
+    cmd = draw(st.sampled_from(sorted(WRITERS)))
+    table, out = WRITERS[cmd]
+    argv = [cmd] + draw(options(table, max_size=3))
+    if out is not None:
+        argv += [out, draw(st.sampled_from(BAD_DIRS if cmd in ("profiles", "figures") else BAD_FILES))]
+    elif "--nope" not in argv:
+        argv += ["--nope"]
+    return argv
+
+
+@FAST
+@given(argv=writer_argv())
+def test_fuzz_writers_refuse_before_the_work(argv, tmp_path_factory):
+    d = tmp_path_factory.mktemp("w")
+    cwd = os.getcwd()
+    os.chdir(d)
+    try:
+        rc, out, err = run_cli(argv)
+    finally:
+        os.chdir(cwd)
+    check_outcome(argv, rc, out, err)
+    assert rc == 2 and os.listdir(d) == [], (argv, err)
 
 
 #: a few real runs in a child process: exit status, output and the child's peak memory
