@@ -156,4 +156,9 @@ def __getattr__(name):
 
 
 def __dir__():
-    return sorted(list(globals()) + __all__)
+    # the public names and the package's own attributes; not the modules this file imports
+    # for its machinery (importlib, sys, types, annotations of ``from __future__``)
+    hidden = {"annotations", "importlib", "sys", "types"}
+    own = {k for k in globals() if k not in hidden and not (k.startswith("_") and not k.startswith("__"))}
+    own -= {k for k, v in globals().items() if isinstance(v, type) and k.startswith("_")}
+    return sorted(own | set(__all__) | set(_LAZY))

@@ -10,7 +10,7 @@ speed/accuracy plot from when it is given no ``--bench FILE``.
 from __future__ import annotations
 
 from ipmc_asym.cli.common import count_type
-from ipmc_asym.io.fileio import check_output_path
+from ipmc_asym.io.fileio import FIGURE_FORMATS, check_output_path
 from ipmc_asym.io.jsonio import dumps
 
 __all__ = ["SUMMARY", "register", "run", "speed_accuracy_data"]
@@ -31,8 +31,8 @@ def register(sub):
     p.add_argument("--section", action="append", default=None, metavar="NAME",
                    help="run only these further sections (repeatable; default all registered)")
     p.add_argument("--quick", action="store_true", help="smaller samples in the further sections")
-    p.add_argument("--figure", default="figures/speed_accuracy.png",
-                   help="where to draw the speed/accuracy plot ('' for none)")
+    p.add_argument("--figure", default=None, metavar="F.png",
+                   help="draw the speed/accuracy plot to this file (.png, .pdf, .svg; default: no figure)")
 
 
 def run(args) -> int:
@@ -42,7 +42,7 @@ def run(args) -> int:
     )
 
     if args.figure:
-        check_output_path(args.figure, "file", "--figure")
+        check_output_path(args.figure, "file", "--figure", formats=FIGURE_FORMATS)
     res = run_bench(args.points, args.bvp_points, compile_times=not args.no_compile, layout=args.layout,
                     sections=args.section, quick_sections=args.quick)
     if args.figure:

@@ -18,7 +18,7 @@ import sys
 from importlib.metadata import entry_points
 
 from ipmc_asym import __version__
-from ipmc_asym.cli.common import Parser, UsageError, join_negative_values
+from ipmc_asym.cli.common import Parser, UsageError, check_size_caps, join_negative_values
 
 __all__ = ["main", "build_parser", "COMMANDS", "UsageError", "PLUGIN_GROUP", "plugin_commands", "load_plugin"]
 
@@ -127,6 +127,7 @@ def main(argv=None) -> int:
         ap, handlers = build_parser(only if known else None, plugins)
         args = ap.parse_args(argv)
         command = args.command
+        check_size_caps(args)  # every size-like option against its cap, before any work
         rc = handlers[args.command](args)
     except (ValueError, UsageError, OverflowError, ArithmeticError) as exc:
         msg = str(exc).splitlines()[0] if str(exc) else exc.__class__.__name__

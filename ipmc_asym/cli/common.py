@@ -21,7 +21,8 @@ __all__ = ["UsageError", "Parser", "add_strip_options", "add_material_options", 
            "scene_with_material",
            "material_from_args", "strip_from_args",
            "arg_type", "count_type", "join_negative_values", "fmt_num", "c_moy_label", "length_type", "pressure_type",
-           "voltage_type", "tol_type", "first_run_notice", "diffusion_type"]
+           "voltage_type", "tol_type", "first_run_notice", "diffusion_type", "add_size_option", "check_size_caps",
+           "seed_type", "model_help"]
 
 
 class UsageError(Exception):
@@ -133,6 +134,60 @@ def count_type(name, minimum=1):
     return arg_type(conv, name)
 
 
+def add_size_option(p, flag, *, default, maximum, minimum=1, help="", cap_flag=None, metavar=None):
+    """A size-like option ``flag`` with its documented cap ``--max-<name>`` (settable, like sweep's ``--max-rows``).
+
+    The cap is checked by :func:`check_size_caps` before any work (``main`` calls it), so a
+    size that would exhaust memory or time is refused in one line, exit 2.
+    """
+    cap_flag = cap_flag or "--max-" + flag.lstrip("-")
+    kw = {"metavar": metavar} if metavar else {}
+    p.add_argument(flag, type=count_type(flag, minimum), default=default,
+                   help=f"{help} (default {default:g}; at most {cap_flag}, default {maximum:g})".replace("%", "%%"), **kw)
+    p.add_argument(cap_flag, type=count_type(cap_flag), default=maximum,
+                   help=f"refuse {flag} above this (default {maximum:g}: memory and time stay bounded)")
+    caps = p.get_default("_size_caps") or ()
+    p.set_defaults(_size_caps=tuple(caps) + ((flag, cap_flag),))
+
+
+def _dest(flag):
+    return flag.lstrip("-").replace("-", "_")
+
+
+def check_size_caps(args):
+    """Refuse (ValueError, one line) every size option of ``args`` above its cap."""
+    for flag, cap in getattr(args, "_size_caps", ()) or ():
+        v, m = getattr(args, _dest(flag), None), getattr(args, _dest(cap), None)
+        if v is not None and m is not None and v > m:
+            raise ValueError(f"{flag} {v:.6g} is above {cap} {m:.6g} (the cap bounding memory and time); "
+                             f"lower {flag} or raise {cap}")
+
+
+def _seed(text):
+    t = str(text).strip().replace("_", "")
+    try:
+        v = int(t)
+    except ValueError:
+        try:
+            f = float(t)
+            v = int(f) if f.is_integer() else None
+        except (ValueError, OverflowError):
+            v = None
+    if v is None or not 0 <= v < 2**63:
+        raise ValueError(f"--seed must be an integer in [0, 2^63), e.g. 0 or 42; got {text!r}")
+    return v
+
+
+#: ``--seed``: a non-negative integer (checked at parsing, before any work)
+seed_type = arg_type(_seed, "seed")
+
+
+def model_help(default, *, all_allowed=False):
+    """Help text of ``--model`` stating its default (the default differs by command)."""
+    choices = "constant, linear, affine" + (" or all" if all_allowed else "")
+    return f"permittivity model: {choices} (default {default})"
+
+
 _NEGATIVE = re.compile(r"^-(\d|\.\d)")
 
 
@@ -160,13 +215,20 @@ def join_negative_values(argv):
 
 
 def fmt_num(x, spec="g"):
-    """``format(x, spec)`` with ``-0`` printed as ``0`` and ``None`` as ``n/a``."""
+    """``format(x, spec)`` with a zero never signed (``-0``, ``-0.000`` of a tiny negative) and
+    ``None`` as ``n/a``."""
     if x is None:
         return "n/a"
     x = float(x)
     if x == 0.0:
         x = 0.0  # drops the sign of -0.0
-    return format(x, spec)
+    text = format(x, spec)
+    mant = text.split("e")[0].split("E")[0]
+    if "-" in mant and not any(c in "123456789" for c in mant):
+        # rounds to zero: no sign (the spec's width kept)
+        width = re.match(r"[<>=^]?[-+ ]?#?0?(\d*)", spec).group(1)
+        text = text.replace("-", "", 1).rjust(int(width) if width else 0)
+    return text
 
 
 def c_moy_label(material) -> str:
@@ -291,3 +353,4 @@ def first_run_notice():
 
     if not (os.path.isdir(CACHE_DIR) and any(f.endswith(".nbi") for _, _, fs in os.walk(CACHE_DIR) for f in fs)):
         sys.stderr.write("ipmc-asym: compiling the Numba kernels (first run after install, ~10-30 s)...\n")
+        sys.stderr.flush()

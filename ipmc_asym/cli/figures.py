@@ -5,15 +5,21 @@ from __future__ import annotations
 import sys
 
 from ipmc_asym.cli import SUMMARIES, load_plugin
-from ipmc_asym.cli.common import count_type, new_dir_removed_on_failure
-from ipmc_asym.io.fileio import check_output_path
+from ipmc_asym.cli.common import add_size_option, new_dir_removed_on_failure
+from ipmc_asym.io.fileio import check_output_path, make_output_dir
 from ipmc_asym.plotting.speed import load_bench
+
+#: resolution of the figures: 600 dpi is print quality; the pixel count (and time) grows as dpi^2;
+#: settable with --max-dpi
+MAX_DPI = 600
 
 
 def register(sub):
     p = sub.add_parser("figures", help=SUMMARIES["figures"])
-    p.add_argument("--out", default="figures", help="output directory (default figures/)")
-    p.add_argument("--dpi", type=count_type("--dpi", 10), default=110, help="resolution (>= 10, default 110)")
+    p.add_argument("--out", default="figures",
+                   help="output directory (default figures/, relative to the working directory; only its last "
+                        "level is created)")
+    add_size_option(p, "--dpi", default=110, maximum=MAX_DPI, minimum=10, help="resolution in dots per inch (>= 10)")
     p.add_argument("--quick", action="store_true", help="fewer points (for tests)")
     p.add_argument("--bench", default=None, metavar="FILE",
                    help="draw the speed/accuracy plot from a saved `ipmc-asym bench --json` "
@@ -30,6 +36,7 @@ def run(args) -> int:
     from ipmc_asym.plotting.figures import make_all  # deferred: matplotlib (start-up)
 
     with new_dir_removed_on_failure(args.out):
+        make_output_dir(args.out)
         out = make_all(args.out, args.dpi, quick=args.quick, bench=bench,
                        log=lambda msg: print(f"figures: {msg}", file=sys.stderr, flush=True))
     for f in out["files"]:

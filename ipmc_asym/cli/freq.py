@@ -5,14 +5,16 @@ from __future__ import annotations
 import numpy as np
 
 from ipmc_asym.base.registry import model_names
-from ipmc_asym.base.units import parse_quantity, parse_sheet_resistance
+from ipmc_asym.base.units import fmt_length, parse_quantity, parse_sheet_resistance
 from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import (
+    add_size_option,
     add_strip_options,
     arg_type,
-    count_type,
     diffusion_type,
+    fmt_num,
     material_from_args,
+    model_help,
     strip_from_args,
     voltage_type,
 )
@@ -22,6 +24,10 @@ from ipmc_asym.dynamics.line import line_response
 from ipmc_asym.dynamics.reduction import transfer_function
 from ipmc_asym.io.fileio import atomic_write, check_output_path
 from ipmc_asym.io.jsonio import dumps
+
+#: frequencies of one run (log-spaced: 1e5 points resolve any spectrum; the --json text stays ~10 MB);
+#: settable with --max-points
+MAX_POINTS = 10**5
 
 
 def _freq(name):
@@ -49,8 +55,8 @@ def register(sub):
     add_strip_options(p, voltage=False, mechanics=False)
     p.add_argument("--from", dest="f1", type=_freq("--from"), required=True, help="first frequency (e.g. 0.01Hz)")
     p.add_argument("--to", dest="f2", type=_freq("--to"), required=True, help="last frequency (e.g. 1kHz)")
-    p.add_argument("--points", type=count_type("--points", 2), default=50, help="log-spaced points (default 50)")
-    p.add_argument("--model", default="constant", choices=list(model_names()), help="permittivity model")
+    add_size_option(p, "--points", default=50, maximum=MAX_POINTS, minimum=2, help="log-spaced points")
+    p.add_argument("--model", default="constant", choices=list(model_names()), help=model_help("constant"))
     p.add_argument("--method", default="pnp-linear", choices=FREQ_METHODS,
                    help="pnp-linear (exact linearised PNP, closed form) or circuit (R + 1/(i w C_d))")
     p.add_argument("--diffusion", type=diffusion_type(), default=None,
@@ -149,7 +155,7 @@ def run(args):
         return 0
     line = "" if args.sheet_resistance is None else f", electrode sheet resistance {args.sheet_resistance:g} Ohm/sq"
     print(f"small signal about {args.voltage:g} V, model {r.model}, method {r.method}, beam {args.beam}, total "
-          f"thickness 2e = {strip.thickness * 1e6:.4g} um{line}: tau = {r.tau:.4g} s, D = {material.D:.3g} m^2/s")
+          f"thickness 2e = {fmt_length(strip.thickness)}{line}: tau = {r.tau:.4g} s, D = {material.D:.3g} m^2/s")
     if head["resonances"]:
         print(f"resonances: free tip {', '.join(f'{v:.4g}' for v in head['resonances']['clamped-free'])} Hz; "
               f"blocked tip {', '.join(f'{v:.4g}' for v in head['resonances']['clamped-pinned'])} Hz")
@@ -157,8 +163,9 @@ def run(args):
     print(f"{'f [Hz]':>11s} {'Z_re [Ohm]':>12s} {'Z_im [Ohm]':>12s} {'|w|/V [mm/V]':>13s} {'phase [rad]':>11s}"
           + (f" {'error':>9s}" if ecol else ""))
     for i in range(f.size):
-        print(f"{f[i]:11.4g} {cols['Z_re'][i]:12.5g} {cols['Z_im'][i]:12.5g} {cols['w_amp'][i] * 1e3:13.5g} "
-              f"{cols['w_phase'][i]:11.4g}" + (f" {cols['error'][i]:9.2g}" if ecol else ""))
+        print(f"{fmt_num(f[i], '11.4g')} {fmt_num(cols['Z_re'][i], '12.5g')} {fmt_num(cols['Z_im'][i], '12.5g')} "
+              f"{fmt_num(cols['w_amp'][i] * 1e3, '13.5g')} {fmt_num(cols['w_phase'][i], '11.4g')}"
+              + (f" {fmt_num(cols['error'][i], '9.2g')}" if ecol else ""))
     for n in head["notes"]:
         print(f"note: {n}")
     if args.export is not None:

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from ipmc_asym.base.registry import model_choices, model_names
 from ipmc_asym.cli import SUMMARIES
-from ipmc_asym.cli.common import add_strip_options, material_from_args, new_dir_removed_on_failure, strip_from_args
-from ipmc_asym.io.fileio import check_output_path
+from ipmc_asym.cli.common import add_strip_options, fmt_num, material_from_args, new_dir_removed_on_failure, strip_from_args
+from ipmc_asym.io.fileio import check_output_path, make_output_dir
 from ipmc_asym.io.jsonio import dumps
 from ipmc_asym.studies.profiles import PAPER_LAYERS
 
@@ -14,7 +14,9 @@ def register(sub):
     p = sub.add_parser("profiles", help=SUMMARIES["profiles"])
     add_strip_options(p, mechanics=False)
     p.add_argument("--model", default="all", choices=model_choices(), help="permittivity model (default all)")
-    p.add_argument("--out", default="figures", help="output directory for CSV and PNG (default figures/)")
+    p.add_argument("--out", default="figures",
+                   help="output directory for CSV and PNG (default figures/, relative to the working directory; "
+                        "only its last level is created)")
     p.add_argument("--json", action="store_true", help="print the layer summary as JSON")
 
 
@@ -28,6 +30,7 @@ def run(args) -> int:
 
     models = model_names() if args.model == "all" else (args.model,)
     with new_dir_removed_on_failure(args.out):
+        make_output_dir(args.out)
         out = write_all(args.out, models, strip, mat)
     if args.json:
         print(dumps(out, indent=2))
@@ -41,7 +44,7 @@ def run(args) -> int:
         pa = PAPER_LAYERS.get((s["model"], "accumulation"))
         print(f"{s['model']:9s} {s['devoid_um']:8.4g} {s['depletion_um']:10.4g} {s['accumulation_um']:10.4g} "
               f"{s['accumulation_half_um']:10.4g} {s['B1']:9.4g} {s['debye_um']:8.3g} "
-              f"{(pd if pd is not None else float('nan')):9.3g} {(pa if pa is not None else float('nan')):9.3g}")
+              f"{fmt_num(pd, '9.3g') if pd is not None else '-':>9s} {fmt_num(pa, '9.3g') if pa is not None else '-':>9s}")
     for f in out["files"]:
         print("wrote", f)
     return 0

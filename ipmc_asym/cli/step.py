@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import csv
+import json
+import os
 import sys
 
 import numpy as np
@@ -11,13 +13,14 @@ from ipmc_asym.base.registry import model_names
 from ipmc_asym.base.units import fmt_length, parse_time
 from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import (
+    add_size_option,
     add_strip_options,
     arg_type,
-    count_type,
     diffusion_type,
     first_run_notice,
     fmt_num,
     material_from_args,
+    model_help,
     strip_from_args,
 )
 from ipmc_asym.cli.drive import add_beam_options
@@ -30,6 +33,17 @@ from ipmc_asym.io.jsonio import dumps
 COLUMNS = ("t", "phi0", "sigma", "current_density", "M_A", "theta", "w")
 #: per time point: the forward model's checks (forward.model.CHECKS), as in estimate and sweep
 CHECK_COLUMNS = tuple(f"check_{c}" for c in CHECKS) + ("valid",)
+#: output times of one run: the arrays of the integrator (~2 substeps per interval) and of the
+#: forward model stay ~100 MB; settable with --max-points
+MAX_POINTS = 10**5
+#: the same with --fidelity pnp, whose solver keeps the profiles of every output time (~10 kB each:
+#: 1e5 points reach 1 GB); applies where --max-points is left at its default
+MAX_POINTS_PNP = 10**4
+
+
+def sidecar_path(out: str) -> str:
+    """The metadata file beside a step CSV: ``x.csv`` -> ``x.csv.json`` (tau, thickness, model, units)."""
+    return out + ".json"
 
 
 def _duration(text):
@@ -52,22 +66,29 @@ def register(sub):
     p.add_argument("--fidelity", default="circuit", choices=STEP_FIDELITIES,
                    help="circuit (reduced nonlinear capacitor) or pnp (transient Nernst-Planck/Gauss)")
     p.add_argument("--model", default="constant", choices=list(model_names()) + ["all"],
-                   help="permittivity model (all: each in turn)")
+                   help=model_help("constant") + "; all: each in turn")
     p.add_argument("--diffusion", type=diffusion_type(), default=None,
                    help="cation diffusion coefficient D (1e-10m2/s, 1e-6cm2/s; a bare number is m^2/s)")
-    p.add_argument("--points", type=count_type("--points", 2), default=1000, help="output times (default 1000)")
+    add_size_option(p, "--points", default=1000, maximum=MAX_POINTS, minimum=2,
+                    help=f"output times (with --fidelity pnp at most {MAX_POINTS_PNP:.0e} unless --max-points is given)")
     p.add_argument("--waveform", type=arg_type(parse_waveform, "--waveform"), default=None,
                    help="instead of the step of --voltage: a SPEC such as 'sine:1V@10Hz' or 'step:1V+square:0.1V@5Hz' "
                         "(see ipmc-asym drive --help)")
     add_beam_options(p, "quasi-static")
-    p.add_argument("--out", default=None, help="CSV file (columns t, phi0, sigma, current_density, M_A, theta, w, "
-                                               "check_* and valid per time point; a first column model with --model all)")
+    p.add_argument("--out", default=None, metavar="F.csv",
+                   help="CSV file (header row t, phi0, sigma, current_density, M_A, theta, w, check_* and valid per "
+                        "time point; SI; a first column model with --model all), with the metadata (tau, total "
+                        "thickness, model, units) in the sidecar F.csv.json")
     p.add_argument("--json", action="store_true", help="print one JSON object")
 
 
 def run(args):
+    if args.fidelity == "pnp" and args.max_points == MAX_POINTS and args.points > MAX_POINTS_PNP:
+        raise ValueError(f"--points {args.points:g} with --fidelity pnp is above {MAX_POINTS_PNP:g} (the pnp solver keeps "
+                         f"every output time's profiles: ~10 kB each); lower --points or set --max-points")
     if args.out:
-        check_output_path(args.out, "file")
+        check_output_path(args.out, "file", formats=(".csv",))
+        check_output_path(sidecar_path(args.out), "file")
     material = material_from_args(args)
     if args.diffusion is not None:
         material = material.with_(D=args.diffusion)
@@ -94,18 +115,25 @@ def run(args):
     drive = "step" if args.waveform is None else args.waveform.spec
     if args.out:
         many = len(models) > 1
+        # the CSV has one header row (pandas.read_csv reads it as is); the metadata goes to a
+        # sidecar JSON file beside it
+        meta = {"csv": os.path.basename(args.out), "tau": {m: results[m].tau for m in models} if many else r0.tau,
+                "thickness_total": strip.thickness, "half_thickness_e": strip.e, "voltage": strip.voltage,
+                "model": args.model, "fidelity": r0.fidelity, "drive": drive, "beam": args.beam, "notes": r0.notes,
+                "units": {"t": "s", "phi0": "V", "sigma": "C/m^2", "current_density": "A/m^2", "M_A": "N m",
+                          "theta": "rad", "w": "m"}}
         with atomic_write(args.out) as fh:
             wr = csv.writer(fh)
-            taus = ", ".join(f"{m}: {results[m].tau!r}" for m in models)
-            wr.writerow([f"# tau = {taus} s; thickness_total = {strip.thickness!r} m; model = {args.model}; "
-                         f"fidelity = {r0.fidelity}; drive = {drive}; beam = {args.beam}; SI units; {r0.notes[0]}"])
             wr.writerow((("model",) if many else ()) + COLUMNS + CHECK_COLUMNS)
             for mname in models:
                 cols, flags = cols_of(results[mname]), flags_of(results[mname])
                 for i in range(results[mname].t.size):
-                    wr.writerow(([mname] if many else []) + [repr(float(cols[c][i])) for c in COLUMNS]
+                    wr.writerow(([mname] if many else []) + [repr(float(cols[c][i]) + 0.0) for c in COLUMNS]
                                 + [str(bool(flags[c][i])) for c in CHECK_COLUMNS])
-        sys.stderr.write(f"step: {sum(r.t.size for r in results.values())} rows -> {args.out}\n")
+        with atomic_write(sidecar_path(args.out)) as fh:
+            fh.write(json.dumps(meta, indent=1) + "\n")
+        sys.stderr.write(f"step: {sum(r.t.size for r in results.values())} rows -> {args.out} "
+                         f"(metadata: {sidecar_path(args.out)})\n")
 
     def head_of(r):
         return {"tau": r.tau, "R": r.R, "C_d0": r.C_d0, "model": r.model, "fidelity": r.fidelity,
@@ -138,8 +166,9 @@ def run(args):
             print(f"{'t [s]':>11s} {'sigma [C/m^2]':>14s} {'J [A/m^2]':>11s} {'M_A [N m]':>11s} {'theta':>9s} "
                   f"{'w [mm]':>9s} valid")
             for i in idx:
-                print(f"{r.t[i]:11.4g} {r.sigma[i]:14.6g} {r.current_density[i]:11.4g} {r.M_A[i]:11.4g} "
-                      f"{_num(r.theta[i], 1.0):>9s} {_num(r.w[i], 1e3):>9s} {'yes' if r.valid[i] else 'no'}")
+                print(f"{fmt_num(r.t[i], '11.4g')} {fmt_num(r.sigma[i], '14.6g')} {fmt_num(r.current_density[i], '11.4g')} "
+                      f"{fmt_num(r.M_A[i], '11.4g')} {_num(r.theta[i], 1.0):>9s} {_num(r.w[i], 1e3):>9s} "
+                      f"{'yes' if r.valid[i] else 'no'}")
         for n in r0.notes:
             print(f"note: {n}")
     return 0

@@ -18,8 +18,10 @@ from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import (
     add_strip_options,
     count_type,
+    first_run_notice,
     material_comments,
     material_from_args,
+    model_help,
     strip_from_args,
     tol_type,
 )
@@ -32,6 +34,8 @@ from ipmc_asym.studies.fits import sweep_fits
 from ipmc_asym.studies.sweep_chunks import sweep_chunked
 from ipmc_asym.studies.sweeps import iter_sweep, prefetched, sweep, warm_writer, withhold, write_csv, write_json
 
+#: extensions of --out (the format follows the extension)
+OUT_FORMATS = (".csv", ".json", ".nc")
 #: points per axis used for the fits (a subsample of a longer axis fits the same law)
 FIT_POINTS = 2000
 
@@ -43,7 +47,7 @@ def register(sub):
                         "(e.g. length=1cm:4cm:16, thickness=10um:1mm:20:log); repeat for a grid")
     add_strip_options(p)
     p.add_argument("--model", default="constant", choices=model_choices(),
-                   help="permittivity model: constant, linear, affine or all (default constant)")
+                   help=model_help("constant", all_allowed=True))
     p.add_argument("--fidelity", default="quadrature", choices=fidelity_names(),
                    help="cheapest rung tried per point (default quadrature); escalated where not valid "
                         "(fidelity_used / escalated columns)")
@@ -55,8 +59,9 @@ def register(sub):
     p.add_argument("--max-rows", type=count_type("--max-rows"), default=MAX_ROWS,
                    help=f"refuse a sweep of more rows than this (default {MAX_ROWS:.0e}, settings.MAX_ROWS)")
     p.add_argument("--out", default=None,
-                   help="output file, written in chunks and atomically: .json for JSON, .nc for a labelled "
-                        "NetCDF dataset (xarray; held in memory), CSV otherwise (SI columns; default: stdout)")
+                   help="output file, written in chunks and atomically; the format follows the extension: .csv "
+                        "(SI columns), .json, or .nc for a labelled NetCDF dataset (xarray; held in memory); "
+                        "default: CSV on stdout")
     p.add_argument("--scheduler", default=None, metavar="local|tcp://HOST:PORT",
                    help="run the sweep's chunks on dask.distributed (results identical to the serial run; "
                         "held in memory)")
@@ -124,9 +129,10 @@ def run(args) -> int:
                          "narrow it or raise --max-rows")
     vary = {k: vary_values(*sp[1:]) for k, sp in specs.items()}
     if args.out:
-        check_output_path(args.out, "file")
+        check_output_path(args.out, "file", formats=OUT_FORMATS)
     if args.scheduler is not None:
         check_scheduler(args.scheduler)
+    first_run_notice()
 
     base = strip_from_args(args)
     mat = material_from_args(args)

@@ -6,28 +6,45 @@ import sys
 
 from ipmc_asym.base.registry import compiled_fidelities
 from ipmc_asym.cli import SUMMARIES
-from ipmc_asym.cli.common import add_material_options, count_type, print_citations, scene_with_material
+from ipmc_asym.cli.common import (
+    add_material_options,
+    add_size_option,
+    first_run_notice,
+    fmt_num,
+    print_citations,
+    scene_with_material,
+    seed_type,
+)
 from ipmc_asym.io.datasets import uq_dataset, write_netcdf
-from ipmc_asym.io.fileio import check_output_path
+from ipmc_asym.io.fileio import FIGURE_FORMATS, check_output_path
 from ipmc_asym.io.jsonio import dumps
 from ipmc_asym.parallel.executors import check_scheduler
-from ipmc_asym.studies.uq import run_uq
+from ipmc_asym.studies.uq import SOBOL_BATCHES, run_uq
+
+#: model runs of one uq: inputs, outputs and the Saltelli design stay in memory for the exact
+#: quantiles (~200 B per run); settable with --max-samples
+MAX_SAMPLES = 10**6
+#: fewer runs give no usable 2.5 %/97.5 % quantile (a handful of samples beyond each) nor a
+#: Sobol' index with a batch-means interval
+MIN_SAMPLES = 100
 
 
 def register(sub):
     p = sub.add_parser("uq", help=SUMMARIES["uq"],
                        description="Sample a scene's [uncertain] table (normal, lognormal, uniform, triangular), "
-                                   "report quantiles 2.5/50/97.5 %%, mean, sd and Sobol' first/total indices.")
+                                   "report quantiles 2.5/50/97.5 %, mean, sd and Sobol' first/total indices.")
     p.add_argument("scene", metavar="SCENE.toml", help="scene with an [uncertain] table (examples/uq_nominal.toml)")
-    p.add_argument("--samples", type=count_type("--samples"), default=10**5,
-                   help="model runs wanted (rounded up to N(D+2), N a power of two; default 1e5)")
+    add_size_option(p, "--samples", default=10**5, maximum=MAX_SAMPLES, minimum=MIN_SAMPLES,
+                    help=f"model runs wanted (>= {MIN_SAMPLES}; rounded up to N(D+2), N a power of two)")
     p.add_argument("--fidelity", default=None, choices=list(compiled_fidelities()),
                    help="force a fidelity (default: per sample, cheapest meeting the scene's tolerance)")
-    p.add_argument("--seed", type=int, default=0, help="seed of the scrambled Sobol' sequence")
+    p.add_argument("--seed", type=seed_type, default=0,
+                   help="seed of the scrambled Sobol' sequence (integer >= 0, default 0; stored in the NetCDF)")
     p.add_argument("--scheduler", default=None, metavar="local|tcp://HOST:PORT",
                    help="run the chunks on dask.distributed (default: in this process)")
-    p.add_argument("--out", default=None, metavar="F.nc", help="NetCDF file of samples, outputs and indices")
-    p.add_argument("--plot", default=None, metavar="F.png", help="histograms of the outputs")
+    p.add_argument("--out", default=None, metavar="F.nc", help="NetCDF file (.nc) of samples, outputs and indices")
+    p.add_argument("--plot", default=None, metavar="F.png",
+                   help=f"histograms of the outputs ({', '.join(FIGURE_FORMATS)})")
     p.add_argument("--keep-invalid", action="store_true",
                    help="keep the samples outside a model assumption (past a quarter turn, above the strain limit, "
                         "beyond the validated voltage, not slender) in the statistics; by default they are counted "
@@ -38,13 +55,13 @@ def register(sub):
 
 
 def run(args) -> int:
-
-    for opt in ("out", "plot"):
-        if getattr(args, opt):
-            check_output_path(getattr(args, opt), "file", f"--{opt}")
+    if args.out:
+        check_output_path(args.out, "file", "--out", formats=(".nc",))
+    if args.plot:
+        check_output_path(args.plot, "file", "--plot", formats=FIGURE_FORMATS)
     if args.scheduler is not None:
-
         check_scheduler(args.scheduler)
+    first_run_notice()
     res = run_uq(scene_with_material(args.scene, args), args.samples, seed=args.seed, fidelity=args.fidelity,
                  scheduler=args.scheduler, keep_invalid=args.keep_invalid)
     if args.cite and res.material is not None:
@@ -56,9 +73,14 @@ def run(args) -> int:
         sys.stderr.write(f"uq: {res.n_outside} of {res.n_samples} samples outside a model assumption, {how}\n")
         for w in res.warnings:
             sys.stderr.write(f"uq: warning: {w}\n")
+    if res.base_n < 4 * SOBOL_BATCHES:
+        sys.stderr.write(f"uq: warning: N = {res.base_n} base points (< {4 * SOBOL_BATCHES}): the Sobol' indices "
+                         f"and their intervals are rough; use --samples {4 * SOBOL_BATCHES * (len(res.inputs) + 2)} "
+                         f"or more\n")
     if args.out:
-
-        eng = write_netcdf(uq_dataset(res), args.out)
+        ds = uq_dataset(res)
+        ds.attrs["seed"] = int(args.seed)  # the run is reproducible from the file alone
+        eng = write_netcdf(ds, args.out)
         sys.stderr.write(f"uq: {res.n_samples} samples -> {args.out} (NetCDF, engine {eng})\n")
     if args.plot:
         from ipmc_asym.plotting.uq import plot_uq  # deferred: matplotlib (start-up)
@@ -79,7 +101,8 @@ def run(args) -> int:
         if sob is None:
             print(f"  {o}: constant output, no indices")
             continue
-        print(f"  {o}: " + "; ".join(f"{k} S1={v['S1']:.3f}±{v['S1_conf']:.1g} ST={v['ST']:.3f}±{v['ST_conf']:.1g}"
+        print(f"  {o}: " + "; ".join(f"{k} S1={fmt_num(v['S1'], '.3f')}±{fmt_num(v['S1_conf'], '.1g')} "
+                                      f"ST={fmt_num(v['ST'], '.3f')}±{fmt_num(v['ST_conf'], '.1g')}"
                                       for k, v in sob.items()))
     if args.plot:
         print(f"figure: {args.plot}")

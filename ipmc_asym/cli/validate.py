@@ -12,13 +12,13 @@ def register(sub):
     """Add the ``validate`` subcommand."""
     p = sub.add_parser("validate", help=SUMMARIES["validate"])
     p.add_argument("--json", action="store_true", help='print {"claims": [...]}')
-    p.add_argument("--out", default=None, help="write a Markdown report to this file")
+    p.add_argument("--out", default=None, metavar="F.md", help="write a Markdown report to this file (.md)")
 
 
 def run(args) -> int:
     """Run ``ipmc-asym validate``."""
     if args.out:
-        check_output_path(args.out, "file")
+        check_output_path(args.out, "file", formats=(".md",))
     rows = claims()
     if args.out:
         with atomic_write(args.out) as fh:

@@ -187,7 +187,7 @@ def netcdf_engine() -> str:
 
 def write_netcdf(ds, path, engine: str | None = None) -> str:
     """Write ``ds`` to ``path`` atomically (temp file + rename); returns the engine used."""
-    p = check_output_path(path, what="--out")
+    p = check_output_path(path, what="--out", formats=(".nc",))
     eng = engine or netcdf_engine()
     with atomic_path(p) as tmp:
         ds.to_netcdf(tmp, engine=eng)

@@ -1,15 +1,33 @@
-"""Output files: paths checked before the work, files written atomically.
+"""Output files: the one set of rules every command follows.
 
-Every command that writes a file calls :func:`check_output_path` before computing and
-writes through :func:`atomic_write` (a temporary file in the same directory, renamed over
-the target on success, removed on any error or Ctrl-C), so no partial file is ever left.
+* **Format from the extension.**  :func:`check_output_path` with ``formats`` accepts only
+  the listed extensions (case-insensitive) and refuses any other in one line listing them:
+  a ``.csv`` name never receives NetCDF bytes, nor ``.xlsx`` CSV text.
+* **Checked before the work.**  Every command calls :func:`check_output_path` on each
+  output target before computing.  Writability is probed by creating (and removing) a file
+  in the target directory, because ``os.access`` says yes to root on ``/proc`` or a
+  read-only mount.  Messages name the path the user gave.
+* **Directories.**  An output directory may be missing only at its last level: it is
+  created (:func:`make_output_dir`); a missing parent is refused -- the same rule for every
+  command (no chain of directories created by a typo).
+* **Atomic.**  Files are written through :func:`atomic_write` / :func:`atomic_path` (a
+  temporary file in the same directory, renamed over the target on success, removed on any
+  error or Ctrl-C), so no partial file is ever left; an ``OSError`` names the target, not
+  the temporary file.
 """
 
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
 import tempfile
+
+__all__ = ["check_output_path", "atomic_write", "atomic_path", "make_output_dir", "output_format",
+           "FIGURE_FORMATS"]
+
+#: extensions of figure files (matplotlib writes each from the name)
+FIGURE_FORMATS = (".png", ".pdf", ".svg")
 
 
 def _umask_mode() -> int:
@@ -18,20 +36,49 @@ def _umask_mode() -> int:
     os.umask(mask)
     return 0o666 & ~mask
 
-__all__ = ["check_output_path", "atomic_write"]
+
+def output_format(path, formats, what: str = "--out") -> str:
+    """The extension of ``path`` (lower case, with the dot) if it is one of ``formats``.
+
+    Raises
+    ------
+    ValueError
+        One line naming ``what``, the path and the allowed extensions.
+    """
+    p = os.fspath(path)
+    ext = os.path.splitext(p)[1].lower()
+    allowed = tuple(f.lower() for f in formats)
+    if ext not in allowed:
+        got = f"extension {ext!r}" if ext else "no extension"
+        raise ValueError(f"{what} {p!r}: {got}; the format follows the extension, allowed: {', '.join(allowed)}")
+    return ext
 
 
-def check_output_path(path, kind: str = "file", what: str = "--out") -> str:
+def _probe_writable(d: str, p: str, what: str) -> None:
+    """Create and remove a file in directory ``d`` (the only reliable test, also for root)."""
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=".ipmc-asym-probe.", dir=d)
+    except OSError as exc:
+        raise ValueError(f"{what} {p!r}: cannot write in {d!r} ({exc.strerror or exc.__class__.__name__})") from None
+    os.close(fd)
+    with contextlib.suppress(OSError):
+        os.unlink(tmp)
+
+
+def check_output_path(path, kind: str = "file", what: str = "--out", formats=None) -> str:
     """Check that ``path`` can be written; one-line ``ValueError`` otherwise.
 
     Parameters
     ----------
     path : str or os.PathLike
     kind : {"file", "dir"}
-        A file whose directory must exist and be writable (and that is not a directory),
-        or a directory that exists writable or can be created (its parent writable).
+        A file whose directory must exist and be writable (and that is not a directory), or
+        a directory that exists writable, or whose parent exists writable (then only the last
+        level is created, by :func:`make_output_dir`).
     what : str
         The option or parameter named in the message.
+    formats : sequence of str, optional
+        Allowed extensions of a file (``(".csv", ".json")``); any other is refused.
 
     Returns
     -------
@@ -41,28 +88,51 @@ def check_output_path(path, kind: str = "file", what: str = "--out") -> str:
     p = os.fspath(path)
     if not p:
         raise ValueError(f"{what} must be a path; got an empty string")
+    if "\0" in p:
+        raise ValueError(f"{what} {p!r}: a path cannot contain a NUL character")
     if kind == "file":
+        if formats is not None:
+            output_format(p, formats, what)
         if os.path.isdir(p):
             raise ValueError(f"{what} {p!r} is a directory; give a file name")
         d = os.path.dirname(os.path.abspath(p))
         if not os.path.isdir(d):
-            raise ValueError(f"{what} {p!r}: directory {d!r} does not exist")
-        if not os.access(d, os.W_OK) or (os.path.exists(p) and not os.access(p, os.W_OK)):
+            raise ValueError(f"{what} {p!r}: directory {os.path.dirname(p) or d!r} does not exist")
+        if os.path.exists(p) and not os.access(p, os.W_OK):
             raise ValueError(f"{what} {p!r}: not writable")
+        _probe_writable(d, p, what)
     elif kind == "dir":
         if os.path.exists(p) and not os.path.isdir(p):
             raise ValueError(f"{what} {p!r} exists and is not a directory")
-        probe = os.path.abspath(p)
-        while not os.path.exists(probe):
-            parent = os.path.dirname(probe)
-            if parent == probe:
-                break
-            probe = parent
-        if not os.path.isdir(probe) or not os.access(probe, os.W_OK):
-            raise ValueError(f"{what} {p!r}: not writable (nearest existing directory {probe!r})")
+        if os.path.isdir(p):
+            _probe_writable(p, p, what)
+        else:
+            parent = os.path.dirname(os.path.abspath(p))
+            if not os.path.isdir(parent):
+                raise ValueError(f"{what} {p!r}: parent directory {parent!r} does not exist (only the last level "
+                                 f"of an output directory is created)")
+            _probe_writable(parent, p, what)
     else:
         raise ValueError(f"kind must be 'file' or 'dir'; got {kind!r}")
     return p
+
+
+def make_output_dir(path, what: str = "--out") -> str:
+    """Create output directory ``path`` if missing -- its last level only (the parent must exist)."""
+    p = check_output_path(path, "dir", what)
+    if not os.path.isdir(p):
+        try:
+            os.mkdir(p)
+        except FileExistsError:
+            pass
+        except OSError as exc:
+            raise ValueError(f"{what} {p!r}: cannot create ({exc.strerror or exc.__class__.__name__})") from None
+    return p
+
+
+def _named(exc: OSError, p: str) -> OSError:
+    """The same error, naming the user's path instead of the temporary file."""
+    return OSError(exc.errno if exc.errno is not None else errno.EIO, exc.strerror or str(exc), p)
 
 
 @contextlib.contextmanager
@@ -73,11 +143,15 @@ def atomic_write(path, mode: str = "w", **open_kw):
     ------
     file object
         Opened with ``mode`` (``"w"``, ``"wb"``, ...).  On an exception (including
-        ``KeyboardInterrupt``) the temporary file is removed and ``path`` is untouched.
+        ``KeyboardInterrupt``) the temporary file is removed and ``path`` is untouched; an
+        ``OSError`` is raised naming ``path``.
     """
     p = os.fspath(path)
     d = os.path.dirname(os.path.abspath(p))
-    fd, tmp = tempfile.mkstemp(prefix=f".{os.path.basename(p)}.", suffix=".part", dir=d)
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{os.path.basename(p)}.", suffix=".part", dir=d)
+    except OSError as exc:
+        raise _named(exc, p) from None
     try:
         if "b" not in mode:
             open_kw.setdefault("encoding", "utf-8")
@@ -86,9 +160,11 @@ def atomic_write(path, mode: str = "w", **open_kw):
             yield fh
         os.chmod(tmp, _umask_mode())
         os.replace(tmp, p)
-    except BaseException:
+    except BaseException as exc:
         with contextlib.suppress(OSError):
             os.unlink(tmp)
+        if isinstance(exc, OSError) and not isinstance(exc, BrokenPipeError) and exc.filename in (tmp, None):
+            raise _named(exc, p) from None
         raise
 
 
@@ -105,18 +181,25 @@ class _AtomicPath:
     def __enter__(self):
         d = os.path.dirname(os.path.abspath(self.path))
         base, ext = os.path.splitext(os.path.basename(self.path))
-        fd, self.tmp = tempfile.mkstemp(prefix=f".{base}.", suffix=f".part{ext}", dir=d)
+        try:
+            fd, self.tmp = tempfile.mkstemp(prefix=f".{base}.", suffix=f".part{ext}", dir=d)
+        except OSError as exc:
+            raise _named(exc, self.path) from None
         os.close(fd)
         return self.tmp
 
     def __exit__(self, et, ev, tb):
         if et is None:
-            os.chmod(self.tmp, _umask_mode())
-            os.replace(self.tmp, self.path)
-        else:
-            with contextlib.suppress(OSError):
-                os.unlink(self.tmp)
+            try:
+                os.chmod(self.tmp, _umask_mode())
+                os.replace(self.tmp, self.path)
+            except OSError as exc:
+                with contextlib.suppress(OSError):
+                    os.unlink(self.tmp)
+                raise _named(exc, self.path) from None
+            return False
+        with contextlib.suppress(OSError):
+            os.unlink(self.tmp)
+        if isinstance(ev, OSError) and not isinstance(ev, BrokenPipeError) and ev.filename in (self.tmp, None):
+            raise _named(ev, self.path) from None
         return False
-
-
-__all__.append("atomic_path")

@@ -25,7 +25,13 @@ import numpy as np
 
 from ipmc_asym.kernels.jit import jit
 
-__all__ = ["format_table", "format_floats", "AMBIGUOUS", "MAX_FLOAT_WIDTH"]
+__all__ = ["format_table", "format_floats", "shortest_text", "AMBIGUOUS", "MAX_FLOAT_WIDTH", "SHORTEST"]
+
+#: ``precision`` of :func:`format_table` asking for the shortest text that reads back as the
+#: same double (``0.005``, not ``%.17g``'s ``0.0050000000000000001``): the first of ``%.15g``,
+#: ``%.16g``, ``%.17g`` that round-trips (15 digits always reproduce a double that has a
+#: representation of <= 15 digits, so this is as short as Python's ``repr`` in digits)
+SHORTEST = 0
 
 #: a discarded fraction within this of 1/2 (the double-double's error is < 1e-14 at 17 digits)
 #: is either an exact tie (decided in integers, :func:`_is_tie`) or left to the caller
@@ -35,7 +41,7 @@ MAX_FLOAT_WIDTH = 26
 
 #: decimal scalings 10^k, k in [K_LO, K_HI], as double-doubles; beyond +-SCALED_FROM the value is
 #: first scaled by 2^-+SCALE_BITS (exact) so that neither it nor the table leaves the normal range
-K_LO, K_HI = -320, 345
+K_LO, K_HI = -345, 345
 SCALED_FROM = 280
 SCALE_BITS = 256
 
@@ -289,19 +295,65 @@ def _write_decomposed(n, e10, neg, P, out, pos):
 
 
 @jit(inline="always")  # numba-level: cached callers keep it inlined
-def _decompose_all(F, P, N, E, S):
-    """:func:`_decompose` of every finite element of ``F`` (2-D) into ``N``, ``E``, ``S`` (sign);
-    a tight loop of independent iterations, which the processor overlaps.  False if a rounding
-    was too close to call."""
+def _round_trips(n, e10, P, a):
+    """Does ``n 10^(e10 - P + 1)`` (``P`` digits) read back as the double ``a`` (> 0)?
+
+    The decimal times the double-double power of ten (~1e-32 relative error) is compared with
+    half an ulp of ``a`` (a quarter below a power of two); a value within 1e-9 of the edge
+    answers False (the caller then takes more digits, which is always right at 17).
+    """
+    k = e10 - P + 1
+    if k < K_LO or k > K_HI or a < 2.2250738585072014e-308:
+        return False  # subnormal: 17 digits (the ulp is no longer relative)
+    m2, e2 = math.frexp(a)
+    ulp = math.ldexp(1.0, e2 - 53)
+    # the table holds 10^k scaled by 2^-+SCALE_BITS beyond +-SCALED_FROM: scale a and its ulp alike
+    if k > SCALED_FROM:
+        a = a / _TWO_SCALE
+        ulp = ulp / _TWO_SCALE
+    elif k < -SCALED_FROM:
+        a = a * _TWO_SCALE
+        ulp = ulp * _TWO_SCALE
+    hi = _P10_HI[k - K_LO]
+    lo = _P10_LO[k - K_LO]
+    nh = float(n)
+    nl = float(n - np.int64(nh))
+    p, e = _two_prod(nh, hi)
+    e += nh * lo + nl * hi
+    d = (p - a) + e  # p - a exact (Sterbenz: p within a factor 2 of a)
+    half = 0.25 * ulp if (m2 == 0.5 and d < 0.0) else 0.5 * ulp
+    if abs(d) == half and 0 <= k <= 22:
+        # an exact decimal midpoint (10^k and the products exact): reading rounds half to
+        # even, so it comes back as ``a`` iff a's significand is even (for k < 0 no decimal of <= 16
+        # digits is a binary midpoint)
+        return (np.int64(m2 * 9007199254740992.0) & 1) == 0
+    return abs(d) < half * (1.0 - 1e-9)
+
+
+@jit(inline="always")  # numba-level: cached callers keep it inlined
+def _decompose_all(F, P, N, E, S, PV):
+    """:func:`_decompose` of every finite element of ``F`` (2-D) into ``N``, ``E``, ``S`` (sign)
+    and ``PV`` (the digits used: ``P``, or with ``P = SHORTEST`` the first of 15, 16, 17 that
+    round-trips); a tight loop of independent iterations, which the processor overlaps.  False
+    if a rounding was too close to call."""
     ok_all = True
     for j in range(F.shape[0]):
         for i in range(F.shape[1]):
             x = F[j, i]
             if math.isfinite(x):
-                n, e10, neg, ok = _decompose(x, P)
+                if P == 0:
+                    a = -x if x < 0.0 else x
+                    for q in range(15, 18):
+                        n, e10, neg, ok = _decompose(x, q)
+                        if q == 17 or (ok and (a == 0.0 or _round_trips(n, e10, q, a))):
+                            break
+                else:
+                    q = P
+                    n, e10, neg, ok = _decompose(x, P)
                 N[j, i] = n
                 E[j, i] = e10
                 S[j, i] = neg
+                PV[j, i] = q
                 ok_all = ok_all and ok
     return ok_all
 
@@ -331,7 +383,8 @@ def _format_rows(F, C, U, kinds, idx, quote_strings, P, text, pre_off, pre_len, 
     N = np.empty(F.shape, np.int64)
     E = np.empty(F.shape, np.int64)
     S = np.empty(F.shape, np.bool_)
-    if not _decompose_all(F, P, N, E, S):
+    PV = np.empty(F.shape, np.int64)
+    if not _decompose_all(F, P, N, E, S, PV):
         return -1
     ncol = kinds.size
     w = U.shape[2]
@@ -355,7 +408,7 @@ def _format_rows(F, C, U, kinds, idx, quote_strings, P, text, pre_off, pre_len, 
                     pos = _copy(out, last_pos[j], last_len[j], out, pos)
                 elif math.isfinite(x):
                     start = pos
-                    pos = _write_decomposed(N[k, i], E[k, i], S[k, i], P, out, pos)
+                    pos = _write_decomposed(N[k, i], E[k, i], S[k, i], PV[k, i], out, pos)
                     last[j] = x
                     last_pos[j] = start
                     last_len[j] = pos - start
@@ -416,7 +469,8 @@ def format_table(columns, prefixes, precision: int, nonfinite: str = "", row_sta
     prefixes : list of str
         Text written before each column's field (separators, JSON keys).
     precision : int
-        Significant digits of the floats, 1-17.
+        Significant digits of the floats, 1-17, or :data:`SHORTEST` (0): the shortest of
+        ``%.15g``/``%.16g``/``%.17g`` that reads back as the same double (:func:`shortest_text`).
     nonfinite, row_start, row_end, row_sep : str
         Field of a NaN/inf; text before and after each row; text between rows.
     as_bytes : bool
@@ -426,8 +480,8 @@ def format_table(columns, prefixes, precision: int, nonfinite: str = "", row_sta
     -------
     str or bytes or None
     """
-    if not 1 <= int(precision) <= 17:
-        raise ValueError(f"precision must be an integer in 1..17; got {precision!r}")
+    if not 0 <= int(precision) <= 17:
+        raise ValueError(f"precision must be an integer in 1..17 or SHORTEST (0); got {precision!r}")
     if len(prefixes) != len(columns):
         raise ValueError("prefixes must give one prefix per column")
     floats, codes, texts, kinds, idx, offs, vocab = [], [], [], [], [], [], []
@@ -491,6 +545,19 @@ def format_table(columns, prefixes, precision: int, nonfinite: str = "", row_sta
         return None
     b = out[:m].tobytes()
     return b if as_bytes else b.decode("ascii")
+
+
+def shortest_text(x: float) -> str:
+    """The first of ``%.15g``, ``%.16g``, ``%.17g`` of ``x`` that reads back as ``x`` (the
+    Python reference of ``precision=SHORTEST``)."""
+    x = float(x)
+    if x != 0.0 and abs(x) < 2.2250738585072014e-308:
+        return "%.17g" % x  # subnormal: the compiled formatter's rule (17 digits, exact round trip)
+    for p in (15, 16):
+        t = "%.*g" % (p, x)
+        if float(t) == x:
+            return t
+    return "%.17g" % x
 
 
 def format_floats(x, precision: int) -> str | None:

@@ -73,7 +73,18 @@ def plot_fit(result, path) -> str:
         axr.axhline(0, color="k", lw=0.8)
         axr.set_ylabel("(data − fit)/σ" if sig is not None else "(data − fit)/data")
         axr.set_xlabel(f"{xl} [{xu}]")
-    pars = ", ".join(_parameter_text(n, p) for n, p in result.parameters.items())
-    fig.suptitle(f"fit [{result.model}, {result.fidelity}]: {pars}; χ²_red = {result.chi2_red:.3g}", fontsize=10)
+    def label(p):
+        if p.get("status") == "at_bound":
+            return " (at the bound)"
+        if not p["identifiable"]:
+            return " (not identifiable)"
+        if p["stderr"] is not None:
+            return f" ± {p['stderr']:.2g}"
+        return f" [{p['ci95'][0]:.4g}, {p['ci95'][1]:.4g}]"
+
+    pars = ", ".join(f"{n} = {p['value']:.4g}{label(p)}" for n, p in result.parameters.items())
+    gof = (f"χ²_red = {result.chi2_red:.3g}" if result.chi2_red is not None
+           else f"noise s = {result.noise_scale:.2g} (relative, estimated)")
+    fig.suptitle(f"fit [{result.model}, {result.fidelity}]: {pars}; {gof}", fontsize=10)
     fig.tight_layout()
     return savefig(fig, path, dpi=120)

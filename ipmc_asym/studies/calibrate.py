@@ -81,6 +81,9 @@ MEASURED = {"deflection": "m", "blocking_force": "N"}
 GEOMETRY = ("length", "width", "thickness", "voltage")
 #: the fidelity ladder, cheapest first (the registry is the one list)
 LADDER = fidelity_names()
+#: data rows of a calibration file read at most (each is one forward evaluation per residual
+#: call; --max-rows on the command line)
+MAX_DATA_ROWS = 10**5
 #: starting value of a permittivity parameter whose nominal value is 0 (log parameters)
 _EPS_START = {"eps0": 5e-6, "deps": 1e-3}
 
@@ -130,13 +133,19 @@ def _parse_cell(col, text):
     raise ValueError(f"column {col!r} not readable")  # pragma: no cover - filtered earlier
 
 
-def read_data(path, base: Strip | None = None) -> CalibrationData:
+def read_data(path, base: Strip | None = None, max_rows: int | None = MAX_DATA_ROWS) -> CalibrationData:
     """Read a calibration CSV (header row; SI numbers or values with units).
 
     Columns: any of ``length, width, thickness, voltage`` (width/thickness TOTAL; a missing
     column takes ``base``), measured ``deflection`` (``|w|``, m) and/or ``blocking_force``
     (``|F|``, N), optional ``sigma_deflection``, ``sigma_blocking_force``.  An empty measured
     cell means "not measured in this row".  Every error is one line naming the row/column.
+
+    The header is case-insensitive and a UTF-8 byte-order mark (Excel's "CSV UTF-8") is
+    skipped.  Physically impossible rows are refused, naming the row: a magnitude <= 0, or a
+    deflection ``|w| >= L`` (an arc of length ``L`` never reaches ``L`` off its clamp line:
+    ``max (1 - cos u)/u = 0.72`` of ``L``).  More than ``max_rows`` data rows (default
+    :data:`MAX_DATA_ROWS`; None: no cap) are refused before they are parsed.
 
     Examples
     --------
@@ -151,15 +160,25 @@ def read_data(path, base: Strip | None = None) -> CalibrationData:
     base = Strip() if base is None else base
     p = os.fspath(path)
     name = os.path.basename(p)
+    if max_rows is not None and (isinstance(max_rows, bool) or int(max_rows) < 1):
+        raise ValueError(f"max_rows must be an integer >= 1 or None; got {max_rows!r}")
+    rows = []
     try:
-        with open(p, newline="", encoding="utf-8") as fh:
-            rows = list(csv.reader(fh))
-    except (OSError, UnicodeDecodeError) as exc:
+        # utf-8-sig: a byte-order mark (Excel's "CSV UTF-8") is not part of the first header name
+        with open(p, newline="", encoding="utf-8-sig") as fh:
+            for r in csv.reader(fh):
+                if not any(c.strip() for c in r) or r[0].lstrip().startswith("#"):
+                    continue
+                rows.append(r)
+                # header + max_rows data rows; one more is refused before the rest is read
+                if max_rows is not None and len(rows) > int(max_rows) + 1:
+                    raise ValueError(f"{name}: more than {int(max_rows)} data rows (the cap; --max-rows "
+                                     f"on the command line)")
+    except (OSError, UnicodeDecodeError, csv.Error) as exc:
         raise ValueError(f"data file {p!r}: cannot read ({exc.__class__.__name__})") from None
-    rows = [r for r in rows if any(c.strip() for c in r) and not r[0].lstrip().startswith("#")]
     if not rows:
         raise ValueError(f"{name}: empty file (need a header row and data rows)")
-    header = [h.strip() for h in rows[0]]
+    header = [h.strip().lower() for h in rows[0]]
     allowed = list(GEOMETRY) + list(MEASURED) + [f"sigma_{m}" for m in MEASURED]
     for j, h in enumerate(header, 1):
         if h == "charge_density" or h == "sigma_charge_density":
@@ -197,6 +216,8 @@ def read_data(path, base: Strip | None = None) -> CalibrationData:
             if h != "voltage" and not v > 0:
                 what = "a magnitude > 0" if h in MEASURED else "> 0"
                 raise ValueError(f"{name} row {rowno}, column {h!r}: must be {what}; got {cell!r}")
+            if not math.isfinite(v):
+                raise ValueError(f"{name} row {rowno}, column {h!r}: must be finite; got {cell!r}")
             cols[h][i] = v
     for m in meas:
         s = f"sigma_{m}"
@@ -205,6 +226,14 @@ def read_data(path, base: Strip | None = None) -> CalibrationData:
             if np.any(miss):
                 raise ValueError(f"{name} row {int(np.argmax(miss)) + 2}, column {s!r}: empty where {m} is given")
     geometry = {g: (cols[g] if g in cols else np.full(n, float(getattr(base, g)))) for g in GEOMETRY}
+    if "deflection" in cols:
+        # the tip of an arc of length L lies within 0.72 L of the clamp line: |w| >= L is no bending
+        far = np.isfinite(cols["deflection"]) & (cols["deflection"] >= geometry["length"])
+        if np.any(far):
+            i = int(np.argmax(far))
+            raise ValueError(f"{name} row {i + 2}, column 'deflection': |w| = {cols['deflection'][i]:.4g} m is not "
+                             f"below the strip length L = {geometry['length'][i]:.4g} m (physically impossible; "
+                             f"units?)")
     for m in meas:
         zero_v = np.isfinite(cols[m]) & (geometry["voltage"] == 0.0)
         if np.any(zero_v):
@@ -336,13 +365,27 @@ class CalibrationResult:
     Attributes
     ----------
     parameters : dict
-        name -> ``{"value", "stderr", "ci95", "identifiable"}`` (SI); ``stderr`` None and
-        ``ci95`` with None on the open side(s) where the parameter is not identifiable.
+        name -> ``{"value", "stderr", "ci95", "identifiable", "status", "note"}`` (SI).
+        ``ci95`` is the profile-likelihood interval, the answer; None on an open side.
+        ``stderr`` (linearised, from the Jacobian) only where the profile is locally quadratic
+        (both profile ends within :data:`QUADRATIC_TOL` of the linearised ones), else None
+        with the reason in ``note``.  ``status``: ``"ok"``, ``"at_bound"`` (the best fit lies
+        on a bound of ``--free``: the data want a value beyond it) or ``"not_identifiable"``
+        (flat or one-sided profile with the optimum inside the bounds).
     correlation : list of list
         Correlation matrix of the free parameters (order of ``names``); None entries for
         non-identifiable parameters.
-    chi2_red : float
-        ``chi^2/(n - p)`` (relative residuals without sigma columns).
+    chi2_red : float or None
+        ``chi^2/(n - p)`` with the given ``sigma_`` columns (a goodness of fit: ~1 if the model
+        and the sigma are right).  None without sigma columns: the noise scale is then
+        estimated from the residuals (``noise_scale``) and ``chi2_red`` would be 1 by
+        construction, no test of anything.
+    noise_scale : float or None
+        Without sigma columns: the estimated relative noise ``s = sqrt(chi^2/(n - p))`` of the
+        relative residuals (e.g. 0.03 for 3 % noise); None with sigma columns.
+    warnings : list of str
+        Outliers (a large ``chi2_red`` with known sigma), rows where the forward model's
+        assumptions fail at the fitted parameters (past a quarter turn, above the strain limit).
     n_points, fidelity, model
     success : bool
     message : str
@@ -356,7 +399,7 @@ class CalibrationResult:
 
     parameters: dict
     correlation: list
-    chi2_red: float
+    chi2_red: float | None
     n_points: int
     fidelity: str
     model: str
@@ -366,11 +409,22 @@ class CalibrationResult:
     predictions: dict = field(default_factory=dict, repr=False)
     data: CalibrationData | None = field(default=None, repr=False)
     flagged_rows: dict = field(default_factory=dict)
+    noise_scale: float | None = None
+    warnings: list = field(default_factory=list)
+
+    @property
+    def chi2_note(self) -> str:
+        """What ``chi2_red`` means here (one sentence)."""
+        if self.chi2_red is None:
+            return ("no sigma_ columns: the noise scale is estimated from the residuals (noise_scale, relative), "
+                    "so chi2_red would be 1 by construction and is not a goodness of fit")
+        return "chi2/(n - p) with the given sigma_ columns: ~1 when the model and the sigma are right"
 
     def as_dict(self) -> dict:
-        """Exactly the keys of ``--json``."""
+        """The keys of ``--json``."""
         return {"parameters": self.parameters, "correlation": self.correlation, "chi2_red": self.chi2_red,
-                "n_points": self.n_points, "fidelity": self.fidelity, "model": self.model}
+                "n_points": self.n_points, "fidelity": self.fidelity, "model": self.model,
+                "noise_scale": self.noise_scale, "chi2_note": self.chi2_note, "warnings": self.warnings}
 
 
 class _Problem:
@@ -385,6 +439,12 @@ class _Problem:
             self.scale = {k: data.sigma[k][self.masks[k]] for k in self.keys}
         else:
             self.scale = {k: data.measured[k][self.masks[k]] for k in self.keys}
+        self.bar = None  # a progress bar counting model evaluations (this process only)
+
+    def __getstate__(self):
+        d = dict(self.__dict__)
+        d["bar"] = None  # workers of a multistart get no bar
+        return d
 
     def values(self, x):
         v = dict(self.fixed)
@@ -392,6 +452,8 @@ class _Problem:
         return v
 
     def residuals(self, x):
+        if self.bar is not None:
+            self.bar.update(1)
         out, _, _ = predict(self.values(x), self.data.geometry, self.model, self.fidelity, self.material)
         parts = []
         for k in self.keys:
@@ -437,7 +499,8 @@ def _start_values(names, model, material):
 
 
 def fit(data: CalibrationData, free, model="constant", material: Material = NAFION_LI,
-        fidelity: str | None = None, multistart: int = 0, seed: int = 0, scheduler=None) -> CalibrationResult:
+        fidelity: str | None = None, multistart: int = 0, seed: int = 0, scheduler=None,
+        progress: bool | None = False) -> CalibrationResult:
     """Weighted least squares of ``data`` over the ``free`` parameters, with profile intervals.
 
     Parameters
@@ -457,6 +520,8 @@ def fit(data: CalibrationData, free, model="constant", material: Material = NAFI
         Extra starts, log-uniform inside the bounds (seeded by ``seed``), run through
         :func:`ipmc_asym.parallel.executors.run_chunks` on ``scheduler``; the best one is kept.
     scheduler : None, "local" or "tcp://HOST:PORT"
+    progress : bool or None
+        A bar on stderr counting model evaluations (None: when stderr is a terminal).
 
     Returns
     -------
@@ -480,6 +545,8 @@ def fit(data: CalibrationData, free, model="constant", material: Material = NAFI
     """
     from scipy import stats  # deferred: heavy import (start-up)
 
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise ValueError(f"seed must be an integer >= 0; got {seed!r}")
     bounds = parse_free(free)
     names = list(bounds)
     p = len(names)
@@ -505,12 +572,27 @@ def fit(data: CalibrationData, free, model="constant", material: Material = NAFI
     if multistart and multistart > 0:
         rng = np.random.default_rng(seed)
         starts += [rng.uniform(lo, hi) for _ in range(int(multistart))]
+    from ipmc_asym.base.progress import progress as _bar  # deferred: tqdm
+
+    bar = _bar(None, "fit", enabled=progress, unit="eval")
+    try:
+        return _fit(data, bounds, names, p, n, lo, hi, x0, ladder, starts, model, material, fidelity, scheduler,
+                    bar, stats)
+    finally:
+        bar.close()
+
+
+def _fit(data, bounds, names, p, n, lo, hi, x0, ladder, starts, model, material, fidelity, scheduler, bar,
+         stats) -> CalibrationResult:
+    """The body of :func:`fit` (``bar`` counts model evaluations)."""
     notes = []
+    warns = []
     res = None
     chosen = None
     x = x0
     for k, fid in enumerate(ladder):
         prob = _Problem(data, names, model, material, fid)
+        prob.bar = bar
         if k == 0 and len(starts) > 1:
 
             outs = run_chunks(_multistart_task, [(prob, s, lo, hi) for s in starts], scheduler=scheduler)
@@ -541,34 +623,74 @@ def fit(data: CalibrationData, free, model="constant", material: Material = NAFI
                      f"{rel:.2g}" + ("" if np.all(valid[rows]) else " (outside validity)"))
     if chosen is None:
         if fidelity is not None:
-            raise ValueError(f"fidelity {fidelity!r}: error estimate {worst:.2g} is not below a tenth of the data's "
-                             f"relative error {rel:.2g}; leave --fidelity unset to escalate")
+            why = notes[-1].split(": ", 1)[-1] if notes else "not accurate enough"
+            raise ValueError(f"fidelity {fidelity!r}: {why}; leave --fidelity unset to escalate")
         raise ValueError(f"no fidelity is accurate enough for data this precise ({'; '.join(notes)})")
     prob = _Problem(data, names, model, material, chosen)
+    prob.bar = bar
     chi2 = 2.0 * float(res.cost)
     dof = n - p
-    chi2_red = chi2 / dof if dof > 0 else float("nan")
-    s2 = 1.0 if data.has_sigma else chi2_red
+    s2_hat = chi2 / dof if dof > 0 else float("nan")
+    # chi2_red is a goodness of fit only with known sigma; without it the scale is estimated
+    # (s^2 = chi^2/(n - p)) and chi2/(s^2 (n - p)) = 1 identically
+    chi2_red = s2_hat if data.has_sigma else None
+    noise_scale = None if data.has_sigma else math.sqrt(s2_hat)
+    s2 = 1.0 if data.has_sigma else s2_hat
     thr = float(stats.chi2.ppf(0.95, 1)) if data.has_sigma else float(stats.t.ppf(0.975, dof) ** 2)
+    if data.has_sigma and dof > 0:
+        pval = float(stats.chi2.sf(chi2, dof))
+        if pval < 1e-3:
+            warns.append(_outlier_warning(prob, res.x, chi2_red, pval, dof))
 
     J = np.asarray(res.jac, float)
     cov = s2 * np.linalg.pinv(J.T @ J)
     sd_log = np.sqrt(np.clip(np.diag(cov), 0.0, None))
 
-    params, ident = {}, []
+    params, quad = {}, []
     for j, nm in enumerate(names):
         lo_ci, hi_ci, why = _profile(prob, res.x, j, lo, hi, chi2, s2, thr, sd_log[j])
         ok = lo_ci is not None and hi_ci is not None
-        ident.append(ok)
         val = math.exp(float(res.x[j]))
+        at = _at_bound(res.x[j], lo[j], hi[j])
+        if at and not ok:
+            # "at the bound" only where the data pull beyond it: the profile's slope there
+            # (others re-minimised: d(chi^2/s^2)/dx_j = 2 J_j.r / s^2) would lower chi^2 by more
+            # than the 95 % threshold within an e-fold beyond; a flat approach is not identifiable
+            g = 2.0 * float(J[:, j] @ np.asarray(res.fun, float)) / s2
+            if not (-at * g > thr):
+                at = 0
+        status = "ok" if ok else ("at_bound" if at else "not_identifiable")
+        # the linearised standard error describes the profile only where it is locally
+        # quadratic: both profile ends at the Wald ends x^ -+ sqrt(thr) sd (log parameter)
+        h = math.sqrt(thr) * float(sd_log[j])
+        is_quad = ok and h > 0 and math.isfinite(h) and all(
+            abs(d - h) <= QUADRATIC_TOL * h for d in (float(res.x[j]) - lo_ci, hi_ci - float(res.x[j])))
+        quad.append(is_quad)
+        if status == "at_bound":
+            side, bnd = ("lower", lo[j]) if at < 0 else ("upper", hi[j])
+            note = (f"the best fit lies on the {side} bound {math.exp(bnd):.4g} {FREE_PARAMETERS[nm][0]}: the data "
+                    f"want a value beyond it; widen --free {nm}=LO:HI (no interval, no standard error)")
+        elif status == "not_identifiable":
+            note = f"not identifiable from these data: {why}"
+        elif not is_quad:
+            wald = (math.exp(float(res.x[j]) - h), math.exp(float(res.x[j]) + h)) if math.isfinite(h) else None
+            note = ("profile not locally quadratic (the linearised interval "
+                    + (f"[{wald[0]:.4g}, {wald[1]:.4g}]" if wald else "is undefined")
+                    + " differs from the profile's by more than "
+                    + f"{QUADRATIC_TOL:.0%} of its half-width): no standard error; the profile interval is the answer")
+        else:
+            note = ""
         params[nm] = {
             "value": val,
-            "stderr": val * float(sd_log[j]) if ok else None,
+            "stderr": val * float(sd_log[j]) if is_quad else None,
             "ci95": [None if lo_ci is None else math.exp(lo_ci), None if hi_ci is None else math.exp(hi_ci)],
             "identifiable": ok,
+            "status": status,
+            "note": note,
         }
-        if not ok:
-            notes.append(f"{nm} not identifiable from these data: {why}")
+        if note:
+            notes.append(f"{nm} {note}" if status == "not_identifiable" else f"{nm}: {note}")
+    ident = quad
     corr = []
     for a in range(p):
         row = []
@@ -580,6 +702,7 @@ def fit(data: CalibrationData, free, model="constant", material: Material = NAFI
         corr.append(row)
     out, _, _, chk = predict(prob.values(res.x), data.geometry, model, chosen, material, with_checks=True)
     flagged = {c: [int(i) for i in np.flatnonzero(~ok)] for c, ok in chk.items() if not np.all(ok)}
+    warns.extend(_assumption_warnings(flagged, data))
     msg = (f"fidelity {chosen} (cheapest with error estimate < 1/10 of the data's relative error and a model-error "
            f"shift < 0.1 standard error on every estimate)")
     if notes:
@@ -590,7 +713,49 @@ def fit(data: CalibrationData, free, model="constant", material: Material = NAFI
 
     return CalibrationResult(parameters=params, correlation=corr, chi2_red=chi2_red, n_points=n,
                              fidelity=chosen, model=get_model(model).name, success=bool(res.success),
-                             message=msg, names=names, predictions=out, data=data, flagged_rows=flagged)
+                             message=msg, names=names, predictions=out, data=data, flagged_rows=flagged,
+                             noise_scale=noise_scale, warnings=warns)
+
+
+#: the profile is "locally quadratic" when each of its 95 % ends lies within this fraction of
+#: the linearised half-width from the linearised end (then the standard error describes it)
+QUADRATIC_TOL = 0.2
+
+
+def _at_bound(x, lo, hi, tol=1e-6) -> int:
+    """-1 / +1 if log parameter ``x`` sits on its lower / upper bound, else 0."""
+    if x - lo <= tol * max(1.0, abs(lo)):
+        return -1
+    if hi - x <= tol * max(1.0, abs(hi)):
+        return 1
+    return 0
+
+
+def _row_of_residual(prob) -> np.ndarray:
+    """Row index (0-based data row) of each entry of the residual vector."""
+    return np.concatenate([np.flatnonzero(prob.masks[k]) for k in prob.keys])
+
+
+def _outlier_warning(prob, x, chi2_red, pval, dof) -> str:
+    r = prob.residuals(x)
+    rows = _row_of_residual(prob)
+    worst = np.argsort(-np.abs(r))[:3]
+    which = ", ".join(f"row {int(rows[i]) + 2} ({r[i]:+.1f} sigma)" for i in worst)
+    pv = f"= {pval:.1g}" if pval > 0 else "< 1e-300"
+    return (f"chi2_red = {chi2_red:.3g} with the given sigma (p {pv}, {dof} degrees of freedom): outliers "
+            f"or underestimated sigma; largest standardised residuals: {which}; the intervals assume the model "
+            f"and the sigma are right")
+
+
+def _assumption_warnings(flagged: dict, data) -> list:
+    """One line per model assumption that rows fail at the fitted parameters (``flagged``: check ->
+    0-based rows, from the forward model through :func:`predict`); data rows count from 2 (header 1)."""
+    out = []
+    for check, idx in flagged.items():
+        rows = ", ".join(str(i + 2) for i in idx[:8]) + (", ..." if len(idx) > 8 else "")
+        out.append(f"{len(idx)} of {data.n_rows} rows fail the {check} assumption at the fitted parameters (rows {rows}): "
+                   f"the forward model flags them; they still enter the fit")
+    return out
 
 
 def _bias_check(prob, res, out, errs, chi2, n, p, has_sigma):
@@ -639,6 +804,7 @@ def _profile(prob, xhat, j, lo, hi, chi2min, s2, thr, sd):
             fixed[prob.names[j]] = math.exp(xj)
             sub = _Problem(prob.data, [prob.names[i] for i in others], prob.model, prob.material, prob.fidelity,
                            fixed)
+            sub.bar = prob.bar
             r = _solve(sub, warm[side], sub_lo, sub_hi)
             warm[side] = r.x
             c = 2.0 * float(r.cost)

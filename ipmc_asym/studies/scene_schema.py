@@ -117,7 +117,8 @@ class Scene:
 
 
 def _toml_loads(text: str) -> dict:
-    return tomllib.loads(text)
+    # a UTF-8 byte-order mark (editors' "UTF-8 with BOM") is not part of the first key
+    return tomllib.loads(text.removeprefix("\ufeff"))
 
 
 def load_scene(path) -> dict:

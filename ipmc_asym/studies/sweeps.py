@@ -41,7 +41,7 @@ from ipmc_asym.forward.model import CHECKS, FREE_STRIP_KEYS, MECHANICAL_KEYS, WI
 from ipmc_asym.integral.api import check_fidelity
 from ipmc_asym.io.fileio import atomic_write
 from ipmc_asym.io.jsonio import dumps
-from ipmc_asym.io.textfmt import format_table
+from ipmc_asym.io.textfmt import SHORTEST, format_table, shortest_text
 from ipmc_asym.model.params import NAFION_LI, Material, Strip
 from ipmc_asym.model.permittivity import get_model
 
@@ -304,7 +304,7 @@ def _row_format(names, sep, json_keys=False):
     parts = []
     for c in names:
         kind = DTYPE[c].kind
-        f = ("%.17g" if json_keys else "%.10g") if kind == "f" else "%s"
+        f = ("%s" if json_keys else "%.10g") if kind == "f" else "%s"  # JSON: shortest_text strings
         if json_keys:
             key = LABELS.get(c, c)
             f = f'"{key}": ' + (f if kind in "fb?" else f'"{f}"')
@@ -322,8 +322,9 @@ def _pieces(arr):
 
 
 def format_chunk(arr: np.ndarray, kind: str = "csv") -> str:
-    """Text of one chunk (no header), one line per row: floats ``%.10g`` (CSV) or ``%.17g``
-    (JSON, round-trip), non-finite floats an empty CSV field / JSON ``null``, booleans
+    """Text of one chunk (no header), one line per row: floats ``%.10g`` (CSV) or the shortest
+    text that reads back as the same double (JSON, :func:`ipmc_asym.io.textfmt.shortest_text`),
+    non-finite floats an empty CSV field / JSON ``null``, booleans
     ``True``/``False`` (CSV) or ``true``/``false`` (JSON).
 
     Written by the compiled formatter (:mod:`ipmc_asym.io.textfmt`), byte for byte the text of
@@ -356,7 +357,7 @@ def _format_chunk_compiled(arr: np.ndarray, kind: str, as_bytes: bool = False):
         return format_table(cols, [""] + [","] * (len(names) - 1), 10, nonfinite="", row_sep="\n",
                             as_bytes=as_bytes)
     keys = [f'"{LABELS.get(c, c)}": ' for c in names]
-    return format_table(cols, keys[:1] + [", " + k for k in keys[1:]], 17, nonfinite="null", row_start="{",
+    return format_table(cols, keys[:1] + [", " + k for k in keys[1:]], SHORTEST, nonfinite="null", row_start="{",
                         row_end="}", row_sep=",\n", quote_strings=True, as_bytes=as_bytes)
 
 
@@ -369,6 +370,8 @@ def _format_chunk_python(arr: np.ndarray, kind: str = "csv") -> str:
         a = arr[c]
         if a.dtype.kind == "b":
             cols.append(a.tolist() if kind == "csv" else np.where(a, "true", "false").tolist())
+        elif a.dtype.kind == "f" and kind != "csv":
+            cols.append([shortest_text(v) for v in a.tolist()])
         else:
             cols.append(a.tolist())
     if kind == "csv":

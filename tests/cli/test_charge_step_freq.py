@@ -33,10 +33,14 @@ def test_step_json_and_csv(tmp_path, capsys):
     f = tmp_path / "s.csv"
     assert main(["step", "--voltage", "1V", "--duration", "20ms", "--points", "30", "--out", str(f)]) == 0
     rows = list(csv.reader(f.read_text().splitlines()))
-    assert rows[0][0].startswith("# tau =")
-    assert rows[1][:7] == ["t", "phi0", "sigma", "current_density", "M_A", "theta", "w"]
-    assert rows[1][7:] == [f"check_{c}" for c in CHECKS] + ["valid"]
-    assert len(rows) == 32 and float(rows[-1][0]) == pytest.approx(0.02)
+    assert rows[0][:7] == ["t", "phi0", "sigma", "current_density", "M_A", "theta", "w"]
+    assert rows[0][7:] == [f"check_{c}" for c in CHECKS] + ["valid"]
+    assert len(rows) == 31 and float(rows[-1][0]) == pytest.approx(0.02)
+    meta = json.loads((tmp_path / "s.csv.json").read_text())
+    assert meta["tau"] > 0 and meta["thickness_total"] == pytest.approx(200e-6) and meta["units"]["w"] == "m"
+    pd = pytest.importorskip("pandas")
+    df = pd.read_csv(f)  # the header row is the first line: no comment= needed
+    assert list(df.columns) == rows[0] and len(df) == 30
 
 
 def test_freq_json(capsys):

@@ -374,3 +374,284 @@ def test_voltage_beyond_the_validated_range_is_never_silent(capsys):
     assert "validated" in (cap.out + cap.err)
     assert main(["estimate", "--model", "linear", "--voltage", f"{VALIDATED_VOLTAGE / 2:g}V"]) == 0
     assert "validated" not in capsys.readouterr().out
+
+
+# ---------------------------------------------------------------------------------------
+# sizes: every size-like option has a documented cap, refused before any work
+# ---------------------------------------------------------------------------------------
+UQ_SCENE = os.path.join(ROOT, "examples", "uq_nominal.toml")
+FIT_DATA = os.path.join(ROOT, "examples", "fit_synthetic.csv")
+
+SIZE_CASES = [
+    (["step", "--points", "1e9"], "--max-points"),
+    (["freq", "--from", "1Hz", "--to", "1kHz", "--points", "1e7", "--json"], "--max-points"),
+    (["freq", "--from", "1Hz", "--to", "1kHz", "--points", "1e9"], "--max-points"),
+    (["uq", UQ_SCENE, "--samples", "1e12"], "--max-samples"),
+    (["uq", UQ_SCENE, "--samples", "1e9"], "--max-samples"),
+    (["fit", FIT_DATA, "--free", "modulus", "--multistart", "1e12"], "--max-multistart"),
+    (["figures", "--dpi", "5000", "--quick"], "--max-dpi"),
+    (["figures", "--dpi", "1e6", "--quick"], "--max-dpi"),
+]
+
+
+@pytest.mark.parametrize("argv, cap", SIZE_CASES)
+def test_size_above_its_cap_refused_in_one_line(argv, cap, capsys, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)  # figures' default directory: nothing may be created
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    _one_line_error(err)
+    assert cap in err and cap.replace("--max-", "--") + " " in err
+    assert os.listdir(tmp_path) == []
+
+
+def test_caps_are_settable_and_documented(capsys):
+    """Each cap is an option (like sweep's --max-rows) and the help of the size option names it."""
+    assert main(["step", "--points", "300", "--max-points", "200"]) == 2
+    assert "--max-points 200" in capsys.readouterr().err
+    for cmd, opt, cap in (("step", "--points", "--max-points"), ("uq", "--samples", "--max-samples"),
+                          ("fit", "--multistart", "--max-multistart"), ("figures", "--dpi", "--max-dpi"),
+                          ("freq", "--points", "--max-points"), ("fit", "--max-rows", "--max-rows")):
+        with pytest.raises(SystemExit):
+            main([cmd, "--help"])
+        out = " ".join(capsys.readouterr().out.split())
+        assert cap in out and opt in out, (cmd, cap)
+
+
+def test_fit_csv_rows_capped(tmp_path, capsys):
+    p = tmp_path / "big.csv"
+    p.write_text("voltage,deflection\n" + "1V,1mm\n" * 30)
+    assert main(["fit", str(p), "--free", "modulus", "--max-rows", "10"]) == 2
+    err = capsys.readouterr().err
+    _one_line_error(err)
+    assert "more than 10 data rows" in err
+
+
+def test_refusal_costs_under_two_cpu_seconds():
+    """The refusal comes before any work: the child's CPU time (not the wall time of a loaded machine)."""
+    import resource
+
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    for argv in (["step", "--points", "1e9"], ["uq", UQ_SCENE, "--samples", "1e12"]):
+        r = subprocess.run([sys.executable, "-m", "ipmc_asym", *argv], capture_output=True, text=True,
+                           env={**os.environ, "PYTHONPATH": ROOT}, timeout=60)
+        assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1, r.stderr
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    assert cpu < 2 * 2.0
+
+
+# ---------------------------------------------------------------------------------------
+# outputs: format from the extension, checked first, last directory level only
+# ---------------------------------------------------------------------------------------
+@pytest.mark.parametrize("argv, allowed", [
+    (["uq", UQ_SCENE, "--samples", "100", "--out", "{d}/out.csv"], ".nc"),
+    (["uq", UQ_SCENE, "--samples", "100", "--plot", "{d}/u.txt"], ".png"),
+    (["sweep", "--vary", "voltage=1:2:3", "--out", "{d}/x.xlsx"], ".csv, .json, .nc"),
+    (["step", "--out", "{d}/s.txt"], ".csv"),
+    (["validate", "--out", "{d}/r.html"], ".md"),
+    (["fit", FIT_DATA, "--free", "modulus", "--plot", "{d}/p.txt"], ".png"),
+    (["bench", "--figure", "{d}/b.txt", "--points", "1e3"], ".png"),
+])
+def test_output_format_follows_the_extension(argv, allowed, tmp_path, capsys):
+    argv = [a.format(d=tmp_path) for a in argv]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    _one_line_error(err)
+    assert allowed in err and "extension" in err
+    assert os.listdir(tmp_path) == []
+
+
+@pytest.mark.skipif(not os.path.isdir("/proc/self"), reason="needs /proc")
+@pytest.mark.parametrize("argv", [
+    ["uq", UQ_SCENE, "--samples", "100", "--out", "/proc/x.nc"],
+    ["validate", "--out", "/proc/r.md"],
+    ["step", "--out", "/proc/s.csv"],
+    ["fit", FIT_DATA, "--free", "modulus", "--plot", "/proc/p.png"],
+])
+def test_unwritable_target_named_as_given_before_the_work(argv, capsys):
+    """os.access says yes to root on /proc: the check creates a file; the message names the user's path."""
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    _one_line_error(err)
+    target = next(a for a in argv if a.startswith("/proc/"))
+    assert repr(target) in err and ".part" not in err
+
+
+@pytest.mark.parametrize("cmd", [["profiles"], ["figures", "--quick"]])
+def test_output_directory_last_level_only(cmd, tmp_path, capsys):
+    deep = tmp_path / "a" / "b" / "c"
+    assert main([*cmd, "--out", str(deep)]) == 2
+    err = capsys.readouterr().err
+    _one_line_error(err)
+    assert "does not exist" in err and not (tmp_path / "a").exists()
+
+
+def test_atomic_write_errors_name_the_target(tmp_path):
+    from ipmc_asym.io.fileio import atomic_path, atomic_write
+
+    target = tmp_path / "gone" / "x.csv"  # no directory: the temporary file cannot be made
+    with pytest.raises(OSError) as ei:
+        with atomic_write(target) as fh:
+            fh.write("x")
+    assert ei.value.filename == str(target)
+    with pytest.raises(OSError) as ei:
+        with atomic_path(target):
+            pass
+    assert ei.value.filename == str(target)
+
+
+def test_bench_default_writes_no_figure(monkeypatch, tmp_path):
+    """No default output path that depends on the working directory."""
+    from ipmc_asym.cli import build_parser, plugin_commands
+
+    if "bench" not in plugin_commands():
+        pytest.skip("bench plugin not installed")
+    monkeypatch.chdir(tmp_path)
+    ap, _ = build_parser("bench")
+    assert ap.parse_args(["bench"]).figure is None
+
+
+# ---------------------------------------------------------------------------------------
+# friction
+# ---------------------------------------------------------------------------------------
+def test_fit_options_checked_before_the_work(capsys, monkeypatch):
+    import ipmc_asym.studies.calibrate as cal
+
+    def no_work(*a, **k):  # reaching the fit means an option was not checked first
+        raise AssertionError("fit started")
+
+    monkeypatch.setattr(cal, "fit", no_work)
+    for argv, word in ((["--seed", "-5"], "--seed"), (["--plot", "p.txt"], "--plot"),
+                       (["--free", "stiffness"], "stiffness"), (["--plot", "/nonexistent/p.png"], "--plot")):
+        with pytest.raises(SystemExit) if argv[0] == "--seed" else _nullcontext():
+            assert main(["fit", FIT_DATA, "--free", "modulus", *argv] if argv[0] != "--free"
+                        else ["fit", FIT_DATA, *argv]) == 2
+        err = capsys.readouterr().err
+        _one_line_error(err)
+        assert word in err
+
+
+def _nullcontext():
+    import contextlib
+
+    return contextlib.nullcontext()
+
+
+def test_fit_text_note_lines_apart_from_correlation(capfd):
+    assert main(["fit", FIT_DATA, "--free", "modulus,c_moy", "--fidelity", "corrected", "--no-progress"]) == 0
+    out = capfd.readouterr().out.splitlines()
+    corr = [ln for ln in out if "correlation:" in ln]
+    assert len(corr) == 1 and corr[0].startswith("correlation: ") and "note" not in corr[0]
+    assert "chi2_red" in out[0]
+
+
+def test_fit_without_sigma_reports_a_noise_scale(tmp_path, capsys):
+    p = tmp_path / "d.csv"
+    p.write_text("\ufeffVoltage,Deflection\n0.5V,1.0mm\n1V,2.1mm\n1.5V,2.9mm\n2V,4.2mm\n")
+    assert main(["fit", str(p), "--free", "modulus", "--fidelity", "corrected", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["chi2_red"] is None and 0 < out["noise_scale"] < 0.2 and "by construction" in out["chi2_note"]
+
+
+def test_help_texts_have_no_doubled_percent(capsys):
+    from ipmc_asym.cli import COMMANDS
+
+    for cmd in COMMANDS:
+        with pytest.raises(SystemExit):
+            main([cmd, "--help"])
+        out = capsys.readouterr().out
+        assert "%%" not in out, cmd
+
+
+@pytest.mark.parametrize("cmd", ["fit", "step", "freq", "sweep", "estimate", "charge", "profiles", "laws"])
+def test_model_help_states_the_default(cmd, capsys):
+    with pytest.raises(SystemExit):
+        main([cmd, "--help"])
+    out = " ".join(capsys.readouterr().out.split())
+    i = out.rindex("--model {")  # the option's entry (the usage line comes first)
+    assert "default" in out[i:i + 200]
+
+
+def test_step_text_has_no_negative_zero(capsys):
+    assert main(["step", "--voltage", "1V", "--points", "11"]) == 0
+    out = capsys.readouterr().out
+    assert " -0 " not in out and not any(f.strip() == "-0" for f in out.split())
+
+
+def test_profiles_prints_no_nan(tmp_path, capsys):
+    assert main(["profiles", "--out", str(tmp_path / "p"), "--model", "constant"]) == 0
+    table = [ln for ln in capsys.readouterr().out.splitlines() if not ln.startswith("wrote ")]
+    assert table and not any("nan" in ln.lower().split() for ln in table)
+    assert (tmp_path / "p").is_dir()
+
+
+def test_freq_lengths_in_readable_units(capsys):
+    assert main(["freq", "--from", "1Hz", "--to", "10Hz", "--points", "2", "--thickness", "1m"]) == 0
+    first = capsys.readouterr().out.splitlines()[0]
+    assert "1 m" in first and "um" not in first
+
+
+def test_uq_netcdf_carries_the_seed(tmp_path, capsys):
+    xr = pytest.importorskip("xarray")
+    nc = tmp_path / "u.nc"
+    assert main(["uq", UQ_SCENE, "--samples", "100", "--seed", "7", "--fidelity", "leading",
+                 "--out", str(nc)]) == 0
+    capsys.readouterr()
+    with xr.open_dataset(nc) as ds:
+        assert int(ds.attrs["seed"]) == 7
+
+
+def test_uq_too_few_samples_refused(capsys):
+    with pytest.raises(SystemExit) as ei:
+        main(["uq", UQ_SCENE, "--samples", "1"])
+    assert ei.value.code == 2
+    err = capsys.readouterr().err
+    _one_line_error(err)
+    assert ">= 100" in err
+
+
+def test_dir_shows_the_public_api_only():
+    names = dir(ipmc_asym)
+    for hidden in ("annotations", "importlib", "sys", "types", "_LAZY", "_Package"):
+        assert hidden not in names
+    assert set(ipmc_asym.__all__) <= set(names)
+
+
+def test_first_compile_is_announced(monkeypatch, tmp_path, capsys):
+    """sweep and uq say once that Numba compiles (an empty cache), as estimate --compiled does."""
+    import ipmc_asym.kernels.jit as jit
+    from ipmc_asym.cli.common import first_run_notice
+
+    monkeypatch.setattr(jit, "CACHE_DIR", str(tmp_path / "empty"))
+    first_run_notice()
+    assert "compiling" in capsys.readouterr().err
+    src = {c: Path(ROOT, "ipmc_asym", "cli", f"{c}.py").read_text() for c in ("sweep", "uq")}
+    assert all("first_run_notice()" in s for s in src.values())
+
+
+def test_scene_and_uq_toml_with_a_bom_accepted(tmp_path, capsys):
+    scene = tmp_path / "bom.toml"
+    text = Path(UQ_SCENE).read_text(encoding="utf-8")
+    scene.write_bytes(("\ufeff" + text).encode("utf-8"))
+    assert main(["uq", str(scene), "--samples", "100", "--fidelity", "leading", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["n_samples"] >= 100
+    plain = tmp_path / "nominal.toml"
+    plain.write_bytes(("\ufeff" + Path(ROOT, "examples", "nominal.toml").read_text(encoding="utf-8")).encode("utf-8"))
+    assert main(["scene", str(plain), "--json"]) == 0
+
+
+def test_step_pnp_has_its_own_default_cap(capsys):
+    """The pnp solver keeps every output time's profiles: its default cap is lower (1e4)."""
+    assert main(["step", "--fidelity", "pnp", "--points", "2e4"]) == 2
+    err = capsys.readouterr().err
+    _one_line_error(err)
+    assert "pnp" in err and "--max-points" in err
+
+
+def test_no_signed_zero_in_printed_numbers():
+    """A value that rounds to zero prints unsigned (uq's Sobol' S1 = -0.000 of a -4e-8 estimate)."""
+    from ipmc_asym.cli.common import fmt_num
+
+    assert fmt_num(-4e-8, ".3f") == "0.000" and fmt_num(-1e-9, "9.3f") == "    0.000"
+    assert fmt_num(-0.0, "11.4g").strip() == "0" and fmt_num(-0.5, ".3f") == "-0.500"
+    assert fmt_num(-1e-20, ".3g") == "-1e-20"  # a small number is not zero

@@ -75,3 +75,26 @@ def test_format_chunk_is_the_python_text(kind):
     arr = np.concatenate([sweeps.withhold(c) for c in sweeps.iter_sweep(vary, "all", "leading")])
     assert np.isnan(arr["w"]).any() and (~np.isnan(arr["w"])).any()
     assert sweeps.format_chunk(arr, kind) == sweeps._format_chunk_python(arr, kind)
+
+
+def test_shortest_round_trip_text():
+    """SHORTEST: the first of %.15g/%.16g/%.17g reading back as the same double (no float noise
+    such as 0.0050000000000000001); exact midpoints read half to even; scaled and tiny exponents."""
+    rng = np.random.default_rng(3)
+    x = np.concatenate([_doubles(40000, seed=11), np.round(rng.standard_normal(5000), 3),
+                        rng.integers(1, 2**62, 5000).astype(float),
+                        np.array([0.005, 0.1, 1e-300, 1e-200, 1e300, 7.189405658150542e16, 4.450147717014403e-308,
+                                  5e-324, -0.0, 1.7976931348623157e308])])
+    text = format_floats(x, textfmt.SHORTEST)
+    assert text is not None
+    got = text.split("\n")
+    for v, g in zip(x.tolist(), got):
+        assert float(g) == v and g == textfmt.shortest_text(v), (v, g)
+        # at most one digit more than Python's shortest repr (which may round a %.16g tie the
+        # other way, e.g. 2^-24), never 17 where repr has <= 15 (subnormals: 17)
+        if abs(v) >= 2.2250738585072014e-308:
+            def sig(t):
+                return len(t.split("e")[0].replace("-", "").replace(".", "").lstrip("0").rstrip("0")) or 1
+
+            assert sig(g) <= sig(repr(v)) + 1 and (sig(repr(v)) > 15 or sig(g) <= 15), (v, g)
+    assert got[-10:-7] == ["0.005", "0.1", "1e-300"]
