@@ -46,7 +46,7 @@ from ipmc_asym.kernels.exact import (
 from ipmc_asym.kernels.jit import jit
 from ipmc_asym.kernels.special import gauss_legendre
 
-__all__ = ["moment_pressure", "pressure_groups", "face_values", "NODES"]
+__all__ = ["moment_pressure", "pressure_groups", "face_values", "pressure_of_y", "volt_of_y", "NODES"]
 
 NODES = 10
 _X, _W, _S = (np.ascontiguousarray(a) for a in gauss_legendre(NODES))
@@ -116,6 +116,20 @@ def _p_of_y(y, A3, b0, g0):
 def _v_of_y(y, b0, g0):
     em = math.expm1(y)
     return pressure_volt(y, em, _l1(b0 * em), b0, g0)
+
+
+@jit
+def pressure_of_y(y, A3, b0, g0, out):
+    """``P(y)`` at every ``y`` (array) into ``out``: ``p = P/A2 + const``, ``P(0) = 0``."""
+    for i in range(y.shape[0]):
+        out[i] = _p_of_y(y[i], A3, b0, g0)
+    return out
+
+
+@jit
+def volt_of_y(y, b0, g0):
+    """``V(y)``, ``V' = 1/(g0 (1 - b0 m))``: ``A2 (phi(y1) - phi(y2)) = V(y2) - V(y1)``."""
+    return _v_of_y(y, b0, g0)
 
 
 @jit
