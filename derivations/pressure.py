@@ -57,7 +57,7 @@ from .kernel import Kernel
 
 y, rho, A3 = M.y, M.rho, M.A3
 beta, b0, g0 = sp.symbols("beta b0 g0", real=True)
-m, em, l1, r3, u, x, tau = sp.symbols("m em l1 r3 u x tau", real=True)
+m, em, l1, r3, u, x, tau, omr = sp.symbols("m em l1 r3 u x tau omr", real=True)
 
 
 def boltzmann_relation():
@@ -161,7 +161,14 @@ def s_closed():
     assert sp.simplify(S.subs({m: 0, y: 0})) == 0
     # beta -> 0: the paper's first integral 2 Hhat
     assert sp.simplify(S.subs(b0, 0) - S0) == 0
-    return S.subs(m, em)
+    # each coefficient factored: (rho - 1 - b0) multiplies the em^3 R3 term as one factor, so
+    # that for rho = 1 (constant model) the two b0 em^3 terms are not formed and subtracted
+    # and in terms of omr = 1 - rho (an argument): b0 + 1 - rho is then b0 + omr, exact for the
+    # constant model (omr = 0) instead of (b0 + 1) - 1
+    poly = sp.Poly(sp.expand(S.subs(rho, 1 - omr)), m, r3, y)
+    Sf = sum(sp.factor(c) * m**i * r3**j * y**k for (i, j, k), c in poly.terms())
+    assert sp.simplify(Sf.subs(omr, 1 - rho) - S) == 0
+    return Sf.subs(m, em)
 
 
 def s_far():
@@ -236,8 +243,8 @@ def kernels():
     ks.append(Kernel("pressure_core_q", (x, rho, b0), (core_q(),),
                      "q(x) = ehat exprel/(1 - b0 m): S(y) = y^2 int_0^1 2 tau q(y tau) dtau in the core.",
                      f"{src}:core_q"))
-    ks.append(Kernel("pressure_s_outer", (y, em, r3, rho, b0), (s_closed(),),
-                     "S(y) closed form (|y| >= 1/2), em = e^y - 1, r3 = R3(b0 em); D^2 = lambda^2 (S + kappa^2)/g0.",
+    ks.append(Kernel("pressure_s_outer", (y, em, r3, omr, b0), (s_closed(),),
+                     "S(y) closed form (|y| >= 1/2, |b0 em| <= 1/2), em = e^y - 1, r3 = R3(b0 em), omr = 1 - rho.",
                      f"{src}:s_closed"))
     Sf, lg, ib0 = s_far()
     ks.append(Kernel("pressure_s_far", (y, em, lg, rho, b0, ib0), (Sf,),

@@ -56,18 +56,14 @@ def pressure_s_far(y, em, lg, rho, b0, ib0):
 
 
 @jit
-def pressure_s_outer(y, em, r3, rho, b0):
-    """S(y) closed form (|y| >= 1/2), em = e^y - 1, r3 = R3(b0 em); D^2 = lambda^2 (S + kappa^2)/g0.
+def pressure_s_outer(y, em, r3, omr, b0):
+    """S(y) closed form (|y| >= 1/2, |b0 em| <= 1/2), em = e^y - 1, r3 = R3(b0 em), omr = 1 - rho.
 
     Derived in ``derivations.pressure:s_closed``.
     """
-    t0 = 2.0*rho
-    t1 = em*em
-    t2 = (1.0/((b0 + 1.0)))
-    t3 = b0*t2
-    t4 = em*em*em
-    t5 = 2.0*r3*t4
-    return -b0*b0*t2*t5 + 2.0*b0*r3*rho*t2*t4 + b0*rho*t1*t2 + 2.0*b0*rho*t2*y + 2.0*em*rho - em*t0*t3 - rho*t1 - t0*y + t1 - t3*t5
+    t0 = omr - 1.0
+    t1 = b0 + omr
+    return (-2.0*b0*em*em*em*r3*t1 + em*em*t1 - 2.0*em*t0 + 2.0*t0*y)/(b0 + 1.0)
 
 
 @jit

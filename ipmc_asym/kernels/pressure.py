@@ -103,7 +103,7 @@ def _s_of_y(y, rho, b0):
     x = b0 * em
     if abs(x) > 0.5:
         return pressure_s_far(y, em, math.log1p(-x), rho, b0, 1.0 / b0)
-    return pressure_s_outer(y, em, _r3(x), rho, b0)
+    return pressure_s_outer(y, em, _r3(x), 1.0 - rho, b0)
 
 
 @jit
