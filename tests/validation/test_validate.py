@@ -152,3 +152,25 @@ def test_verdicts_match_the_golden_file(rows, request):
     pinned = json.loads(GOLDEN.read_text(encoding="utf-8"))
     changed = {k: (pinned.get(k), now.get(k)) for k in set(pinned) | set(now) if pinned.get(k) != now.get(k)}
     assert not changed, f"verdicts changed (pinned, now): {changed}; rerun with --update-golden if intended"
+
+
+def test_neglected_terms_rows_against_the_bvp(rows):
+    """The pressure-term and porosity rows from independent solves (the BVP with and without it)."""
+    from ipmc_asym.bvp.pressure import solve_pressure
+    from ipmc_asym.bvp.solver import solve
+    from ipmc_asym.model.groups import pressure_beta
+    from ipmc_asym.model.params import NAFION_LI, Strip
+
+    s, m = Strip(), NAFION_LI
+    beta = float(pressure_beta(m))
+    pv = rows["pressure_term"]["value"]
+    por = rows["porosity_variation"]["value"]
+    for mm in ("constant", "affine"):
+        off = solve(s, mm, m)
+        on = solve_pressure(s, mm, m, beta=beta)
+        assert pv[f"{mm}: I, M_A"] == pytest.approx(100 * abs(on.I / off.I - 1), rel=1e-6)
+        assert pv[f"{mm}: cathode face"] == pytest.approx(100 * abs(beta) * (off.B1 + off.groups.A3), rel=1e-9)
+        M_A = off.groups.A5 * off.I
+        EI = m.E * s.I_p
+        assert por[mm] == pytest.approx(100 * (1 - m.phi4) * s.e * abs(M_A) / EI, rel=1e-8)
+    assert rows["pressure_term"]["verdict"] == "differs"
