@@ -141,6 +141,9 @@ def face_values(A2, rho, b0, g0):
     """
     Yc = math.log(b1_exact(A2, rho))
     Ya = Yc - A2
+    if b0 > 0.0 and 1.0 - b0 * math.expm1(Yc) < 0.5:
+        # beta > 0: C saturates below 1 + 1/b0; start inside, where 1 - b0 m = 1/2
+        Yc = math.log1p(0.5 / b0)
     for it in range(400):
         mc = math.expm1(Yc)
         ma = math.expm1(Ya)
