@@ -97,7 +97,7 @@ def solve_pressure(strip: Strip, model="constant", material: Material = NAFION_L
     p = np.array([b, b - g.A2])
     res = None
     steps = 1
-    while steps <= 64:
+    while steps <= 16:
         ok = True
         zc, Uc, pc = z, U, p
         for k in range(1, steps + 1):
@@ -113,7 +113,7 @@ def solve_pressure(strip: Strip, model="constant", material: Material = NAFION_L
             break
         steps *= 4
     if res is None:
-        fail.message = "solve_bvp with the pressure term did not converge (continuation in beta up to 64 steps)"
+        fail.message = "solve_bvp with the pressure term did not converge (continuation in beta up to 16 steps)"
         return fail
     b, a = float(res.p[0]), float(res.p[1])
     I = float(res.y[2, -1])

@@ -56,3 +56,21 @@ def test_beta_to_zero_reproduces_the_paper_model(model, th, v):
     d2 = moment_pressure(*a, 2e-6)[0] / I0 - 1.0
     assert abs(d1) < 1e-5
     assert d2 == pytest.approx(2.0 * d1, rel=1e-3, abs=1e-12)
+
+
+@pytest.mark.parametrize("th,v", [(200e-6, 10.0), (1e-6, 20.0), (10e-6, 5.0), (1e-2, 20.0)])
+def test_panel_refinement_where_the_bvp_does_not_converge(th, v):
+    """Constant model, beta < 0, >= 5 V: C(1)/C_moy reaches 1e3-1e9 and the BVP with the pressure
+    term does not converge from the paper's solution; a different discretisation (panels split in
+    two, 14 instead of 10 Gauss-Legendre nodes) must agree within the stated 1e-11."""
+    import numpy as np
+
+    from ipmc_asym.kernels.pressure import _S, _W, _X, moment_pressure_nodes
+    from ipmc_asym.kernels.special import gauss_legendre
+
+    X2, W2, S2 = (np.ascontiguousarray(a) for a in gauss_legendre(14))
+    a = _args("constant", th, v) + (-0.0241,)
+    r1 = moment_pressure_nodes(*a, _X, _W, _S, 1)
+    r2 = moment_pressure_nodes(*a, X2, W2, S2, 2)
+    assert r1[4] > 0 and r2[4] > 0
+    assert r2[0] == pytest.approx(r1[0], rel=1e-11)
