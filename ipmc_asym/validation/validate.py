@@ -43,8 +43,11 @@ from ipmc_asym.base.registry import MODELS, model_names
 from ipmc_asym.base.settings import LAW_HOLD_TOL, OUTSIDE_REGIMES
 from ipmc_asym.beam.statics import small_displacement_error
 from ipmc_asym.forward.estimate import evaluate
+from ipmc_asym.forward.model import forward
 from ipmc_asym.integral.api import moment
-from ipmc_asym.model.params import NAFION_LI, Material, Strip, make_groups
+from ipmc_asym.integral.pressure import moment_pressure_term
+from ipmc_asym.model.groups import A3, pressure_beta
+from ipmc_asym.model.params import M_SOURCE, NAFION_LI, V1_LI_RANGE, V1_LI_SOURCE, V2_WATER_SOURCE, Material, Strip, make_groups
 from ipmc_asym.studies.charge_studies import charge_claims
 from ipmc_asym.studies.fits import fit_power_law, linear_r, scaling_fits, variation_table
 from ipmc_asym.studies.laws import law_ranges
@@ -559,11 +562,6 @@ def _pressure_term(ctx):
     ``beta (C/C_moy + A3)`` (``derivations/pressure.py``), evaluated as the paper does, on the
     solution without the term (its table of face values), and on the solution with it.
     """
-    from ipmc_asym.forward.model import forward  # deferred: the moment kernels (start-up of validate)
-    from ipmc_asym.integral.pressure import moment_pressure_term
-    from ipmc_asym.model.groups import A3, pressure_beta
-    from ipmc_asym.model.params import M_SOURCE, V1_LI_RANGE, V1_LI_SOURCE, V2_WATER_SOURCE
-
     s, a3 = ctx.s, float(A3(ctx.m))
     value, parts = {}, []
     for v1 in V1_LI_RANGE:
