@@ -16,7 +16,7 @@ import sympy as sp
 from sympy.printing.numpy import NumPyPrinter
 from sympy.printing.pycode import PythonCodePrinter
 
-from . import charge, exact, kernels_spec
+from . import charge, exact, kernels_spec, pressure
 from .kernel import Kernel
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -255,6 +255,21 @@ def build_charge_source() -> str:
 
 
 TARGETS[ROOT / "ipmc_asym" / "kernels" / "_generated_charge.py"] = build_charge_source
+
+PRESSURE_HEADER = EXACT_HEADER.replace(
+    "Integrands and assembly of the exact moment integral (fidelity ``exact``).",
+    "Pressure term of the Nernst-Planck law: integrands of the ``exact`` rung with it.").replace(
+    "derivations/exact.py", "derivations/pressure.py")
+
+
+def build_pressure_source() -> str:
+    body = PRESSURE_HEADER.format(ver=sp.__version__)
+    for k in sorted(pressure.kernels(), key=lambda k: k.name):
+        body += render_kernel(k) + "\n"
+    return body
+
+
+TARGETS[ROOT / "ipmc_asym" / "kernels" / "_generated_pressure.py"] = build_pressure_source
 
 
 def write() -> list:

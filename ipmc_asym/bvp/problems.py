@@ -312,3 +312,103 @@ def eps_bar_custom(func: Callable, g: Groups, material: Material) -> Callable:
         return v * scale
 
     return eps_bar
+
+
+class PressureProblem:
+    """:class:`AffineProblem` with the pressure term of the Nernst-Planck law (paper eq. (5)).
+
+    Derivation in ``derivations/pressure.py``: ``y' = A2 E (gamma - beta C)``, so with the
+    state ``s = A0 C + A1 ln C`` (``s' = eps y'``)::
+
+        s' = A2 D g0 (1 - b0 (C - 1)),   D' = C - 1,   Q' = P(y) z / A2,   Q(-1) = 0
+
+    ``g0 = 1 - beta (1 + A3)``, ``b0 = beta/g0``, ``P`` the closed-form pressure
+    (:func:`ipmc_asym.kernels.pressure.pressure_of_y`, ``p = P/A2 + const``).  The Boltzmann
+    relation is no longer ``Ya = Yc - A2``: both face values are parameters ``(b, a)``
+    (``ln C`` at the cathode and the anode), with the voltage condition
+    ``V(b) - V(a) = A2`` (:func:`ipmc_asym.kernels.pressure.volt_of_y`) as the fifth boundary
+    condition.  For ``A1 = 0`` (linear model) ``Q`` carries ``P - A3 y/gamma`` (bounded at the
+    anode) and ``int y z dz`` is added after the solve (:func:`moment_y_linear`).
+    """
+
+    def __init__(self, g: Groups, beta: float):
+        from ipmc_asym.kernels.pressure import pressure_groups, pressure_of_y, volt_of_y  # deferred: Numba compile
+
+        self.A0, self.A1, self.A2, self.A3 = g.A0, g.A1, g.A2, g.A3
+        self.beta = float(beta)
+        self.g0, self.b0 = pressure_groups(self.beta, g.A3)
+        self.gamma = self.g0 * (1.0 + self.b0)
+        self._p = pressure_of_y
+        self._v = volt_of_y
+
+    def S(self, y):
+        return self.A0 * expc(y) + self.A1 * y
+
+    def C_y(self, s):
+        if self.A1 == 0.0:
+            C = np.maximum(s / self.A0, TINY)
+            return C, np.log(C)
+        y = y_of_s(s, self.A0, self.A1)
+        return expc(y), y
+
+    def pq(self, y):
+        """``P(y)``, or ``P(y) - A3 y/gamma`` for the linear model (bounded at the anode)."""
+        y = np.atleast_1d(np.asarray(y, dtype=float))
+        P = self._p(np.ascontiguousarray(y), self.A3, self.b0, self.g0, np.empty(y.size))
+        return P - self.A3 * y / self.gamma if self.A1 == 0.0 else P
+
+    def fun(self, z, u, p):
+        s, D = u[0], u[1]
+        C, y = self.C_y(s)
+        fac = self.g0 * (1.0 - self.b0 * (C - 1.0))
+        return np.vstack((self.A2 * D * fac, C - 1.0, self.pq(y) * z / self.A2))
+
+    def fun_jac(self, z, u, p):
+        s, D = u[0], u[1]
+        n = s.size
+        C, y = self.C_y(s)
+        eps = self.A0 * C + self.A1
+        dC = C / eps if self.A1 > 0.0 else np.full(n, 1.0 / self.A0)
+        den = 1.0 - self.b0 * (C - 1.0)
+        J = np.zeros((3, 3, n))
+        J[0, 0] = -self.A2 * D * self.g0 * self.b0 * dC
+        J[0, 1] = self.A2 * self.g0 * den
+        J[1, 0] = dC
+        if self.A1 > 0.0:
+            dq = (C + self.A3) / (self.g0 * den) / eps
+        else:  # d(P - A3 y/gamma)/dy = C (gamma + A3 beta)/(gamma g0 den); dy/ds = 1/(A0 C)
+            dq = (self.gamma + self.A3 * self.beta) / (self.gamma * self.g0 * den * self.A0)
+        J[2, 0] = dq * z / self.A2
+        return J, np.zeros((3, 2, n))
+
+    def _dv(self, y):
+        return 1.0 / (self.g0 * (1.0 - self.b0 * math.expm1(y)))
+
+    def bc(self, ua, ub, p):
+        b, a = p
+        return np.array([ua[0] - self.S(a), ub[0] - self.S(b), ub[1] - ua[1], ua[2],
+                         self._v(b, self.b0, self.g0) - self._v(a, self.b0, self.g0) - self.A2])
+
+    def bc_jac(self, ua, ub, p):
+        b, a = p
+        Ja = np.zeros((5, 3))
+        Jb = np.zeros((5, 3))
+        Jp = np.zeros((5, 2))
+        Ja[0, 0] = 1.0
+        Jp[0, 1] = -(self.A0 * math.exp(min(a, EXP_MAX)) + self.A1)
+        Jb[1, 0] = 1.0
+        Jp[1, 0] = -(self.A0 * math.exp(min(b, EXP_MAX)) + self.A1)
+        Jb[2, 1] = 1.0
+        Ja[2, 1] = -1.0
+        Ja[3, 2] = 1.0
+        Jp[4, 0] = self._dv(b)
+        Jp[4, 1] = -self._dv(a)
+        return Ja, Jb, Jp
+
+    def eps_of_C(self, C):
+        return self.A0 * C + self.A1
+
+    def state_from_sD(self, z, s, D):
+        """``(s, D, Q)`` with ``Q`` integrated from ``s`` (trapezoid; an initial guess)."""
+        _, y = self.C_y(s)
+        return np.vstack((s, D, cumtrapz(self.pq(y) * z / self.A2, z)))

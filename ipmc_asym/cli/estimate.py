@@ -32,6 +32,9 @@ def register(sub):
     p.add_argument("--tol", type=tol_type, default=None,
                    help="relative accuracy required of I (escalate until the error bound meets it) and the "
                         "threshold for calling a displacement 'small', e.g. 1e-3 or 0.1%% (default 1%%)")
+    p.add_argument("--pressure-term", action="store_true",
+                   help="keep the pressure term of the Nernst-Planck law (paper eq. 5, dropped by the paper): "
+                        "I from the exact or bvp rung, beta = (v1 - M1 v2/M2) C_moy from the material")
     p.add_argument("--json", action="store_true", help="print one JSON object {inputs, results}")
     p.add_argument("--compiled", action="store_true",
                    help="run the compiled kernels even for these few points (loads them from Numba's cache, "
@@ -48,7 +51,7 @@ def run(args):
     else:
         interpret_small()
     rows = estimate_rows(strip, model_list(args.model), args.fidelity, material, args.tol,
-                         escalate=not args.no_escalate, on_invalid="nan")
+                         escalate=not args.no_escalate, on_invalid="nan", pressure_term=args.pressure_term)
     for r in rows:
         if r["I"] is None:  # no rung valid: refuse the whole command, one line
             raise ValueError(r["warnings"][-1])
@@ -57,6 +60,7 @@ def run(args):
         "half_thickness_e": strip.e, "half_width_l": strip.l, "voltage": strip.voltage,
         "modulus": material.E, "c_moy": material.C_moy, "c_moy_source": str(material.c_moy),
         "I_p": strip.I_p, "material": material.name, "material_sources": list(material.sources),
+        "pressure_term": bool(args.pressure_term),
     }
     if args.json:
         print(dumps({"inputs": inputs, "results": rows}, indent=2))

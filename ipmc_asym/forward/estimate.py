@@ -22,6 +22,7 @@ from ipmc_asym.base.registry import check_choice
 from ipmc_asym.forward.escalation import Escalated, check_tol, moment_escalating
 from ipmc_asym.forward.model import CHECKS, FREE_STRIP_KEYS, MECHANICAL_KEYS, assumption_warnings, forward
 from ipmc_asym.integral.api import check_fidelity
+from ipmc_asym.model.groups import pressure_beta
 from ipmc_asym.model.params import NAFION_LI, Material, Strip, debye_length
 from ipmc_asym.model.permittivity import MODELS, get_model
 
@@ -39,7 +40,8 @@ def _f(x):
 
 
 def evaluate(strip: Strip, model="constant", fidelity="quadrature", material: Material = NAFION_LI,
-             tol: float | None = None, *, escalate: bool = True, on_invalid: str = "raise") -> dict:
+             tol: float | None = None, *, escalate: bool = True, on_invalid: str = "raise",
+             pressure_term: bool = False) -> dict:
     """One result row (SI units) for one strip and one permittivity model.
 
     Parameters
@@ -60,6 +62,10 @@ def evaluate(strip: Strip, model="constant", fidelity="quadrature", material: Ma
         (default), or the row with the moment and mechanical outputs ``None`` and
         ``valid = False``.  A failed model assumption never raises: the row keeps its numbers,
         ``valid = False``, the failed ``checks`` and one warning line each.
+    pressure_term : bool
+        Keep the pressure term of the Nernst-Planck law (paper eq. (5)): ``I`` at ``exact`` or
+        ``bvp`` (:func:`ipmc_asym.forward.model.forward`); the row then also has
+        ``pressure_term`` and ``beta``.
 
     Returns
     -------
@@ -78,7 +84,7 @@ def evaluate(strip: Strip, model="constant", fidelity="quadrature", material: Ma
     t0 = time.perf_counter()
     g = perm.groups(strip, material)
     r = forward(strip.length, strip.width, strip.thickness, strip.voltage, material=material, model=perm,
-                fidelity=fidelity, tol=tol, escalate=escalate)
+                fidelity=fidelity, tol=tol, escalate=escalate, pressure_term=pressure_term)
     settled = bool(r.moment_valid)
     if not settled and on_invalid == "raise":
         raise ValueError(r.moment_message)
@@ -127,14 +133,19 @@ def evaluate(strip: Strip, model="constant", fidelity="quadrature", material: Ma
         "withheld": withheld,
         "warnings": warnings,
     }
+    if pressure_term:
+        row["pressure_term"] = True
+        row["beta"] = float(pressure_beta(material))
     for k in withheld:
         row[k] = None
     return row
 
 
 def estimate_rows(strip: Strip, models=("constant", "linear", "affine"), fidelity="quadrature",
-                  material: Material = NAFION_LI, tol=None, *, escalate=True, on_invalid="raise") -> list[dict]:
-    return [evaluate(strip, m, fidelity, material, tol, escalate=escalate, on_invalid=on_invalid) for m in models]
+                  material: Material = NAFION_LI, tol=None, *, escalate=True, on_invalid="raise",
+                  pressure_term: bool = False) -> list[dict]:
+    return [evaluate(strip, m, fidelity, material, tol, escalate=escalate, on_invalid=on_invalid,
+                     pressure_term=pressure_term) for m in models]
 
 
 def model_list(name: str) -> list[str]:

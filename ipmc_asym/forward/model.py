@@ -35,6 +35,7 @@ from ipmc_asym.base.registry import compiled_fidelities, fidelity_names
 from ipmc_asym.base.settings import OUTSIDE_REGIMES, STRAIN_LIMIT, STRAIN_LIMIT_SOURCE, VALIDATED_VOLTAGE, VALIDITY_LIMIT
 from ipmc_asym.beam.statics import REGIMES, blocking_force_ratio, solve_beam
 from ipmc_asym.forward.escalation import Escalated, check_tol, moment_escalating, rung_checks
+from ipmc_asym.forward.pressure import moment_pressure_escalating
 from ipmc_asym.integral.api import check_fidelity, check_min_thickness, closed_model_id, validity_limit
 from ipmc_asym.integral.samples import moment_samples
 from ipmc_asym.model import groups
@@ -377,7 +378,7 @@ def _moment_per_point_material(th, v, perm, fidelity, material, c_moy, tol, esca
 
 def forward(length, width, thickness, voltage, *, modulus=None, c_moy=None, material: Material = NAFION_LI,
             model="constant", fidelity="quadrature", tol=None, escalate: bool = True,
-            pair_code=None) -> ForwardResult:
+            pair_code=None, pressure_term: bool = False) -> ForwardResult:
     """Mechanical outputs of the strip(s), with the validity checks (SI units).
 
     Parameters
@@ -406,6 +407,11 @@ def forward(length, width, thickness, voltage, *, modulus=None, c_moy=None, mate
     pair_code : array_like of int, optional
         Per point: equal codes mean equal (thickness, voltage) (and, with ``c_moy``, equal
         ``c_moy``); ``I`` is then evaluated once per distinct code.
+    pressure_term : bool
+        Keep the pressure term of the Nernst-Planck law (paper eq. (5), which the paper drops;
+        ``beta = (v1 - M1 v2/M2) C_moy`` from ``material``): ``I`` from the rungs that hold it,
+        ``exact`` then ``bvp`` (:func:`ipmc_asym.forward.pressure.moment_pressure_escalating`;
+        a cheaper ``fidelity`` starts there).  Default off: the paper's model.
 
     All inputs broadcast to one shape ``S``.
 
@@ -441,7 +447,11 @@ def forward(length, width, thickness, voltage, *, modulus=None, c_moy=None, mate
     def pairs(a):  # per-point values -> one per distinct pair
         return a if first is None else a[first]
 
-    if c_moy is None:
+    if pressure_term:
+        if c_moy is not None:
+            raise ValueError("pressure_term: a per-point c_moy is not available with the pressure term")
+        r = moment_pressure_escalating(pairs(th), pairs(v), perm, fidelity, material, tol=tol, escalate=escalate)
+    elif c_moy is None:
         r = moment_escalating(pairs(th), pairs(v), perm, fidelity, material, tol=tol, escalate=escalate,
                               progress=False)
     else:

@@ -22,7 +22,7 @@ import numpy as np
 
 __all__ = ["Groups", "make_groups", "A0", "A1", "A2", "A3", "A5", "inverse_thermal_voltage",
            "thermal_voltage", "debye_length", "debye_length_m", "kappa", "geometric_capacitance",
-           "b1_neutral", "moment_scale", "electrode_line_resistance", "line_propagation"]
+           "b1_neutral", "moment_scale", "electrode_line_resistance", "line_propagation", "pressure_beta"]
 
 
 def _cm(material: Material, C_moy):
@@ -84,6 +84,20 @@ def A3(material: Material, C_moy=None):
     C_moy : array_like, optional   mol/m^3 (default ``material.C_moy``)
     """
     return -material.rho2 * material.Z3 / (_cm(material, C_moy) * material.F)
+
+
+def pressure_beta(material: Material, C_moy=None):
+    """``beta = (v1 - M1 v2/M2) C_moy`` (dimensionless): the pressure term of the Nernst-Planck
+    law (paper eq. (5)) relative to migration is ``beta (C/C_moy + A3)``
+    (``derivations/pressure.py``); 0 drops it (the paper's model).
+
+    Parameters
+    ----------
+    material : Material   ``v1``, ``v2`` (m^3/mol), ``M1``, ``M2`` (kg/mol)
+    C_moy : array_like, optional   mol/m^3 (default ``material.C_moy``)
+    """
+    m = material
+    return (m.v1 - m.M1 * m.v2 / m.M2) * _cm(material, C_moy)
 
 
 def moment_scale(width, thickness, voltage, F, C_moy):

@@ -36,6 +36,11 @@ from ipmc_asym.model.groups import Groups, debye_length, make_groups, moment_sca
 
 __all__ = [
     "C_MOY_PAPER",
+    "V1_LI_DEFAULT",
+    "V1_LI_SOURCE",
+    "V1_LI_RANGE",
+    "V2_WATER_SOURCE",
+    "M_SOURCE",
     "D_CATION_DEFAULT",
     "D_CATION_SOURCE",
     "SHEET_RESISTANCE_SOURCE",
@@ -74,6 +79,28 @@ SHEET_RESISTANCE_SOURCE = (
     "plated on Nafion-117 after one round of NaBH4 reduction (four-point probe, 10 x 50 mm samples; E. Manaf et "
     "al., Polymers 16 (2024) 2338, abstract); the same group reports that R_s depends strongly on the plating "
     "conditions (Actuators 13 (2024) 350). No range is given here: one measured value was read"
+)
+
+#: Partial molar volumes and molar masses of the pressure term of the Nernst-Planck law (paper
+#: eq. (5); option ``pressure_term``), SI, with the sources read.  The paper names them
+#: (``v_k``, ``M_k`` in its nomenclature) but gives no values.
+V1_LI_DEFAULT = -0.87e-6
+V1_LI_SOURCE = (
+    "v1 = -0.87 cm^3/mol: standard partial molal volume of Li+(aq) at 25 C on the conventional scale "
+    "(V(H+) = 0), E. L. Shock and H. C. Helgeson, Geochim. Cosmochim. Acta 52 (1988) 2009, as tabulated in "
+    "the WORM-db thermodynamic database (github.com/worm-portal/WORM-db, wrm_data_latest.csv, row Li+, "
+    "column V).  No absolute (single-ion) aqueous value was found; the only other value read, ~5 cm^3/mol, "
+    "is the volume of Li+ in carbonate solvents (propylene/ethylene/dimethyl carbonate; abstract of "
+    "'Ion solvation in carbonate-based lithium battery electrolyte solutions'), not water"
+)
+V1_LI_RANGE = (-0.87e-6, 5.0e-6)
+V2_WATER_SOURCE = (
+    "v2 = M2/rho2 = 18.015e-6 m^3/mol: molar volume of water from the paper's rho2 = 1000 kg/m^3 "
+    "(section 4) and M2 (a dilute solution: the partial molar volume of the solvent is its molar volume)"
+)
+M_SOURCE = (
+    "M1 = 6.941e-3 kg/mol (Li), M2 = 18.0154e-3 kg/mol (H2O from H 1.008, O 15.9994): the atomic masses "
+    "of the CHARMM water/ion parameter file par_water_ions.prm (LIT 6.94100, HT 1.00800, OT 15.99940)"
 )
 
 #: The value the paper states (section 4) and uses; the formula with the quoted data gives
@@ -126,6 +153,9 @@ class Material:
                  the paper; 0 = ideal electrodes; used only by
                  :func:`ipmc_asym.dynamics.line.line_response`; source
                  :data:`SHEET_RESISTANCE_SOURCE`).
+    v1, v2 : float   partial molar volumes of the cation and the water, m^3/mol (pressure term of
+                 eq. (5) only; sources :data:`V1_LI_SOURCE`, :data:`V2_WATER_SOURCE`)
+    M1, M2 : float   molar masses of the cation and the water, kg/mol (source :data:`M_SOURCE`)
     """
 
     Z3: float = -9.0e4
@@ -139,6 +169,10 @@ class Material:
     D: float = D_CATION_DEFAULT
     c_moy: object = "paper"
     sheet_resistance: float = 0.0
+    v1: float = V1_LI_DEFAULT
+    v2: float = 18.0154e-3 / 1000.0
+    M1: float = 6.941e-3
+    M2: float = 18.0154e-3
     name: str = "nafion-li"
     #: full citations of the sources of the values (a material set's; :data:`NAFION_LI` carries
     #: the paper's)
@@ -164,6 +198,10 @@ class Material:
             raise ValueError(f"strain_limit must be in the open interval (0, 1), e.g. 0.01; got {self.strain_limit!r}")
         if check_finite("sheet_resistance", self.sheet_resistance, "a finite number >= 0 Ohm/sq") < 0.0:
             raise ValueError(f"sheet_resistance must be a finite number >= 0 Ohm/sq; got {self.sheet_resistance!r}")
+        check_finite("v1", self.v1, "a finite number of m^3/mol")
+        check_positive("v2", self.v2, "m^3/mol")
+        check_positive("M1", self.M1, "kg/mol")
+        check_positive("M2", self.M2, "kg/mol")
         if isinstance(self.c_moy, str):
             if self.c_moy not in ("paper", "formula"):
                 raise ValueError(

@@ -13,6 +13,7 @@ File format::
                "profiles", "scaling_fit"]
     tolerance = 1e-3                 # relative, in (0, 1) like --tol (default settings.DEFAULT_SCENE_TOL)
     profile_arrays = false           # "profiles": also return z, C, phi, E, D, p arrays
+    pressure_term = false            # keep the pressure term of the Nernst-Planck law (eq. 5)
 
     [strip]                          # SI numbers or strings with units
     length = "2 cm"
@@ -64,7 +65,7 @@ AXES = ("length", "width", "thickness", "voltage")
 _DEFAULT_OUTPUTS = ("I", "moment", "tip_deflection", "rotation", "blocking_force")
 #: "uncertain" is read by ``ipmc-asym uq`` (ipmc_asym.studies.uq); a plain scene evaluates the nominal values
 _TOP = {"name", "model", "voltage", "voltages", "sweep", "outputs", "tolerance", "strip", "material",
-        "profile_arrays", "uncertain"}
+        "profile_arrays", "uncertain", "pressure_term"}
 _STRIP = ("length", "width", "thickness")
 _SWEEP = ("thickness", "voltage", "length", "width")
 _RANGE = {"start", "stop", "n", "log"}
@@ -94,6 +95,8 @@ class Scene:
         One line per implausible input (:mod:`ipmc_asym.model.limits`: a bare number implausible
         in SI, a length or material parameter outside its plausible range); the same rules as
         the command line.
+    pressure_term : bool
+        Keep the pressure term of the Nernst-Planck law (paper eq. (5)); default off.
     """
 
     name: str
@@ -105,6 +108,7 @@ class Scene:
     tolerance: float
     profile_arrays: bool
     warnings: tuple = field(default=())
+    pressure_term: bool = False
 
     @property
     def n(self) -> int:
@@ -236,6 +240,11 @@ def parse_scene(scene: dict) -> Scene:
     if not isinstance(arrays, bool):
         raise ValueError(f"profile_arrays must be true or false; got {arrays!r}")
     outputs = _outputs(scene.get("outputs", list(_DEFAULT_OUTPUTS)))
+    pressure_term = scene.get("pressure_term", False)
+    if not isinstance(pressure_term, bool):
+        raise ValueError(f"pressure_term must be true or false; got {pressure_term!r}")
+    if pressure_term and "profiles" in outputs:
+        raise ValueError("pressure_term: the profiles output is the paper's model only; drop 'profiles' or pressure_term")
     material = material_from_spec(scene.get("material"))
     strip = scene.get("strip", {})
     _check_keys("strip", strip, _STRIP)
@@ -277,7 +286,7 @@ def parse_scene(scene: dict) -> Scene:
         if line:
             warns.append(line)
     warns += material_warnings(material)
-    return Scene(name, model, material, pts, swept, outputs, tol, arrays, tuple(warns))
+    return Scene(name, model, material, pts, swept, outputs, tol, arrays, tuple(warns), pressure_term)
 
 
 def read_scene(scene) -> Scene:

@@ -63,7 +63,7 @@ def _plan(sc: Scene):
     failed its check)."""
     pts = sc.points
     r = forward(pts["length"], pts["width"], pts["thickness"], pts["voltage"], material=sc.material,
-                model=sc.model, fidelity=LADDER[0], tol=min(sc.tolerance, 0.5))
+                model=sc.model, fidelity=LADDER[0], tol=min(sc.tolerance, 0.5), pressure_term=sc.pressure_term)
     if not np.all(r.moment_valid):
         raise ValueError(r.moment_message)
     return r

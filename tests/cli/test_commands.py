@@ -103,3 +103,18 @@ def test_derive_check_cli():
     """Regenerate the kernels into a temp dir: any difference with the committed file fails
     (the one run of the drift check)."""
     assert main(["derive", "--check"]) == 0
+
+
+def test_estimate_pressure_term(capsys):
+    # the option against the BVP with the pressure term (an independent solver)
+    from ipmc_asym.bvp.pressure import solve_pressure
+    from ipmc_asym.model.groups import pressure_beta
+
+    assert main(["estimate", "--model", "constant", "--pressure-term", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    row = out["results"][0]
+    assert out["inputs"]["pressure_term"] is True and row["pressure_term"] is True
+    assert row["fidelity_used"] == "exact"
+    ref = solve_pressure(Strip(), "constant", NAFION_LI, beta=float(pressure_beta(NAFION_LI)))
+    assert row["I"] == pytest.approx(ref.I, rel=1e-10)
+    assert main(["estimate", "--pressure-term", "--fidelity", "leading", "--no-escalate"]) == 2

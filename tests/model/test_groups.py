@@ -175,3 +175,15 @@ def test_registry_flags():
     assert registry.compiled_fidelities() == ("leading", "corrected", "quadrature", "exact")
     assert registry.is_compiled("exact") and not registry.is_compiled("bvp")
     assert not registry.is_compiled("nope") and not registry.is_compiled(None)
+
+
+def test_pressure_beta_and_its_parameters():
+    from ipmc_asym.model.groups import pressure_beta
+    from ipmc_asym.model.params import NAFION_LI, V1_LI_DEFAULT, Material
+
+    # beta = (v1 - M1 v2/M2) C_moy with v2 = M2/rho2 (dilute water): (v1 - M1/rho2) C_moy
+    assert float(pressure_beta(NAFION_LI)) == pytest.approx((V1_LI_DEFAULT - 6.941e-3 / 1000.0) * 3082.0, rel=1e-12)
+    assert float(pressure_beta(NAFION_LI.with_(v1=NAFION_LI.M1 * NAFION_LI.v2 / NAFION_LI.M2))) == 0.0
+    for bad in ({"v2": -1.0}, {"M1": 0.0}, {"v1": float("nan")}):
+        with pytest.raises(ValueError, match=next(iter(bad))):
+            Material(**bad)

@@ -188,3 +188,18 @@ def test_a_uq_scene_runs_as_a_plain_scene_at_its_nominal_values():
     p = res["points"][0]
     ref = moment_integral(p["thickness"], p["voltage"], res["model"], "quadrature")
     assert res["outputs"]["I"]["values"][0] == pytest.approx(ref, rel=2 * res["tolerance"])
+
+
+def test_pressure_term_scene():
+    from ipmc_asym.forward.model import forward
+
+    sc = {"model": "affine", "voltage": "1V", "outputs": ["I", "moment"], "pressure_term": True}
+    r = run_scene(sc)
+    ref = forward(0.02, 5e-3, 200e-6, 1.0, model="affine", fidelity="bvp", pressure_term=True, escalate=False)
+    assert r["outputs"]["I"]["values"][0] == pytest.approx(float(ref.I), rel=1e-10)
+    plain = run_scene({k: v for k, v in sc.items() if k != "pressure_term"})
+    assert abs(plain["outputs"]["I"]["values"][0] / r["outputs"]["I"]["values"][0] - 1.0) > 1e-3
+    with pytest.raises(ValueError, match="pressure_term"):
+        run_scene({**sc, "pressure_term": "yes"})
+    with pytest.raises(ValueError, match="profiles"):
+        run_scene({**sc, "outputs": ["profiles"]})

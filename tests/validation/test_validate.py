@@ -233,3 +233,23 @@ def test_design_states_the_accumulation_lengths_measured(rows):
         for text_v, v in ((m.group(1 + i), r["value"]), (m.group(4 + i), r["alternatives"]["1/e decay length"]["value"])):
             dec = len(text_v.split(".")[1])
             assert abs(v - float(text_v)) <= 0.5 * 10.0 ** -dec * (1 + 1e-9), (mm, text_v, v)
+def test_neglected_terms_rows_against_the_bvp(rows):
+    """The pressure-term and porosity rows from independent solves (the BVP with and without it)."""
+    from ipmc_asym.bvp.pressure import solve_pressure
+    from ipmc_asym.bvp.solver import solve
+    from ipmc_asym.model.groups import pressure_beta
+    from ipmc_asym.model.params import NAFION_LI, Strip
+
+    s, m = Strip(), NAFION_LI
+    beta = float(pressure_beta(m))
+    pv = rows["pressure_term"]["value"]
+    por = rows["porosity_variation"]["value"]
+    for mm in ("constant", "affine"):
+        off = solve(s, mm, m)
+        on = solve_pressure(s, mm, m, beta=beta)
+        assert pv[f"{mm}: I, M_A"] == pytest.approx(100 * abs(on.I / off.I - 1), rel=1e-6)
+        assert pv[f"{mm}: cathode face"] == pytest.approx(100 * abs(beta) * (off.B1 + off.groups.A3), rel=1e-9)
+        M_A = off.groups.A5 * off.I
+        EI = m.E * s.I_p
+        assert por[mm] == pytest.approx(100 * (1 - m.phi4) * s.e * abs(M_A) / EI, rel=1e-8)
+    assert rows["pressure_term"]["verdict"] == "differs"
