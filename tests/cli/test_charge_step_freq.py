@@ -62,3 +62,24 @@ def test_bad_input_exit_2_one_line(args, word, capsys):
     assert ei.value.code == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and word in err
+
+
+def test_charge_escalates_like_estimate(capsys):
+    assert main(["charge", "--json", "--thickness", "1um", "--voltage", "20V"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    for r in out["results"]:
+        ref = charge(1e-6, 20.0, r["model"], r["fidelity_used"])
+        assert bool(ref.valid) and r["sigma"] == float(ref.sigma)
+        assert r["fidelity"] == "corrected" and r["escalated"] == (r["fidelity_used"] != "corrected")
+        # the cheapest valid rung: every rung below it, from the requested one, is not valid
+        assert r["fidelity_used"] in ("quadrature", "exact")
+        if r["fidelity_used"] == "exact":
+            assert not bool(charge(1e-6, 20.0, r["model"], "quadrature").valid)
+    assert main(["charge", "--thickness", "10um", "--model", "linear"]) == 0
+    assert "corrected" in capsys.readouterr().out
+
+
+def test_charge_below_min_thickness_names_the_limit(capsys):
+    assert main(["charge", "--thickness", "50nm"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "MIN_THICKNESS" in err and "thickness" in err
