@@ -5,19 +5,27 @@ Gauss's law with blocking electrodes (seed paper section 4): the face ``z = -e``
 ``z = +e`` carries ``-sigma`` (``D_z(e) = D_z(-e)`` by electroneutrality).  Derived in
 ``derivations/charge.py`` (generated into :mod:`ipmc_asym.kernels._generated_charge`):
 
-* ``sigma = S Dhat(ln B1)`` with ``S = sqrt(phi4 C_moy eps_core R T)`` (C/m^2), exactly up to the
-  exponentially small core interaction: the lambda-expansion of the face induction stops at
-  first order, so ``leading`` and ``corrected`` give the same closed form;
+* ``sigma = S Dhat(ln B1)`` with ``S = sqrt(phi4 C_moy eps_core R T)`` (C/m^2) for a neutral core:
+  the lambda-expansion of the face induction stops at first order, so ``leading`` and
+  ``corrected`` give the same closed form;
 * ``C_d = dsigma/dphi0 = (eps_core/lambda_D) chat_c chat_a/(chat_c + chat_a)``: the two layer
   capacitances ``chat = exprel(Y) w(Y)`` in series (analytic derivative);
-  ``C_d(0) = eps_core/(2 lambda_D)`` (Debye-Hueckel);
+  ``C_d(0) = eps_core/(2 lambda_D)`` (Debye-Hueckel, thick strip);
 * ``Q = sigma 2l L`` and the apparent permittivity ``eps_app = C_d 2e`` that a capacitance
   measurement on the strip (parallel-plate reading) would report.
 
 Fidelities: ``leading``/``corrected`` (closed form), ``quadrature`` (``sigma`` as the layer
-integral ``int_0^{Yc} chat dy`` by Gauss-Legendre panels, generic-rho kernels), ``bvp`` (face
-value of ``D`` from the full BVP; ``C_d`` by a central difference of two BVP solves with a
-Richardson error estimate).  Thickness is the TOTAL ``2e``; SI throughout.
+integral ``int_0^{Yc} chat dy`` by Gauss-Legendre panels, generic-rho kernels), ``exact`` (the
+exact solution at any thickness, :mod:`ipmc_asym.kernels.charge_exact`: ``sigma = S sqrt(Dhat^2 +
+kappa^2)``, ``C_d`` by implicit differentiation of the thickness constraint; ``C_d(0) = eps_core
+coth(e/lambda_D)/(2 lambda_D)``), ``bvp`` (face value of ``D`` from the full BVP; ``C_d`` by a
+central difference of two BVP solves with a Richardson error estimate).  The closed forms'
+error estimates are twice the neutral-core asymptotics of their difference from the exact
+solution (``kernels/charge_exact.py``), or twice the measured difference where that exceeds
+``NEAR_LIMIT``.  ``Yc = ln B1`` comes from the generated small-voltage series below
+``A2 = 0.25`` (no cancellation), and ``sigma = C_d_secant phi0`` is formed without ``A2^2``, so
+``sigma -> C_d(0) phi0`` down to 0 V and subnormal voltages.  Thickness is the TOTAL ``2e``; SI
+throughout.
 """
 
 from __future__ import annotations
