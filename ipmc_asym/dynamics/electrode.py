@@ -307,6 +307,11 @@ def charge_escalated(thickness: float, voltage: float, model="constant", fidelit
         last = charge(thickness, voltage, model, rung, **kw)
         if bool(last.valid):
             return last
+        if float(voltage) != 0.0 and min(abs(float(last.sigma)), abs(float(last.Q))) < _SUBNORMAL:
+            # no rung helps: the value itself is below the normal range of a double
+            raise ValueError(f"voltage {float(voltage):g} V is too small: sigma or Q = sigma 2l L falls below "
+                             f"{_SUBNORMAL:.3g} (doubles lose relative precision there; relative rounding "
+                             f"{float(last.error):.2g})")
     raise ValueError(f"no fidelity from {fidelity!r} up is valid for model {get_model(model).name!r} (last rung "
                      f"{last.fidelity!r}: error estimates {float(last.error):.2g} / {float(last.error_C_diff):.2g})")
 
@@ -325,10 +330,14 @@ def _subnormal_rounding(x, nonzero=None):
 def _bvp_sigma(thickness, voltage, perm, mat):
     from ipmc_asym.bvp.solver import solve  # deferred: scipy.integrate is heavy (start-up of the closed forms)
 
-    r = solve(Strip(thickness=thickness, voltage=voltage), perm, mat)
-    if not r.success:
+    with np.errstate(all="ignore"):
+        try:
+            r = solve(Strip(thickness=thickness, voltage=voltage), perm, mat)
+        except (ArithmeticError, FloatingPointError):
+            r = None
+    if r is None or not r.success or not np.all(np.isfinite(r.D)):
         raise RuntimeError(f"BVP did not converge at thickness={thickness:g} m, voltage={voltage:g} V "
-                           f"({r.message}); try fidelity 'quadrature'")
+                           f"({'no finite solution' if r is None else r.message}); try fidelity 'exact'")
     # D_bar = D_z/(e phi4 F C_moy) at the face z = -1 (mirrored for a negative voltage)
     return 0.5 * thickness * mat.phi4 * mat.F * mat.C_moy * float(r.D[0])
 
