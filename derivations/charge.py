@@ -37,6 +37,8 @@ cathode carries ``-D_z(e) = -sigma`` since ``D_z(e) = D_z(-e)``).  In the paper'
 from __future__ import annotations
 
 import sympy as sp
+from sympy import QQ
+from sympy.polys.rings import ring
 
 from . import model as M
 from .kernel import Kernel
@@ -193,9 +195,6 @@ def small_voltage_yc(order: int = SMALL_ORDER):
     Returns ``(coeffs, tail)``: ``coeffs[j]`` the coefficient of ``A2^(2j+1)`` in ``Yc/A2 - 1/2``
     (``j = 0 .. order/2 - 1``), ``tail`` that of ``A2^(order+1)``; SymPy polynomials in ``rho``.
     """
-    from sympy import QQ
-    from sympy.polys.rings import ring
-
     R, a, r = ring("a,r", QQ)
     top = order + 2  # d carries a^2 .. a^(order+2): the last one is the omitted term
     cut = top + 2
