@@ -74,7 +74,7 @@ def test_capacitance_is_the_derivative_of_the_exact_charge(rho, lam):
         d = (45 * (sh(A2 + h) - sh(A2 - h)) - 9 * (sh(A2 + 2 * h) - sh(A2 - 2 * h)) + (sh(A2 + 3 * h) - sh(A2 - 3 * h))) / (60 * h)
         Yc, Ya, _ = layer_potentials(A2, rho, -1)
         cd = charge_exact_point(lam, A2, rho, Yc, Ya)[1]
-        assert cd == pytest.approx(d, rel=1e-8)
+        assert cd == pytest.approx(d, rel=1e-9)
 
 
 def test_neutral_core_asymptotics_of_kappa():
