@@ -232,13 +232,17 @@ def test_closed_forms_valid_where_their_error_is_small():
     assert not bool(charge(2e-6, 1.0, "linear", "corrected").valid)
 
 
-def _bvp_points(th, v, model):
+def _bvp_points(th, v, model, bvp_error=False):
+    """Exact rung against the BVP's face induction: within the exact rung's estimate (+1e-13 for the
+    BVP's own rounding), or within both estimates (``bvp_error``: tiny voltages, where the BVP's
+    collocation residual is ~1e-11 relative)."""
     for t in th:
         for u in v:
             ex = charge(t, u, model, "exact")
             ref = charge(t, u, model, "bvp")
             assert bool(ex.valid)
-            assert abs(float(ex.sigma) / float(ref.sigma) - 1) <= float(ex.error) + 1e-13
+            slack = float(ref.error) if bvp_error else 1e-13
+            assert abs(float(ex.sigma) / float(ref.sigma) - 1) <= float(ex.error) + slack
             if bool(ref.valid) and float(ref.error_C_diff) < 1e-3:
                 assert abs(float(ex.C_diff) / float(ref.C_diff) - 1) <= float(ref.error_C_diff) + float(ex.error_C_diff)
 
@@ -252,7 +256,7 @@ def test_exact_rung_against_the_bvp_subset(model):
 @pytest.mark.slow
 @pytest.mark.parametrize("model", MODELS3)
 def test_exact_rung_against_the_bvp_extremes(model):
-    _bvp_points(np.geomspace(1e-6, 1e-2, 7), (-20.0, -1e-4, 1e-3, 0.1, 1.0, 5.0, 20.0), model)
+    _bvp_points(np.geomspace(1e-6, 1e-2, 5), (-20.0, -1e-4, 1e-3, 0.1, 1.0, 5.0, 20.0), model)
 
 
 TINY = (0.0, 5e-324, 1e-300, 1e-100, 1e-20, 1e-12, 1e-7)
@@ -276,8 +280,8 @@ def _tiny_grid(ths):
                             s_ref = charge_scale(MODELS[model], M) / VT * coth * (math.tanh(A2 / 2) / A2 if A2 else 0.5) * v
                             c_ref = charge_scale(MODELS[model], M) / VT * coth * 0.5 / math.cosh(A2 / 2) ** 2
                             slack = 0.0
-                        else:  # Debye-Hueckel: relative O(A2) (the 1e-7 V points are also checked by the BVP)
-                            s_ref, c_ref, slack = cd0 * v, cd0, A2
+                        else:  # Debye-Hueckel: relative O(A2^2) (sigma is odd), coefficient <= 0.25 measured
+                            s_ref, c_ref, slack = cd0 * v, cd0, A2 * A2
                         es = abs(float(r.sigma) - s_ref) / abs(s_ref) if s_ref else abs(float(r.sigma))
                         assert es <= float(r.error) + slack, (model, th, v, fid)
                         assert abs(float(r.C_diff) / c_ref - 1) <= float(r.error_C_diff) + slack, (model, th, v, fid)
@@ -297,7 +301,7 @@ def test_tiny_voltages_subset():
 def test_tiny_voltages_grid():
     _tiny_grid(np.geomspace(1e-6, 1e-2, 9))
     for model in ("constant", "affine"):
-        _bvp_points((1e-6, 200e-6), (1e-7, -1e-7), model)
+        _bvp_points((1e-6, 200e-6), (1e-7, -1e-7), model, bvp_error=True)
 
 
 def test_below_min_thickness_refused():
