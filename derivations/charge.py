@@ -32,6 +32,13 @@ cathode carries ``-D_z(e) = -sigma`` since ``D_z(e) = D_z(-e)``).  In the paper'
    SI: ``Z = (e/kappa) Zhat`` with the core conductivity ``kappa = phi4 F^2 D C_moy/(R T)``.
    The moment ``int p z dz`` linearises to ``(1 + A3)/lambda^2 int d (1 - x^2)/2 dx`` (thermal
    units), also closed form (``moment_transfer``).
+6. Small voltage (``small_voltage_yc``): ``Yc/A2 = 1/2 + sum c_k(rho) A2^k`` (odd k) from
+   electroneutrality in truncated power series, used below ``A2 = SMALL_A2`` where ``ln B1`` of
+   the closed root loses ``eps/(B1 - 1)``; its bound is twice the first omitted term.  With it
+   ``sigma_hat/A2 -> 1/2`` and ``C_d -> eps_core/(2 lambda_D)`` without cancellation; the
+   exact solution at any thickness (``ipmc_asym/kernels/charge_exact.py``) has
+   ``D(+-1) = lambda sqrt(Dhat(Yc)^2 + kappa^2)`` (``derivations/exact.py``), hence
+   ``C_d(0) = eps_core coth(1/lambda)/(2 lambda_D)``.
 """
 
 from __future__ import annotations
