@@ -32,11 +32,20 @@ cathode carries ``-D_z(e) = -sigma`` since ``D_z(e) = D_z(-e)``).  In the paper'
    SI: ``Z = (e/kappa) Zhat`` with the core conductivity ``kappa = phi4 F^2 D C_moy/(R T)``.
    The moment ``int p z dz`` linearises to ``(1 + A3)/lambda^2 int d (1 - x^2)/2 dx`` (thermal
    units), also closed form (``moment_transfer``).
+6. Small voltage (``small_voltage_yc``): ``Yc/A2 = 1/2 + sum c_k(rho) A2^k`` (odd k) from
+   electroneutrality in truncated power series, used below ``A2 = SMALL_A2`` where ``ln B1`` of
+   the closed root loses ``eps/(B1 - 1)``; its bound is twice the first omitted term.  With it
+   ``sigma_hat/A2 -> 1/2`` and ``C_d -> eps_core/(2 lambda_D)`` without cancellation; the
+   exact solution at any thickness (``ipmc_asym/kernels/charge_exact.py``) has
+   ``D(+-1) = lambda sqrt(Dhat(Yc)^2 + kappa^2)`` (``derivations/exact.py``), hence
+   ``C_d(0) = eps_core coth(1/lambda)/(2 lambda_D)``.
 """
 
 from __future__ import annotations
 
 import sympy as sp
+from sympy import QQ
+from sympy.polys.rings import ring
 
 from . import model as M
 from .kernel import Kernel
@@ -172,6 +181,94 @@ def debye_hueckel_series(model: str, order: int = 5):
     return sp.expand(dh)
 
 
+#: small-voltage series of Yc/A2: powers A2^1 .. A2^(SMALL_ORDER - 1) (odd; the even ones vanish)
+SMALL_ORDER = 16
+#: the series replaces ln B1 for A2 below this (there its first omitted term is < 1e-19 relative)
+SMALL_A2 = 0.25
+
+
+def small_voltage_yc(order: int = SMALL_ORDER):
+    """``Yc/A2`` as a series in ``A2`` (coefficients polynomials in rho) and its first omitted term.
+
+    Electroneutrality ``Hhat(Yc) = Hhat(Yc - A2)`` (seed paper section 4, ``D(1) = D(-1)``) with
+    ``Yc = A2/2 + d``: ``A2 d = -(h3(A2/2 + d) - h3(-A2/2 + d))``, ``h3 = Hhat - y^2/2 = O(y^3)``,
+    solved by fixed-point iteration in truncated power series over ``QQ[rho]`` (each pass fixes
+    two more orders; ``d`` is even in ``A2``).  No cancellation: ``ln B1`` from the closed root
+    loses ``eps/(B1 - 1)`` relative, the series none, and ``Yc/A2 -> 1/2`` (Debye-Hueckel:
+    ``sigma -> C_d(0) phi0``).  Checks: the linear model ``Yc = A2/2 - ln cosh(A2/2)``, the
+    constant model ``Yc = ln(A2/(1 - e^{-A2}))``, and the exact root at ``A2 = SMALL_A2`` (30
+    digits) for several rho, where the first omitted term bounds the truncation.
+
+    Returns ``(coeffs, tail)``: ``coeffs[j]`` the coefficient of ``A2^(2j+1)`` in ``Yc/A2 - 1/2``
+    (``j = 0 .. order/2 - 1``), ``tail`` that of ``A2^(order+1)``; SymPy polynomials in ``rho``.
+    """
+    R, a, r = ring("a,r", QQ)
+    top = order + 2  # d carries a^2 .. a^(order+2): the last one is the omitted term
+    cut = top + 2
+
+    def trunc(p, n):
+        return R({m: c for m, c in p.items() if m[0] <= n})
+
+    def h3(yv):
+        em, yk = R(0), R(1)
+        for k in range(1, cut + 1):
+            yk = trunc(yk * yv, cut)
+            em += yk * QQ(1, int(sp.factorial(k)))
+        return trunc((1 - r) * trunc(em * em, cut) * QQ(1, 2) + r * (em - yv) - trunc(yv * yv, cut) * QQ(1, 2), cut)
+
+    d = R(0)
+    for _ in range(top // 2 + 1):
+        num = h3(a * QQ(1, 2) + d) - h3(-a * QQ(1, 2) + d)
+        d = trunc(-R({(m[0] - 1, m[1]): c for m, c in num.items()}), top)
+    a_s = sp.Symbol("a")
+    dd = sp.expand(d.as_expr().subs(sp.Symbol("r"), rho).subs(a_s, A2))
+    coeffs = [sp.expand(dd.coeff(A2, k)) for k in range(2, top + 1)]
+    assert all(c == 0 for c in coeffs[1::2]), "d must be even in A2"
+    even = coeffs[0::2]  # coefficients of A2^2, A2^4, ..., A2^top in d
+    # the two closed-form models
+    lin = sp.series(-sp.log(sp.cosh(A2 / 2)), A2, 0, top + 1).removeO()
+    con = sp.series(sp.log((A2 / 2) / sp.sinh(A2 / 2)), A2, 0, top + 1).removeO()
+    poly = sum(c * A2 ** (2 * j + 2) for j, c in enumerate(even))
+    assert sp.expand(poly.subs(rho, 0) - lin) == 0
+    assert sp.expand(poly.subs(rho, 1) - con) == 0
+    # the exact root at the switch: truncation below the first omitted term (times 2)
+    q, qa, qb, qc = M.b1_quadratic_rho()
+    for rv in (0, sp.Rational(1, 201), sp.Rational(1, 3), sp.Rational(1, 2), sp.Rational(9, 10), 1):
+        av = sp.Rational(SMALL_A2)
+        sub = {rho: rv, q: 1 - sp.exp(-av), A2: av}
+        ca, cb, cc = (sp.N(v.subs(sub), 60) for v in (qa, qb, qc))
+        root = (-cb + sp.sqrt(cb**2 - 4 * ca * cc)) / (2 * ca) if ca != 0 else -cc / cb
+        ex = sp.log(root) / av
+        ser = sp.Rational(1, 2) + sum(c.subs(rho, rv) * av ** (2 * j + 1) for j, c in enumerate(even[:-1]))
+        omitted = abs(sp.N(even[-1].subs(rho, rv) * av ** (top - 1), 40))
+        err = abs(sp.N(ex - ser, 40))
+        assert err <= 2 * omitted + sp.Float(1e-35), (rv, err, omitted)
+        assert err / sp.N(ex) < 1e-18, (rv, err)
+    return even[:-1], even[-1]
+
+
+def small_voltage_kernel():
+    """``(Yc/A2, relative truncation bound)`` for ``0 <= A2 <= SMALL_A2`` (Horner, float coefficients)."""
+
+    coeffs, tail = small_voltage_yc()
+
+    def horner_rho(c):
+        out = sp.Integer(0)
+        for k in range(sp.degree(c, rho) if c.has(rho) else 0, -1, -1):
+            out = out * rho + sp.Float(c.coeff(rho, k), 30)
+        return out
+
+    a2sq = A2 * A2
+    ser = sp.Integer(0)
+    for c in reversed(coeffs):
+        ser = ser * a2sq + horner_rho(c)
+    ratio = sp.Rational(1, 2) + A2 * ser
+    # relative bound: twice the first omitted term (the later ones fall by (A2/pi)^2 < 1e-2
+    # each; checked against the exact root at SMALL_A2), over Yc/A2 >= 0.48 there
+    bound = 2 * abs(horner_rho(tail)) * A2 ** (SMALL_ORDER + 1) / sp.Float(0.48, 30)
+    return ratio, bound
+
+
 def small_signal():
     """Linearised PNP about zero volts: (Zhat(W), moment transfer Mhat(W)) per unit psi0.
 
@@ -233,6 +330,10 @@ def kernels():
     ks.append(Kernel("series_capacitance", (cc, ca), (cd,),
                      "Cdhat = dDhat(ln B1)/dA2 = chat_c chat_a/(chat_c + chat_a) (layers in series).",
                      "derivations.charge:series_capacitance"))
+    ratio, bound = small_voltage_kernel()
+    ks.append(Kernel("yc_small", (A2, rho), (ratio, bound),
+                     f"(Yc/A2, relative truncation bound) for 0 <= A2 <= {SMALL_A2}: Yc = ln B1 without cancellation.",
+                     "derivations.charge:small_voltage_yc"))
     return ks
 
 

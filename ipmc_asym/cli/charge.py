@@ -6,7 +6,7 @@ from ipmc_asym.base.registry import fidelity_names, model_choices
 from ipmc_asym.base.units import fmt_length
 from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import add_strip_options, first_run_notice, material_from_args, strip_from_args
-from ipmc_asym.dynamics.electrode import charge
+from ipmc_asym.dynamics.electrode import charge_escalated
 from ipmc_asym.forward.estimate import model_list
 from ipmc_asym.io.jsonio import dumps
 
@@ -16,7 +16,8 @@ def register(sub):
     add_strip_options(p, mechanics=False)
     p.add_argument("--model", default="all", choices=model_choices(), help="permittivity model (default all three)")
     p.add_argument("--fidelity", default="corrected", choices=fidelity_names(),
-                   help="rung of the fidelity ladder (default corrected)")
+                   help="rung of the fidelity ladder to start from (default corrected); a rung not valid for "
+                        "this strip is escalated to the next valid one (said per row)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
 
 
@@ -27,12 +28,10 @@ def run(args):
         first_run_notice()
     rows = []
     for m in model_list(args.model):
-        r = charge(strip.thickness, strip.voltage, m, args.fidelity, width=strip.width, length=strip.length,
-                   material=material)
-        if not bool(r.valid):
-            raise RuntimeError(f"fidelity {args.fidelity!r} is outside its validity for model {m!r} (error "
-                               f"estimates {float(r.error):.2g} / {float(r.error_C_diff):.2g}); use another fidelity")
-        rows.append({"model": m, "fidelity": args.fidelity, "sigma": float(r.sigma), "Q": float(r.Q),
+        r = charge_escalated(strip.thickness, strip.voltage, m, args.fidelity, width=strip.width,
+                             length=strip.length, material=material)
+        rows.append({"model": m, "fidelity": args.fidelity, "fidelity_used": r.fidelity,
+                     "escalated": r.fidelity != args.fidelity, "sigma": float(r.sigma), "Q": float(r.Q),
                      "C_diff": float(r.C_diff), "eps_app": float(r.eps_app), "error_estimate": float(r.error),
                      "error_estimate_C_diff": float(r.error_C_diff)})
     inputs = {"length": strip.length, "width_total": strip.width, "thickness_total": strip.thickness,
@@ -48,7 +47,10 @@ def run(args):
     print(f"{'model':9s} {'fidelity':10s} {'sigma [C/m^2]':>14s} {'Q [C]':>11s} {'C_diff [F/m^2]':>15s} "
           f"{'eps_app [F/m]':>14s} {'rel.err':>8s}")
     for r in rows:
-        print(f"{r['model']:9s} {r['fidelity']:10s} {r['sigma']:14.6g} {r['Q']:11.4g} {r['C_diff']:15.6g} "
+        fid = r["fidelity_used"] + ("*" if r["escalated"] else "")
+        print(f"{r['model']:9s} {fid:10s} {r['sigma']:14.6g} {r['Q']:11.4g} {r['C_diff']:15.6g} "
               f"{r['eps_app']:14.4g} {max(r['error_estimate'], r['error_estimate_C_diff']):8.1e}")
+    if any(r["escalated"] for r in rows):
+        print("* escalated: the requested fidelity is not valid here; the first valid rung was used")
     print("note: " + notes[0])
     return 0

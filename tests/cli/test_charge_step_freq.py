@@ -68,3 +68,35 @@ def test_bad_input_exit_2_one_line(args, word, capsys):
     assert ei.value.code == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and word in err
+
+
+def test_charge_escalates_like_estimate(capsys):
+    assert main(["charge", "--json", "--thickness", "1um", "--voltage", "20V"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    for r in out["results"]:
+        ref = charge(1e-6, 20.0, r["model"], r["fidelity_used"])
+        assert bool(ref.valid) and r["sigma"] == float(ref.sigma)
+        assert r["fidelity"] == "corrected" and r["escalated"] == (r["fidelity_used"] != "corrected")
+        # the cheapest valid rung: every rung below it, from the requested one, is not valid
+        assert r["fidelity_used"] in ("quadrature", "exact")
+        if r["fidelity_used"] == "exact":
+            assert not bool(charge(1e-6, 20.0, r["model"], "quadrature").valid)
+    assert main(["charge", "--thickness", "10um", "--model", "linear"]) == 0
+    assert "corrected" in capsys.readouterr().out
+
+
+def test_charge_below_min_thickness_names_the_limit(capsys):
+    assert main(["charge", "--thickness", "50nm"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "MIN_THICKNESS" in err and "thickness" in err
+
+
+def test_charge_tiny_voltages(capsys):
+    """sigma -> C_d(0) phi0 (not 0, not a constant); a Q below the double range is refused in one line."""
+    for v in ("1e-300", "-1e-100", "1e-20"):
+        assert main(["charge", "--json", "--model", "affine", f"--voltage={v}"]) == 0
+        r = json.loads(capsys.readouterr().out)["results"][0]
+        assert r["sigma"] / float(v) == pytest.approx(float(charge(200e-6, 0.0, "affine").C_diff), rel=1e-12)
+    assert main(["charge", "--model", "constant", "--voltage=5e-324"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "voltage" in err
