@@ -791,7 +791,7 @@ def solve_beam(M, L, EI, *, tol=None, e=None, strain_limit=0.01) -> BeamResult:
     beyond = flat_th > KL_BLOCK_MAX  # (M, L, EI are checked finite: the only NaN of F_block)
     if np.any(beyond):
         warns.append(
-            f"F_block = NaN: |kappa L| = {_where_msg(beyond, flat_th, n)} rad > "
+            f"F_block withheld (no answer): |kappa L| = {_where_msg(beyond, flat_th, n)} rad > "
             f"{KL_BLOCK_MAX:g}, the large-displacement blocking-force branch is not tracked"
         )
     eps = None

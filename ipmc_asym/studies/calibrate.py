@@ -753,9 +753,17 @@ def _assumption_warnings(flagged: dict, data) -> list:
     out = []
     for check, idx in flagged.items():
         rows = ", ".join(str(i + 2) for i in idx[:8]) + (", ..." if len(idx) > 8 else "")
-        out.append(f"{len(idx)} of {data.n_rows} rows fail the {check} assumption at the fitted parameters (rows {rows}): "
-                   f"the forward model flags them; they still enter the fit")
+        out.append(f"{len(idx)} of {data.n_rows} rows {_ASSUMPTION_WORDS.get(check, 'outside an assumption')} "
+                   f"(the {check} check) at the fitted parameters (rows {rows}): the forward model flags them; "
+                   f"they still enter the fit")
     return out
+
+
+#: what each model assumption's failure means, in the fit's warnings
+_ASSUMPTION_WORDS = {"beam_regime": "past a quarter turn (|theta| > pi/2)",
+                     "blocked_regime": "with the blocked strip past a quarter turn",
+                     "strain": "above the face-strain limit", "voltage": "beyond the validated voltage",
+                     "slender": "outside the slender-strip limits"}
 
 
 def _bias_check(prob, res, out, errs, chi2, n, p, has_sigma):

@@ -33,8 +33,10 @@ Outputs (scene-file names): ``tip_deflection`` (|w|, large displacement), ``bloc
 ``footprint`` (length x width) can be constrained.  Objective and constraints are magnitudes.
 
 Every candidate goes through the one forward model (:func:`ipmc_asym.forward.model.forward`,
-with escalation); a candidate any of whose checks withholds an output the design reads, or
-whose moment has no valid rung, is infeasible: no design is chosen on an invalid number.
+with escalation); a candidate any of whose checks withholds or flags an output the design
+reads (a failed model assumption: past a quarter turn, strain above the material's limit,
+beyond the validated voltage, not slender), or whose moment has no valid rung, is infeasible:
+no design is chosen on an invalid number or outside the model.
 
 Search: every combination of the listed choices x a grid of the continuous variables (one
 vectorised forward call), then from the best few candidates a pattern search in the unit box
@@ -62,7 +64,6 @@ else:  # pragma: no cover - Python 3.10
 import numpy as np
 
 from ipmc_asym.base.registry import fidelity_names, model_names
-from ipmc_asym.base.settings import STRAIN_LIMIT
 from ipmc_asym.base.units import parse_force, parse_length, parse_quantity, parse_voltage
 from ipmc_asym.forward.model import CHECKS, forward
 from ipmc_asym.model.materials import citations
@@ -345,6 +346,13 @@ class _Problem:
             w, F = np.abs(r.w), np.abs(r.F_block)
             raw = {"tip_deflection": w, "blocking_force": F, "rotation": np.abs(r.theta), "moment": np.abs(r.M_A),
                    "I": np.abs(r.I), "work": w * F, "max_strain": np.asarray(r.max_strain, float)}
+            # a design stays inside the model: an output flagged by a failed model assumption (past a
+            # quarter turn, strain above the material's limit, beyond the validated voltage, not
+            # slender) counts as withheld here, so no design rests on it
+            flagged = {"tip_deflection": r.flag_mask("w"), "blocking_force": r.flag_mask("F_block"),
+                       "rotation": r.flag_mask("theta"), "moment": r.flag_mask("M_A"), "I": r.flag_mask("I"),
+                       "work": r.flag_mask("w") | r.flag_mask("F_block")}
+            raw = {k: np.where(flagged[k], np.nan, a) if k in flagged else a for k, a in raw.items()}
         used = {spec.objective[0]} | {k for k in spec.constraints if k in OUTPUTS}
         ok = np.asarray(r.moment_valid, bool).reshape(n, S).all(axis=1)
         vals = {}
@@ -649,9 +657,10 @@ def design(spec, *, pareto: bool = True) -> DesignResult:
             if abs(a - lim) <= ACTIVE_RTOL * abs(hi - lo):
                 active.append({"name": k, "bound": bound, "limit": lim, "value": a, "kind": "variable bound"})
     # model-validity limits the optimum sits on (the checks withhold outputs beyond them)
-    if outputs["max_strain"] is not None and abs(outputs["max_strain"] - STRAIN_LIMIT) <= ACTIVE_RTOL * STRAIN_LIMIT:
-        active.append({"name": "max_strain", "bound": "max", "limit": STRAIN_LIMIT, "value": outputs["max_strain"],
-                       "kind": "model validity: settings.STRAIN_LIMIT (small-strain beam)"})
+    sl = sp.material.strain_limit
+    if outputs["max_strain"] is not None and abs(outputs["max_strain"] - sl) <= ACTIVE_RTOL * sl:
+        active.append({"name": "max_strain", "bound": "max", "limit": sl, "value": outputs["max_strain"],
+                       "kind": "model validity: the material's strain limit (small-strain beam)"})
     if outputs["rotation"] is not None and abs(abs(outputs["rotation"]) - math.pi / 2) <= ACTIVE_RTOL * math.pi / 2:
         active.append({"name": "rotation", "bound": "max", "limit": math.pi / 2, "value": abs(outputs["rotation"]),
                        "kind": "model validity: free strip within a quarter turn (beam regime)"})

@@ -117,7 +117,13 @@ CHEAP = {
              "--diffusion": ["1e-10m2/s", "1e-30", "1e10"], "--json": None},
     "sweep": {**STRIP, "--voltage": VOLTS, "--model": MODELS, "--fidelity": ["leading", "corrected"],
               "--max-rows": COUNTS, "--json": None, "--no-progress": None},
+    "materials": {"--json": None},
+    "drive": {**STRIP, "--model": MODELS[:3], "--points": COUNTS, "--duration": TIMES,
+              "--beam": ["quasi-static", "dynamic", "x"], "--json": None},
 }
+MATERIAL_NAMES = ["nafion-li", "nafion-117-h", "nope", "/nonexistent.toml", "x.csv"]
+WAVEFORMS = ["step:1V", "sine:1V@10Hz", "dc:0.2V+sine:0.5V@10Hz", "square:1V@5Hz", "ramp:1V/1s", "sine:1V@-1Hz",
+             "step:1e300V", "csv:/nonexistent.csv", "nope:1V", ""]
 SWEEP_VARY = ["voltage=1V:2V:3", "length=1cm:4cm:4", "thickness=10um:1mm:3:log", "voltage=1e-300:1e-200:3:log",
               "modulus=1MPa:1GPa:2", "length=1cm:2cm:1e9", "thickness=1:2", "voltage=0:0:1", "nope=1:2:3"]
 
@@ -132,6 +138,14 @@ def cheap_argv(draw):
         argv += ["--from", draw(values(FREQS)), "--to", draw(values(FREQS))]
     if cmd in ("step", "freq") and "--points" not in argv:
         argv += ["--points", "20"]
+    if cmd == "materials" and draw(st.booleans()):
+        argv.insert(1, draw(st.sampled_from(MATERIAL_NAMES)))
+    if cmd == "drive":
+        argv += ["--waveform", draw(values(WAVEFORMS)), "--beam", "quasi-static"]
+        if "--points" not in argv:
+            argv += ["--points", "50"]
+        if "--duration" not in argv:
+            argv += ["--duration", "0.2s"]
     return argv
 
 
@@ -203,7 +217,7 @@ def _write(tmp_path, name, text):
 def test_every_command_is_covered():
     """The fuzz covers every command ``ipmc-asym --help`` lists."""
     listed = set(COMMANDS) | set(plugin_commands())
-    covered = set(CHEAP) | set(WRITERS) | {"fit", "uq", "scene"}
+    covered = set(CHEAP) | set(WRITERS) | {"fit", "uq", "scene", "design"}
     assert listed <= covered, listed - covered
     assert len(listed) >= 14
 
@@ -244,6 +258,29 @@ def test_fuzz_uq_files(tmp_path_factory, text, extra):
 def test_fuzz_scene_files(tmp_path_factory, text, json_):
     d = tmp_path_factory.mktemp("scene")
     argv = ["scene", _write(d, "s.toml", text)] + (["--json"] if json_ else [])
+    check_outcome(argv, *run_cli(argv))
+
+
+DESIGN_VALUES = ['"1cm"', '"4cm"', '"100um"', '"400um"', '"1e-300"', '"1e300"', '"-1cm"', '"abc"', "0", '"2mm"', '"1mN"']
+
+
+@st.composite
+def design_toml(draw):
+    v = lambda: draw(st.sampled_from(DESIGN_VALUES))  # noqa: E731
+    lines = [f'model = "{draw(st.sampled_from(MODELS))}"', "[strip]", 'width = "5mm"', 'voltage = "1V"', "[vary]",
+             f"length = [{v()}, {v()}]", f"thickness = [{v()}, {v()}]", "[objective]",
+             f'{draw(st.sampled_from(["maximize", "minimize", "optimise"]))} = '
+             f'"{draw(st.sampled_from(["blocking_force", "tip_deflection", "nope"]))}"']
+    if draw(st.booleans()):
+        lines += ["[constraints]", f"tip_deflection = {{min = {v()}}}"]
+    return ("\ufeff" if draw(st.booleans()) else "") + "\n".join(lines) + "\n"
+
+
+@FAST
+@given(text=design_toml(), json_=st.booleans())
+def test_fuzz_design_files(tmp_path_factory, text, json_):
+    d = tmp_path_factory.mktemp("design")
+    argv = ["design", _write(d, "d.toml", text)] + (["--json"] if json_ else [])
     check_outcome(argv, *run_cli(argv))
 
 

@@ -273,7 +273,9 @@ def test_every_command_with_a_voltage_option_accepts_negative_values():
         sub = next(a for a in ap._actions if a.dest == "command").choices[name]
         if any("--voltage" in a.option_strings for a in sub._actions):
             # commands with required arguments get them
-            base = {"scene": ["scene", "x.toml"], "fit": ["fit", "d.csv", "--free", "modulus"]}.get(name, [name])
+            base = {"scene": ["scene", "x.toml"], "fit": ["fit", "d.csv", "--free", "modulus"],
+                    "freq": ["freq", "--from", "1Hz", "--to", "1kHz"], "design": ["design", "d.toml"],
+                    "drive": ["drive", "--waveform", "step:1V", "--duration", "1s"]}.get(name, [name])
             args = ap.parse_args(join_negative_values(base + ["--voltage", "-1V"]))
             assert args.voltage == -1.0, name
 
