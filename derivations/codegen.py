@@ -16,7 +16,7 @@ import sympy as sp
 from sympy.printing.numpy import NumPyPrinter
 from sympy.printing.pycode import PythonCodePrinter
 
-from . import charge, exact, kernels_spec
+from . import charge, debye_hueckel, exact, kernels_spec
 from .kernel import Kernel
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -322,8 +322,6 @@ from ipmc_asym.kernels.jit import jit
 
 
 def build_dh_source() -> str:
-    from . import debye_hueckel
-
     ks, constants = debye_hueckel.kernels()
     consts = "\n" + "\n".join(f"{k} = {float(v)!r}" for k, v in sorted(constants.items())) + "\n"
     body = DH_HEADER.format(ver=sp.__version__, consts=consts)
