@@ -25,7 +25,10 @@ Fidelity ladder (docs/design.md; the registry :mod:`ipmc_asym.base.registry`), n
     (the cross-check) and the only rung for a user ``eps(C)``.
 
 ``I`` is computed on ``|phi0|`` and carries the sign of the voltage (mirror symmetry);
-``I = 0`` at zero volts.  Thickness is the TOTAL thickness ``2e`` (SI).
+``I = 0`` at zero volts.  Below ``A2 = kernels.debye.DH_A2`` (~52 uV) every rung evaluates the
+Debye-Hueckel series of ``derivations/debye_hueckel.py`` (``exact`` and ``bvp`` at any lambda,
+the layer rungs its two-term limit), whose remainder bound is added to the rung's error:
+the rungs' own forms lose ~eps/A2 there.  Thickness is the TOTAL thickness ``2e`` (SI).
 
 Names exported for scripts: ``FIDELITIES`` is the tuple of the rung names, cheapest first
 (``registry.fidelity_names()``; the specs are the dict ``ipmc_asym.base.registry.FIDELITIES``);
