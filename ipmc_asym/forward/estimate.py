@@ -21,7 +21,7 @@ import numpy as np
 from ipmc_asym.base.registry import check_choice
 from ipmc_asym.forward.escalation import Escalated, check_tol, moment_escalating
 from ipmc_asym.forward.model import CHECKS, FREE_STRIP_KEYS, MECHANICAL_KEYS, assumption_warnings, forward
-from ipmc_asym.integral.api import check_fidelity
+from ipmc_asym.integral.api import check_fidelity, check_min_thickness
 from ipmc_asym.model.groups import pressure_beta
 from ipmc_asym.model.params import NAFION_LI, Material, Strip, debye_length
 from ipmc_asym.model.permittivity import MODELS, get_model
@@ -81,6 +81,7 @@ def evaluate(strip: Strip, model="constant", fidelity="quadrature", material: Ma
     tol = check_tol(tol)
     check_choice("on_invalid", on_invalid, ("raise", "nan"))
     perm = get_model(model)
+    check_min_thickness(strip.thickness)  # before the groups, which overflow for a 1e-300 m strip
     t0 = time.perf_counter()
     g = perm.groups(strip, material)
     r = forward(strip.length, strip.width, strip.thickness, strip.voltage, material=material, model=perm,

@@ -25,7 +25,10 @@ Fidelity ladder (docs/design.md; the registry :mod:`ipmc_asym.base.registry`), n
     (the cross-check) and the only rung for a user ``eps(C)``.
 
 ``I`` is computed on ``|phi0|`` and carries the sign of the voltage (mirror symmetry);
-``I = 0`` at zero volts.  Thickness is the TOTAL thickness ``2e`` (SI).
+``I = 0`` at zero volts.  Below ``A2 = kernels.debye.DH_A2`` (~52 uV) every rung evaluates the
+Debye-Hueckel series of ``derivations/debye_hueckel.py`` (``exact`` and ``bvp`` at any lambda,
+the layer rungs its two-term limit), whose remainder bound is added to the rung's error:
+the rungs' own forms lose ~eps/A2 there.  Thickness is the TOTAL thickness ``2e`` (SI).
 
 Names exported for scripts: ``FIDELITIES`` is the tuple of the rung names, cheapest first
 (``registry.fidelity_names()``; the specs are the dict ``ipmc_asym.base.registry.FIDELITIES``);
@@ -56,6 +59,7 @@ from ipmc_asym.base.settings import (
     VALIDITY_LIMIT,
 )
 from ipmc_asym.kernels.closed import closed_b1, closed_finish, layer_closed, moment_closed
+from ipmc_asym.kernels.debye import DH_A2, dh_exact, dh_layer
 from ipmc_asym.kernels.exact import moment_exact
 from ipmc_asym.kernels.jit import interpreted, jit, jit_parallel, prange
 from ipmc_asym.kernels.quadrature import moment_quadrature
@@ -188,6 +192,8 @@ def _point(lam, A2, A3, rho, model_id, order):
     """
     if A2 == 0.0:
         return 0.0, 0.0, 1.0, 2.0
+    if A2 < DH_A2:  # small voltage: the Debye-Hueckel series, no eps/A2 rounding
+        return _dh_point(lam, A2, A3, rho, order)
     if order == 3:
         Ii, b1, ell, c, niter = moment_exact(lam, A2, A3, rho)
         if niter < 0:  # thickness constraint not met: no number, and invalid
@@ -213,6 +219,17 @@ def _closed_post(lam, Ii, e_i, b1, c):
     return Ii, e_i + _core_error(c, lam), b1, c
 
 
+@jit
+def _dh_point(lam, A2, A3, rho, order):
+    """:func:`_point` for ``0 < A2 < DH_A2`` (``kernels/debye.py``): ``exact`` gets the series at
+    any ``lam`` (error: its remainder bound plus the stated error of the rung), the layer rungs
+    the series of ``J1``, ``J2`` with the core interaction added as for the closed forms."""
+    if order == 3:
+        Ii, e_i, b1 = dh_exact(lam, A2, A3, rho)
+        return Ii, EXACT_STATED_ERROR + e_i, b1, 2.0
+    Ii, e_i, b1, c = dh_layer(lam, A2, A3, rho, order)
+    return _closed_post(lam, Ii, e_i, b1, c)
+
 #: points per block of the closed-form drivers (a few kB of temporaries per thread)
 BLOCK = 1024
 
@@ -226,7 +243,8 @@ def _closed_block(lam, A2, A3, rho, model_id, order, I, err, B1, core):
     consecutive points are independent and the processor overlaps them.  The operations are
     those of :func:`moment_closed`, in the same order: the results are bit for bit the same
     (tested).  ``I``, ``err``, ``B1``, ``core``: outputs of the block's length, also used as
-    the stage-1 and layer temporaries.  ``A2 = 0`` gives :func:`_point`'s zero-volt values;
+    the stage-1 and layer temporaries.  ``A2 = 0`` gives :func:`_point`'s zero-volt values and
+    ``0 < A2 < DH_A2`` its small-voltage series;
     an ``A2`` that is not a number > 0 gives NaN (callers flag such inputs themselves); both
     run the stages on a stand-in, so no table lookup ever sees a NaN.
     """
@@ -235,17 +253,19 @@ def _closed_block(lam, A2, A3, rho, model_id, order, I, err, B1, core):
     em, yc, w0a, w1a, a2 = tmp[0], tmp[1], tmp[2], tmp[3], tmp[4]
     acc = 2 if order == 2 else 1
     for k in range(m):
-        a2[k] = A2[k] if A2[k] > 0.0 else 1.0
+        a2[k] = A2[k] if A2[k] >= DH_A2 else 1.0  # a stand-in where the series or 0 V applies
         em[k], B1[k], yc[k] = closed_b1(a2[k], model_id)
     for k in range(m):  # the cathode layer functions, held in I and err until stage 3
         I[k], err[k] = layer_closed(yc[k], model_id, acc)
     for k in range(m):
         w0a[k], w1a[k] = layer_closed(yc[k] - a2[k], model_id, acc)
     for k in range(m):
-        if A2[k] > 0.0:
+        if A2[k] >= DH_A2:
             Ii, e_i, b1, c = closed_finish(lam[k], a2[k], A3, rho, model_id, order, em[k], B1[k], yc[k], I[k],
                                            err[k], w0a[k], w1a[k])
             I[k], err[k], B1[k], core[k] = _closed_post(lam[k], Ii, e_i, b1, c)
+        elif A2[k] > 0.0:  # small voltage: the Debye-Hueckel series (as _point)
+            I[k], err[k], B1[k], core[k] = _dh_point(lam[k], A2[k], A3, rho, order)
         elif A2[k] == 0.0:  # zero volts: no field, I = 0 exactly (as _point)
             I[k], err[k], B1[k], core[k] = 0.0, 0.0, 1.0, 2.0
         else:
@@ -605,8 +625,18 @@ def _bvp_loop(thickness, voltage, perm, mat, I, err, B1, core, progress):
     msg = ""
     show = (n > 20) if progress is None else progress
     bar = _progress_bar(n, "BVP", enabled=show)
+    eps_core = perm.eps0 + perm.deps if not perm.is_custom else None
     for idx in np.ndindex(th.shape):
         vi = float(v[idx])
+        a2 = float(groups.A2(vi, mat))
+        if eps_core is not None and 0.0 < a2 < DH_A2:
+            # small voltage: the collocation loses ~eps/A2 of C - 1 (and fails in the subnormal
+            # range); the Debye-Hueckel series is exact there, its bound far below BVP_STATED_ERROR
+            lam = float(groups.debye_length(float(th[idx]), eps_core, mat))
+            Ii, e_i, b1 = dh_exact(lam, a2, float(groups.A3(mat)), perm.eps0 / eps_core)
+            I[idx], err[idx], B1[idx], core[idx] = math.copysign(Ii, vi), BVP_STATED_ERROR + e_i, b1, 2.0
+            bar.update(1)
+            continue
         res = solve(Strip(thickness=float(th[idx]), voltage=abs(vi)), perm, mat)
         core[idx] = 2.0
         if not res.success:
