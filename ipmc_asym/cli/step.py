@@ -18,6 +18,7 @@ from ipmc_asym.cli.common import (
     first_run_notice,
     material_from_args,
     strip_from_args,
+    tol_type,
 )
 from ipmc_asym.dynamics.circuit import STEP_FIDELITIES, step_response
 from ipmc_asym.io.fileio import atomic_write, check_output_path
@@ -43,8 +44,13 @@ def register(sub):
     p.add_argument("--model", default="constant", choices=list(model_names()), help="permittivity model")
     p.add_argument("--diffusion", type=diffusion_type(), default=None,
                    help="cation diffusion coefficient D (1e-10m2/s, 1e-6cm2/s; a bare number is m^2/s)")
+    p.add_argument("--tol", type=tol_type, default=None,
+                   help="relative accuracy required of sigma at every output time, e.g. 1e-3 or 0.1%% (in [1e-8, 0.5)): "
+                        "the circuit's error is bounded against the PNP solver and the PNP is used where it fails; "
+                        "default: no estimate for the circuit, 1e-6 for pnp")
     p.add_argument("--points", type=count_type("--points", 2), default=1000, help="output times (default 1000)")
-    p.add_argument("--out", default=None, help="CSV file (columns t, phi0, sigma, current_density, M_A, theta, w)")
+    p.add_argument("--out", default=None,
+                   help="CSV file (columns t, phi0, sigma, current_density, M_A, theta, w; with --tol also sigma_error)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
 
 
@@ -57,24 +63,27 @@ def run(args):
     strip = strip_from_args(args)
     first_run_notice()
     r = step_response(strip.voltage, args.duration, strip=strip, model=args.model, fidelity=args.fidelity,
-                      material=material, points=args.points)
-    cols = {"t": r.t, "phi0": r.phi0, "sigma": r.sigma, "current_density": r.current_density, "M_A": r.M_A,
+                      material=material, points=args.points, tol=args.tol)
+    cols = {"t": r.t, "phi0": r.phi0, "sigma": r.sigma, "sigma_error": r.sigma_error,
+            "current_density": r.current_density, "M_A": r.M_A,
             "theta": r.theta, "w": r.w}
+    columns = COLUMNS + (("sigma_error",) if args.tol is not None else ())
     if args.out:
         with atomic_write(args.out) as fh:
             wr = csv.writer(fh)
             wr.writerow([f"# tau = {r.tau!r} s; thickness_total = {strip.thickness!r} m; model = {r.model}; "
                          f"fidelity = {r.fidelity}; SI units"])
-            wr.writerow(COLUMNS)
+            wr.writerow(columns)
             for i in range(r.t.size):
-                wr.writerow([repr(float(cols[c][i])) for c in COLUMNS])
+                wr.writerow([repr(float(cols[c][i])) for c in columns])
         sys.stderr.write(f"step: {r.t.size} rows -> {args.out}\n")
     head = {"tau": r.tau, "R": r.R, "C_d0": r.C_d0, "model": r.model, "fidelity": r.fidelity,
             "voltage": strip.voltage, "thickness_total": strip.thickness, "half_thickness_e": strip.e,
-            "diffusion_coefficient": material.D, "seconds": r.seconds, "notes": r.notes, "message": r.message}
+            "diffusion_coefficient": material.D, "seconds": r.seconds, "notes": r.notes, "message": r.message,
+            "tol": args.tol, "valid_from": r.extra.get("valid_from")}
     if args.json:
         out = dict(head)
-        out.update({c: cols[c] for c in COLUMNS})
+        out.update({c: cols[c] for c in columns})
         print(dumps(out, indent=1))
         return 0
     if not args.out:

@@ -224,3 +224,50 @@ def test_charge_claims_rows_follow_their_criteria():
         assert e0[m] == pytest.approx(MODELS[m].eps_moy / lam, rel=1e-9)
     # tau against the test's own formula; the verdicts are pinned in the validate golden file
     assert tim["numbers"]["tau"]["constant"] == pytest.approx(TAU)
+
+
+def _ladder_case(model, V, thickness, tol):
+    """The circuit's error bound (from step_response with tol) against an independent PNP run at 1e-6."""
+    s = Strip(thickness=thickness)
+    tau = float(time_constant(thickness, model))
+    t = tau * np.array([0.0, 0.01, 0.03, 0.1, 0.3, 1.0, 2.0, 5.0])
+    r = step_response(V, strip=s, model=model, t=t, tol=tol)
+    ref = solve_transient(t, waveform("step", V), s, model, NAFION_LI, tol=1e-6, moment=False)
+    assert ref.success, ref.message
+    sc, _, _ = circuit_response(t, waveform("step", V), s, MODELS[model], NAFION_LI)
+    scale = np.max(np.abs(ref.sigma))
+    # the bound holds at every output time (the reference's own error added)
+    assert np.all(np.abs(r.sigma - ref.sigma) <= r.sigma_error + ref.sigma_error)
+    if r.fidelity == "circuit":
+        assert np.max(r.sigma_error) <= tol * np.max(np.abs(r.sigma))
+    else:  # escalated: the circuit alone misses tol somewhere, and the pnp rung meets it
+        assert np.max(np.abs(sc - ref.sigma)) > tol * scale
+        assert np.max(r.sigma_error) <= tol * scale
+    return r
+
+
+def test_step_tol_keeps_the_circuit_where_it_is_accurate():
+    r = _ladder_case("constant", 1.0, S0.thickness, 1e-2)
+    assert r.fidelity == "circuit" and r.extra["valid_from"] == 0.0
+
+
+def test_step_tol_escalates_a_thin_affine_strip_at_2V():
+    """2e = 20 um, affine, 2 V: the circuit is off by tens of percent at 0.01-0.1 tau."""
+    r = _ladder_case("affine", 2.0, 20e-6, 1e-2)
+    assert r.fidelity == "pnp" and any("escalated" in n for n in r.notes)
+    assert r.extra["valid_from"] is None or r.extra["valid_from"] > 0
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("model", ["constant", "affine"])
+@pytest.mark.parametrize("V", [0.05, 1.0, 5.0])
+@pytest.mark.parametrize("thickness", [20e-6, 200e-6, 1e-3])
+def test_step_tol_grid(model, V, thickness):
+    _ladder_case(model, V, thickness, 1e-2)
+
+
+def test_step_tol_refused_for_the_linear_model():
+    with pytest.raises(ValueError, match="linear"):
+        step_response(1.0, TAU, model="linear", points=3, tol=1e-2)
+    with pytest.raises(ValueError, match="tol"):
+        step_response(1.0, TAU, points=3, tol=0.7)
