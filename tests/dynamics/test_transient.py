@@ -39,9 +39,10 @@ def test_charge_conserved_to_1e_10():
         assert np.all(np.abs(r.c @ np.diff(r.faces) - 2.0) <= 1e-10)
 
 
-def test_energy_balance_of_a_step():
-    """Supplied after t = 0+ = stored + dissipated (constant permittivity), to 1e-6."""
-    r = _pnp(0.25, np.linspace(0, 3 * TAU, 7), energy=True, rtol=1e-9)
+@pytest.mark.parametrize("V,n_tau", [(0.25, 3), (2.0, 40)])
+def test_energy_balance_of_a_step(V, n_tau):
+    """Supplied after t = 0+ = stored + dissipated (constant permittivity), to 1e-6 (2 V: depleted anode layer)."""
+    r = _pnp(V, np.linspace(0, n_tau * TAU, 7), energy=True, rtol=1e-9)
     en = r.extra["energy"]
     assert en["dissipated"] > 0 and en["stored"] > 0
     assert en["relative_residual"] <= 1e-6
