@@ -283,7 +283,7 @@ class _Identity:
 
 
 def _lu_bordered(cJ):
-    from scipy.linalg.lapack import dgttrf, dgttrs
+    from scipy.linalg.lapack import dgttrf, dgttrs  # deferred: heavy import (start-up)
 
     lower, diag, upper, u, v = cJ.parts
     c = cJ.scale
@@ -297,7 +297,7 @@ def _lu_bordered(cJ):
 
 
 def _solve_bordered(LU, b):
-    from scipy.linalg.lapack import dgttrs
+    from scipy.linalg.lapack import dgttrs  # deferred: heavy import (start-up)
 
     dl, d, du, du2, ipiv, w, v, c, denom, n_extra = LU
     n = d.size
@@ -313,7 +313,7 @@ def _solve_bordered(LU, b):
 
 def _bordered_bdf(problem, n_extra):
     """A SciPy BDF whose linear algebra is :class:`_BorderedJacobian` (O(N) per step)."""
-    from scipy.integrate import BDF
+    from scipy.integrate import BDF  # deferred: heavy import (start-up)
 
     class _BDF(BDF):
         def __init__(self, fun, t0, y0, t_bound, **kw):
