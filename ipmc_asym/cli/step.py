@@ -22,6 +22,7 @@ from ipmc_asym.cli.common import (
     material_from_args,
     model_help,
     strip_from_args,
+    tol_type,
 )
 from ipmc_asym.cli.drive import add_beam_options
 from ipmc_asym.dynamics.circuit import STEP_FIDELITIES, step_response
@@ -69,6 +70,10 @@ def register(sub):
                    help=model_help("constant") + "; all: each in turn")
     p.add_argument("--diffusion", type=diffusion_type(), default=None,
                    help="cation diffusion coefficient D (1e-10m2/s, 1e-6cm2/s; a bare number is m^2/s)")
+    p.add_argument("--tol", type=tol_type, default=None,
+                   help="relative accuracy required of sigma at every output time, e.g. 1e-3 or 0.1%% (in [1e-8, 0.5)): "
+                        "the circuit's error is bounded against the PNP solver and the PNP is used where it fails; "
+                        "default: no estimate for the circuit, 1e-6 for pnp")
     add_size_option(p, "--points", default=1000, maximum=MAX_POINTS, minimum=2,
                     help=f"output times (with --fidelity pnp at most {MAX_POINTS_PNP:.0e} unless --max-points is given)")
     p.add_argument("--waveform", type=arg_type(parse_waveform, "--waveform"), default=None,
@@ -100,11 +105,14 @@ def run(args):
     for mname in models:
         results[mname] = step_response(strip.voltage, args.duration, strip=strip, model=mname, fidelity=args.fidelity,
                                        material=material, points=args.points, waveform_kind=kind, beam=args.beam,
-                                       viscous_modulus=args.viscous_modulus)
+                                       viscous_modulus=args.viscous_modulus, tol=args.tol)
+
+    columns = COLUMNS + (("sigma_error",) if args.tol is not None else ())
 
     def cols_of(r):
-        return {"t": r.t, "phi0": r.phi0, "sigma": r.sigma, "current_density": r.current_density, "M_A": r.M_A,
-                "theta": r.theta, "w": r.w}
+        cols = {"t": r.t, "phi0": r.phi0, "sigma": r.sigma, "sigma_error": r.sigma_error,
+                "current_density": r.current_density, "M_A": r.M_A, "theta": r.theta, "w": r.w}
+        return {c: cols[c] for c in columns}
 
     def flags_of(r):
         flags = {f"check_{c}": r.checks[c] for c in CHECKS}
@@ -124,11 +132,11 @@ def run(args):
                           "theta": "rad", "w": "m"}}
         with atomic_write(args.out) as fh:
             wr = csv.writer(fh)
-            wr.writerow((("model",) if many else ()) + COLUMNS + CHECK_COLUMNS)
+            wr.writerow((("model",) if many else ()) + columns + CHECK_COLUMNS)
             for mname in models:
                 cols, flags = cols_of(results[mname]), flags_of(results[mname])
                 for i in range(results[mname].t.size):
-                    wr.writerow(([mname] if many else []) + [repr(float(cols[c][i]) + 0.0) for c in COLUMNS]
+                    wr.writerow(([mname] if many else []) + [repr(float(cols[c][i]) + 0.0) for c in columns]
                                 + [str(bool(flags[c][i])) for c in CHECK_COLUMNS])
         with atomic_write(sidecar_path(args.out)) as fh:
             fh.write(json.dumps(meta, indent=1) + "\n")
@@ -139,7 +147,8 @@ def run(args):
         return {"tau": r.tau, "R": r.R, "C_d0": r.C_d0, "model": r.model, "fidelity": r.fidelity,
                 "voltage": strip.voltage, "thickness_total": strip.thickness, "half_thickness_e": strip.e,
                 "diffusion_coefficient": material.D, "seconds": r.seconds, "notes": r.notes, "message": r.message,
-                "waveform": drive, "beam": args.beam, "warnings": r.warnings}
+                "waveform": drive, "beam": args.beam, "warnings": r.warnings, "tol": args.tol,
+                "valid_from": r.extra.get("valid_from")}
 
     for mname in models:  # the forward model's flags, one line each (also in --json's "warnings")
         for w in results[mname].warnings:

@@ -197,12 +197,15 @@ class StepResult:
     fidelity, model : str
     notes : list of str           what the model leaves out (water transport, inertia, D source)
     success : bool ; message : str
-    extra : dict                  solver details (pnp: mesh, energy balance, charge error)
+    extra : dict                  solver details (pnp: mesh, energy balance, charge error; with ``tol``:
+                                  the rung ladder and the circuit's validity window ``valid_from``, s)
     seconds : float
     checks : dict                 check name (``forward.model.CHECKS``) -> bool array (n,): the
                                   forward model's checks at each time point (a failed model
                                   assumption keeps the numbers; :attr:`warnings` says which)
     warnings : list of str        one line per failed model assumption (count of time points)
+    sigma_error : ndarray         error estimate of sigma (C/m^2) at each time; NaN for the circuit
+                                  without ``tol``
     """
 
     t: np.ndarray
@@ -234,6 +237,7 @@ class StepResult:
         for v in self.checks.values():
             out &= v
         return out
+    sigma_error: np.ndarray | None = None
 
 
 @jit
@@ -407,7 +411,7 @@ def circuit_response(t, phi0_fun, strip: Strip, perm: Permittivity, material: Ma
 def step_response(voltage=1.0, duration=None, *, strip: Strip | None = None, model="constant",
                   fidelity="circuit", material: Material | None = None, t=None, points: int = 1000,
                   waveform_kind="step", ramp_time=None, frequency=None, pnp_options=None, beam="quasi-static",
-                  viscous_modulus=0.0, n_modes=TIME_MODES) -> StepResult:
+                  viscous_modulus=0.0, n_modes=TIME_MODES, tol: float | None = None) -> StepResult:
     """Charging transient of the strip under an imposed ``phi0(t)`` (starting uncharged at t = 0).
 
     Parameters
@@ -440,6 +444,14 @@ def step_response(voltage=1.0, duration=None, *, strip: Strip | None = None, mod
         ``eta_E`` (Pa s) of the Kelvin-Voigt law; default 0 (no source gives a value).
     n_modes : int
         Modes kept (the static correction makes the tail negligible).
+    tol : float, optional
+        Relative tolerance on ``sigma`` (relative to ``max |sigma|`` over the times), in [1e-8, 0.5).
+        Picks the cheapest rung that meets it at every output time, starting at ``fidelity``
+        (circuit, then pnp): the circuit's error is bounded by comparison with a PNP run whose own
+        (Richardson) error estimate is ``tol/10`` on a coarse mesh, ``|sigma_c - sigma_pnp| +
+        error_pnp``; when it fails, the PNP at ``tol`` is returned (``fidelity`` says which).
+        Without ``tol`` the circuit carries no error estimate (``sigma_error`` NaN) and the
+        PNP its default tolerance (1e-6).
 
     Returns
     -------
@@ -463,20 +475,41 @@ def step_response(voltage=1.0, duration=None, *, strip: Strip | None = None, mod
     tout = tgrid
     if dyn is not None:
         tgrid, keep = _beam_grid(tgrid, dyn.period)
+    sig_err = np.full(tgrid.size, np.nan)
+    opts = dict(pnp_options or {})
+    r = None
+    if tol is not None:
+        tol = check_finite("tol", tol, "a relative tolerance in [1e-8, 0.5)")
+        if not 1e-8 <= tol < 0.5:
+            raise ValueError(f"tol must be in [1e-8, 0.5) (relative on sigma); got {tol!r}")
+        opts["tol"] = min(tol, 9e-3)
     if fidelity == "circuit":
         sigma, u, J = circuit_response(tgrid, fun, s, perm, m)
         success, message = True, "reduced model integrated (variable-step BDF2, 2 substeps per output interval)"
-    else:
-
-        r = solve_transient(tgrid, fun, s, perm, m, **(pnp_options or {}))
+        if tol is not None:
+            r, sig_err = _circuit_error(sigma, tgrid, fun, s, perm, m, opts)
+            scale = float(np.max(np.abs(sigma)))
+            bad = sig_err > tol * scale
+            # validity window: from the first output time after which every later one meets tol
+            extra["valid_from"] = (float(tgrid[0]) if not bad.any() else
+                                   float(tgrid[np.nonzero(bad)[0][-1] + 1]) if not bad[-1] else None)
+            extra["circuit_error_max_rel"] = float(np.max(sig_err)) / scale
+            if bad.any():
+                fidelity = "pnp"
+                notes.append(f"fidelity escalated circuit -> pnp: the circuit's error bound "
+                             f"{extra['circuit_error_max_rel']:.2g} (relative) exceeds tol = {tol:g}")
+    if fidelity == "pnp":
+        if r is None:
+            r = solve_transient(tgrid, fun, s, perm, m, **opts)
         if not r.success:
             raise RuntimeError(f"transient PNP solver failed: {r.message}")
+        sig_err = r.sigma_error
         sigma, J = r.sigma, r.current_density
         # the voltage left across the layers: phi0 minus the ohmic drop of the core (exact at
         # t = 0+ and t -> infinity; the bulk's displacement current is O(lambda) of J)
         u = fun(tgrid) - core_resistance(s.thickness, m) * J
         success, message = r.success, r.message
-        extra = r.extra
+        extra = dict(extra, **r.extra)
         notes.append("pnp: M_A(t) is the layers' quasi-static moment at the layer voltage phi0 - R J; the moment of the transient "
                      "profiles (p' = (C + A3) E, which adds the pressure gradient of the ohmic core field) is in "
                      "extra['M_A_profiles']")
@@ -499,13 +532,15 @@ def step_response(voltage=1.0, duration=None, *, strip: Strip | None = None, mod
         extra = dict(extra, theta_quasi_static=th[keep], w_quasi_static=w[keep], F_block_quasi_static=Fb[keep],
                      beam_frequencies={"clamped-free": natural_frequencies("clamped-free", dyn.beam, 3).tolist(),
                                        "clamped-pinned": natural_frequencies("clamped-pinned", dyn.beam, 3).tolist()})
-        sigma, J, u, M, th, w, Fb, applied = (a[keep] for a in (sigma, J, u, M, thd, wd, Fd, applied))
+        sigma, J, u, M, th, w, Fb, applied, sig_err = (a[keep] for a in (sigma, J, u, M, thd, wd, Fd, applied,
+                                                                           np.asarray(sig_err)))
         checks = {c: v[keep] for c, v in checks.items()}
         tgrid = tout
     return StepResult(t=tgrid, phi0=applied, sigma=sigma, current_density=J, layer_voltage=u, M_A=M,
                       theta=th, w=w, F_block=Fb, tau=tau, R=R, C_d0=0.5 * capacitance_scale(perm, m),
                       fidelity=fidelity, model=perm.name, notes=notes, success=success, message=message,
-                      extra=extra, seconds=time.perf_counter() - t0, checks=checks, warnings=warns)
+                      extra=extra, seconds=time.perf_counter() - t0, checks=checks, warnings=warns,
+                      sigma_error=sig_err)
 
 
 def circuit_impedance_error(f, thickness, perm: Permittivity, material: Material):
@@ -555,6 +590,25 @@ def circuit_band(f, error, tol):
         else:
             i += 1
     return out
+
+
+def _circuit_error(sigma_c, t, fun, strip, perm, material, opts):
+    """Bound on the circuit's sigma error at each time: ``|sigma_c - sigma_pnp| + error_pnp``.
+
+    The reference is the PNP solver at a tenth of the tolerance, its mesh ladder started coarse
+    (``refine`` 1/4; its own Richardson estimate refines it when that is not enough); it is
+    also the pnp rung when the circuit fails.  Returns ``(pnp result, bound)``.
+    """
+    if perm.eps0 == 0.0:
+        raise ValueError("tol: the linear model has no PNP rung (eps -> 0 at the anode), so the circuit's "
+                         "error cannot be bounded; drop tol or use another model")
+    o = dict(opts)
+    o["tol"] = 0.1 * o["tol"]
+    o.setdefault("refine", 0.25)
+    r = solve_transient(t, fun, strip, perm, material, **o)
+    if not r.success:
+        raise RuntimeError(f"transient PNP solver failed (the reference for the circuit's error): {r.message}")
+    return r, np.abs(sigma_c - r.sigma) + r.sigma_error
 
 
 @dataclass

@@ -25,50 +25,102 @@ TAU = float(time_constant(S0.thickness))
 
 def _pnp(V, t, **kw):
     kw.setdefault("moment", False)
+    kw.setdefault("tol", None)
     return solve_transient(t, waveform("step", V), S0, "constant", NAFION_LI, **kw)
 
 
 def test_charge_conserved_to_1e_10():
     t = np.linspace(0, 3 * TAU, 31)
     for f in (waveform("ramp", 1.5, ramp_time=TAU), waveform("sine", 0.8, frequency=1 / TAU)):
-        r = solve_transient(t, f, S0, "affine", NAFION_LI, moment=False, profiles=True)
+        r = solve_transient(t, f, S0, "affine", NAFION_LI, moment=False, profiles=True, tol=None)
         assert r.success
         assert np.max(np.abs(r.total_charge)) <= 1e-10
         # cations: int c dx = 2 (independent of the state's construction: from the profiles)
         assert np.all(np.abs(r.c @ np.diff(r.faces) - 2.0) <= 1e-10)
 
 
-def test_energy_balance_of_a_step():
-    """Supplied after t = 0+ = stored + dissipated (constant permittivity), to 1e-6."""
-    r = _pnp(0.25, np.linspace(0, 3 * TAU, 7), energy=True, rtol=1e-9)
+@pytest.mark.parametrize("V,n_tau", [(0.25, 3), (2.0, 40)])
+def test_energy_balance_of_a_step(V, n_tau):
+    """Supplied after t = 0+ = stored + dissipated (constant permittivity), to 1e-6 (2 V: depleted anode layer)."""
+    r = _pnp(V, np.linspace(0, n_tau * TAU, 7), energy=True, rtol=1e-9)
     en = r.extra["energy"]
     assert en["dissipated"] > 0 and en["stored"] > 0
     assert en["relative_residual"] <= 1e-6
 
 
-def test_long_time_limit_is_the_static_charge():
-    for V in (0.1, 1.0):
-        r = _pnp(V, np.array([0.0, 30 * TAU]), moment=True)
-        ref = float(charge(S0.thickness, V, "constant").sigma)
-        assert abs(r.sigma[-1] / ref - 1) < 5e-3  # default mesh; converges (test_mesh_self_convergence)
-        # the moment from the relaxed profiles equals the static moment (A5 I)
-        Ms = quasi_static_mechanics(np.array([V]), S0, MODELS["constant"], NAFION_LI)[0][0]
-        assert r.M_A_profiles[-1] == pytest.approx(Ms, rel=5e-3)
+@pytest.mark.parametrize("model,V", [("constant", 1.0), pytest.param("constant", -0.1, marks=pytest.mark.slow),
+                                     pytest.param("affine", 0.5, marks=pytest.mark.slow)])
+def test_long_time_limit_is_the_static_charge_within_tol(model, V):
+    """At the default tolerance (1e-6 relative) the relaxed charge equals the static charge (closed form,
+    exact up to exp(-core/lambda)), within the run's own error estimate, and so does the profile moment."""
+    tau = float(time_constant(S0.thickness, model))
+    r = solve_transient(np.array([0.0, tau, 30 * tau]), waveform("step", V), S0, model, NAFION_LI)
+    assert r.success, r.message
+    ref = float(charge(S0.thickness, V, model, "corrected").sigma)
+    assert abs(r.sigma[-1] - ref) <= r.sigma_error[-1] <= 1e-6 * abs(ref)
+    Ms = quasi_static_mechanics(np.array([V]), S0, MODELS[model], NAFION_LI)[0][0]
+    assert r.M_A_profiles[-1] == pytest.approx(Ms, rel=1e-5)
+
+
+def test_default_mesh_long_time_limit():
+    r = _pnp(0.1, np.array([0.0, 30 * TAU]), moment=True)
+    ref = float(charge(S0.thickness, 0.1, "constant").sigma)
+    assert abs(r.sigma[-1] / ref - 1) < 5e-3
+    assert np.all(np.isnan(r.sigma_error))
 
 
 def test_mesh_self_convergence():
     """Whole-mesh refinement by 2: second-order convergence to the static charge, and sigma(tau) settles.
 
-    The time integration's tolerance (1e-8) sits far below the mesh errors measured here
-    (2.7e-2, 7.3e-3, 1.9e-3 at refine 1, 2, 4), which it would otherwise blur; tighter
-    tolerances cost ~100x the time for the same ratios."""
+    The time integration's tolerance (1e-10) sits far below the mesh errors measured here
+    (~3e-2, 7e-3, 2e-3 at refine 1, 2, 4 with one cell per Debye length)."""
     t = np.array([0.0, TAU, 30 * TAU])
-    s = [_pnp(0.1, t, cells_per_debye=1, refine=rf, rtol=1e-8, atol=1e-12).sigma for rf in (1, 2, 4)]
+    s = [_pnp(0.1, t, cells_per_debye=1, refine=rf, rtol=1e-10, atol=1e-14).sigma for rf in (1, 2, 4)]
     ref = float(charge(S0.thickness, 0.1, "constant").sigma)
     e = [abs(x[-1] / ref - 1) for x in s]
-    assert e[1] < e[0] / 3 and e[2] < e[1] / 3  # ~4 for second order
+    assert 3.5 < e[0] / e[1] < 4.5 and 3.5 < e[1] / e[2] < 4.5  # second order
     d1, d2 = abs(s[0][1] - s[1][1]), abs(s[1][1] - s[2][1])
-    assert d2 < d1 / 3
+    assert 3.5 < d1 / d2 < 4.5
+
+
+@pytest.mark.slow
+def test_tolerance_run_agrees_with_a_twice_refined_run():
+    """The extrapolation from levels (1, 2, 4) and the one from (2, 4, 8): within the sum of their estimates."""
+    t = np.array([0.0, 0.01 * TAU, 0.1 * TAU, TAU, 5 * TAU])
+    a = _pnp(1.0, t, tol=1e-6)
+    b = _pnp(1.0, t, tol=1e-6, refine=2.0)
+    assert a.success and b.success
+    assert np.all(np.abs(a.sigma - b.sigma) <= a.sigma_error + b.sigma_error)
+    assert np.max(a.sigma_error) <= 1e-6 * np.max(np.abs(a.sigma))
+
+
+def test_tolerance_refused_beyond_the_cell_cap():
+    r = _pnp(1.0, np.array([0.0, TAU]), tol=1e-9, max_cells=1500)
+    assert not r.success and "max_cells" in r.message and "\n" not in r.message
+    with pytest.raises(RuntimeError, match="max_cells"):
+        step_response(1.0, TAU, fidelity="pnp", points=3, pnp_options={"tol": 1e-9, "max_cells": 3000})
+
+
+@pytest.mark.parametrize("model,V", [("constant", 1.0), ("affine", -0.5)])
+def test_analytic_jacobian_against_finite_differences(model, V):
+    from ipmc_asym.dynamics.transient import _Problem, make_fv_mesh
+    from ipmc_asym.model import groups
+
+    perm = MODELS[model]
+    lam = float(groups.debye_length(S0.thickness, perm.eps_moy, NAFION_LI))
+    rho = perm.eps0 / perm.eps_moy
+    psi0 = V / float(groups.thermal_voltage(NAFION_LI))
+    X = make_fv_mesh(lam, abs(psi0), rho, cells_per_debye=1.0)
+    P = _Problem(X, lam, rho, lambda t: psi0, 0.0)
+    S = 1e-4 * np.cumsum(np.random.default_rng(1).normal(size=P.N - 1))
+    lo, di, up, u, v = P.jacobian(S, 0.0)
+    J = np.diag(di) + np.diag(lo, -1) + np.diag(up, 1) + np.outer(u, v)
+    Jn = np.empty_like(J)
+    for k in range(S.size):
+        dS = np.zeros(S.size)
+        dS[k] = 1e-7
+        Jn[:, k] = (P.rhs(0.0, S + dS, False) - P.rhs(0.0, S - dS, False)) / 2e-7
+    assert np.max(np.abs(J - Jn)) <= 1e-6 * np.max(np.abs(Jn))
 
 
 def test_time_step_self_convergence():
@@ -140,7 +192,7 @@ def test_small_signal_against_a_small_sine_in_the_pnp_solver():
         per = 1 / f
         t = np.linspace(0, 8 * per, 8 * 32 + 1)
         r = solve_transient(t, waveform("sine", amp, frequency=f), S0, "constant", NAFION_LI, moment=False,
-                            rtol=1e-9, atol=1e-16)
+                            rtol=1e-9, atol=1e-16, tol=None)
         sel = t >= 6 * per
         A = np.column_stack([np.sin(2 * math.pi * f * t[sel]), np.cos(2 * math.pi * f * t[sel])])
         a, b = np.linalg.lstsq(A, r.current_density[sel], rcond=None)[0]
@@ -173,3 +225,50 @@ def test_charge_claims_rows_follow_their_criteria():
         assert e0[m] == pytest.approx(MODELS[m].eps_moy / lam, rel=1e-9)
     # tau against the test's own formula; the verdicts are pinned in the validate golden file
     assert tim["numbers"]["tau"]["constant"] == pytest.approx(TAU)
+
+
+def _ladder_case(model, V, thickness, tol):
+    """The circuit's error bound (from step_response with tol) against an independent PNP run at 1e-6."""
+    s = Strip(thickness=thickness)
+    tau = float(time_constant(thickness, model))
+    t = tau * np.array([0.0, 0.01, 0.03, 0.1, 0.3, 1.0, 2.0, 5.0])
+    r = step_response(V, strip=s, model=model, t=t, tol=tol)
+    ref = solve_transient(t, waveform("step", V), s, model, NAFION_LI, tol=1e-6, moment=False)
+    assert ref.success, ref.message
+    sc, _, _ = circuit_response(t, waveform("step", V), s, MODELS[model], NAFION_LI)
+    scale = np.max(np.abs(ref.sigma))
+    # the bound holds at every output time (the reference's own error added)
+    assert np.all(np.abs(r.sigma - ref.sigma) <= r.sigma_error + ref.sigma_error)
+    if r.fidelity == "circuit":
+        assert np.max(r.sigma_error) <= tol * np.max(np.abs(r.sigma))
+    else:  # escalated: the circuit alone misses tol somewhere, and the pnp rung meets it
+        assert np.max(np.abs(sc - ref.sigma)) > tol * scale
+        assert np.max(r.sigma_error) <= tol * scale
+    return r
+
+
+def test_step_tol_keeps_the_circuit_where_it_is_accurate():
+    r = _ladder_case("constant", 1.0, S0.thickness, 1e-2)
+    assert r.fidelity == "circuit" and r.extra["valid_from"] == 0.0
+
+
+def test_step_tol_escalates_a_thin_affine_strip_at_2V():
+    """2e = 20 um, affine, 2 V: the circuit is off by tens of percent at 0.01-0.1 tau."""
+    r = _ladder_case("affine", 2.0, 20e-6, 1e-2)
+    assert r.fidelity == "pnp" and any("escalated" in n for n in r.notes)
+    assert r.extra["valid_from"] is None or r.extra["valid_from"] > 0
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("model", ["constant", "affine"])
+@pytest.mark.parametrize("V", [0.05, 1.0, 5.0])
+@pytest.mark.parametrize("thickness", [20e-6, 200e-6, 1e-3])
+def test_step_tol_grid(model, V, thickness):
+    _ladder_case(model, V, thickness, 1e-2)
+
+
+def test_step_tol_refused_for_the_linear_model():
+    with pytest.raises(ValueError, match="linear"):
+        step_response(1.0, TAU, model="linear", points=3, tol=1e-2)
+    with pytest.raises(ValueError, match="tol"):
+        step_response(1.0, TAU, points=3, tol=0.7)

@@ -1,0 +1,43 @@
+"""``ipmc-asym step --tol``: the rung that meets the tolerance, its error estimate, refusals."""
+
+import csv
+import json
+
+import numpy as np
+import pytest
+
+from ipmc_asym.cli import main
+from ipmc_asym.dynamics.circuit import time_constant, waveform
+from ipmc_asym.dynamics.transient import solve_transient
+from ipmc_asym.model.params import NAFION_LI, Strip
+
+
+def test_step_tol_json_carries_the_error_estimate(capsys):
+    assert main(["step", "--voltage", "1V", "--points", "6", "--tol", "1%", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["fidelity"] == "circuit" and out["tol"] == 0.01 and out["valid_from"] == 0.0
+    sig, err = np.array(out["sigma"]), np.array(out["sigma_error"])
+    assert np.all(err <= 0.01 * np.max(np.abs(sig)))
+    # independent check: the PNP solver at its default tolerance
+    ref = solve_transient(np.array(out["t"]), waveform("step", 1.0), Strip(), "constant", NAFION_LI, moment=False)
+    assert np.all(np.abs(sig - ref.sigma) <= err + ref.sigma_error)
+
+
+def test_step_tol_escalates_on_a_thin_affine_strip(tmp_path, capsys):
+    f = tmp_path / "s.csv"
+    tau = float(time_constant(20e-6, "affine"))
+    assert main(["step", "--voltage", "2V", "--thickness", "20um", "--model", "affine", "--tol", "1e-2",
+                 "--duration", f"{0.04 * tau}s", "--points", "5", "--out", str(f)]) == 0
+    rows = list(csv.reader(f.read_text().splitlines()))
+    assert "fidelity = pnp" in rows[0][0] and rows[1][-1] == "sigma_error"
+
+
+@pytest.mark.parametrize("argv", [["--tol", "0"], ["--tol", "2"], ["--tol", "1e-9"], ["--model", "linear", "--tol", "1e-2"]])
+def test_step_tol_refusals_are_one_line(argv, capsys):
+    try:
+        rc = main(["step", "--points", "3", *argv])
+    except SystemExit as ex:  # argparse's own refusal of a malformed value
+        rc = ex.code
+    assert rc == 2
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    assert "tol" in err and "Traceback" not in err
