@@ -29,7 +29,8 @@ def test_step_tol_escalates_on_a_thin_affine_strip(tmp_path, capsys):
     assert main(["step", "--voltage", "2V", "--thickness", "20um", "--model", "affine", "--tol", "1e-2",
                  "--duration", f"{0.04 * tau}s", "--points", "5", "--out", str(f)]) == 0
     rows = list(csv.reader(f.read_text().splitlines()))
-    assert "fidelity = pnp" in rows[0][0] and rows[1][-1] == "sigma_error"
+    meta = json.loads((tmp_path / "s.csv.json").read_text())
+    assert meta["fidelity"] == "pnp" and "sigma_error" in rows[0]
 
 
 @pytest.mark.parametrize("argv", [["--tol", "0"], ["--tol", "2"], ["--tol", "1e-9"], ["--model", "linear", "--tol", "1e-2"]])
