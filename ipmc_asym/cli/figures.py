@@ -16,9 +16,9 @@ MAX_DPI = 600
 
 def register(sub):
     p = sub.add_parser("figures", help=SUMMARIES["figures"])
-    p.add_argument("--out", default="figures",
-                   help="output directory (default figures/, relative to the working directory; only its last "
-                        "level is created)")
+    p.add_argument("--out", required=True, metavar="DIR",
+                   help="output directory (required: no default that would depend on the working directory; "
+                        "only its last level is created)")
     add_size_option(p, "--dpi", default=110, maximum=MAX_DPI, minimum=10, help="resolution in dots per inch (>= 10)")
     p.add_argument("--quick", action="store_true", help="fewer points (for tests)")
     p.add_argument("--bench", default=None, metavar="FILE",

@@ -7,16 +7,16 @@ from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import add_strip_options, fmt_num, material_from_args, new_dir_removed_on_failure, strip_from_args
 from ipmc_asym.io.fileio import check_output_path, make_output_dir
 from ipmc_asym.io.jsonio import dumps
-from ipmc_asym.studies.profiles import PAPER_LAYERS
+from ipmc_asym.studies.profiles import PAPER_LAYERS, compute_all, profile_summary
 
 
 def register(sub):
     p = sub.add_parser("profiles", help=SUMMARIES["profiles"])
     add_strip_options(p, mechanics=False)
     p.add_argument("--model", default="all", choices=model_choices(), help="permittivity model (default all)")
-    p.add_argument("--out", default="figures",
-                   help="output directory for CSV and PNG (default figures/, relative to the working directory; "
-                        "only its last level is created)")
+    p.add_argument("--out", default=None, metavar="DIR",
+                   help="output directory for the CSV and PNG files (only its last level is created); without it "
+                        "the layer summary is printed and no file is written")
     p.add_argument("--json", action="store_true", help="print the layer summary as JSON")
 
 
@@ -25,13 +25,17 @@ def run(args) -> int:
     if strip.voltage <= 0:
         raise ValueError("profiles: voltage must be > 0 (a negative voltage is the mirror image)")
     mat = material_from_args(args)
-    check_output_path(args.out, "dir")
-    from ipmc_asym.plotting.profiles import write_all  # deferred: matplotlib (start-up)
-
     models = model_names() if args.model == "all" else (args.model,)
-    with new_dir_removed_on_failure(args.out):
-        make_output_dir(args.out)
-        out = write_all(args.out, models, strip, mat)
+    if args.out is None:
+        out = {"summaries": [profile_summary(m, strip, mat, res=r) for m, r in compute_all(models, strip, mat).items()],
+               "files": []}
+    else:
+        check_output_path(args.out, "dir")
+        from ipmc_asym.plotting.profiles import write_all  # deferred: matplotlib (start-up)
+
+        with new_dir_removed_on_failure(args.out):
+            make_output_dir(args.out)
+            out = write_all(args.out, models, strip, mat)
     if args.json:
         print(dumps(out, indent=2))
         return 0
@@ -47,4 +51,6 @@ def run(args) -> int:
               f"{fmt_num(pd, '9.3g') if pd is not None else '-':>9s} {fmt_num(pa, '9.3g') if pa is not None else '-':>9s}")
     for f in out["files"]:
         print("wrote", f)
+    if args.out is None:
+        print("no files written (--out DIR writes the profiles as CSV and PNG)")
     return 0

@@ -657,3 +657,14 @@ def test_no_signed_zero_in_printed_numbers():
     assert fmt_num(-4e-8, ".3f") == "0.000" and fmt_num(-1e-9, "9.3f") == "    0.000"
     assert fmt_num(-0.0, "11.4g").strip() == "0" and fmt_num(-0.5, ".3f") == "-0.500"
     assert fmt_num(-1e-20, ".3g") == "-1e-20"  # a small number is not zero
+
+
+def test_no_output_path_defaults_to_the_working_directory(tmp_path, monkeypatch, capsys):
+    """figures needs --out; profiles without --out prints the layers and writes nothing."""
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SystemExit) as ex:
+        main(["figures", "--quick"])
+    assert ex.value.code == 2 and "--out" in capsys.readouterr().err
+    assert main(["profiles", "--model", "constant"]) == 0
+    assert "no files written" in capsys.readouterr().out
+    assert list(tmp_path.iterdir()) == []
