@@ -61,7 +61,7 @@ from ipmc_asym.kernels.jit import jit
 from ipmc_asym.model.params import Material, check_positive, second_moment
 
 __all__ = ["SUPPORTS", "DEFAULT_MODES", "VISCOUS_MODULUS_SOURCE", "Beam", "Modes", "hydrated_density",
-           "characteristic", "eigenvalues", "mode_shape", "modes", "natural_frequencies", "transfer",
+           "characteristic", "eigenvalues", "first_resonance", "mode_shape", "modes", "natural_frequencies", "transfer",
            "ModalIntegrator", "viscous_modulus_from_damping_ratio"]
 
 SUPPORTS = ("clamped-free", "clamped-pinned", "clamped-clamped")
@@ -271,6 +271,16 @@ def modes(support, beam: Beam, n=DEFAULT_MODES) -> Modes:
 def natural_frequencies(support, beam: Beam, n=5):
     """Undamped natural frequencies ``f_n = b_n^2 sqrt(EI/(rho A L^4))/(2 pi)`` (Hz)."""
     return eigenvalues(support, n) ** 2 * beam.omega_scale / (2.0 * math.pi)
+
+
+def first_resonance(length, width, thickness, material: Material, support="clamped-free"):
+    """First undamped natural frequency (Hz), vectorised over the geometry (TOTAL width and
+    thickness, m): ``f1 = b1^2 sqrt(E I_p/(rho A L^4))/(2 pi)``, ``b1 = 1.8751`` for a free tip
+    (:func:`eigenvalues`), the same as :func:`natural_frequencies` of :meth:`Beam.from_strip`."""
+    L = np.asarray(length, dtype=float)
+    EI = material.E * second_moment(width, thickness)
+    rhoA = hydrated_density(material) * np.asarray(width, dtype=float) * np.asarray(thickness, dtype=float)
+    return float(eigenvalues(support, 1)[0]) ** 2 * np.sqrt(EI / (rhoA * L**4)) / (2.0 * math.pi)
 
 
 def _static_small(support, beam: Beam):

@@ -65,6 +65,7 @@ import numpy as np
 
 from ipmc_asym.base.registry import fidelity_names, model_names
 from ipmc_asym.base.units import parse_force, parse_length, parse_quantity, parse_voltage
+from ipmc_asym.beam.dynamics import first_resonance
 from ipmc_asym.forward.model import CHECKS, forward
 from ipmc_asym.model.materials import citations
 from ipmc_asym.model.params import NOMINAL_STRIP, Material, check_positive, named_material
@@ -77,7 +78,7 @@ __all__ = ["DesignSpec", "DesignResult", "design", "parse_spec", "load_spec", "O
 INPUTS = ("length", "width", "thickness", "voltage")
 #: outputs (scene-file names) -> unit
 OUTPUTS = {"tip_deflection": "m", "blocking_force": "N", "rotation": "rad", "moment": "N m", "I": "1",
-           "work": "N m", "max_strain": "1"}
+           "work": "N m", "max_strain": "1", "first_resonance": "Hz"}
 #: what a constraint may name -> unit
 CONSTRAINABLE = {**OUTPUTS, "length": "m", "width": "m", "thickness": "m", "voltage": "V", "footprint": "m^2"}
 #: the pattern search stops when its step (in the unit box) is below this
@@ -345,7 +346,8 @@ class _Problem:
                         tol=spec.tol, **kw).withhold()
             w, F = np.abs(r.w), np.abs(r.F_block)
             raw = {"tip_deflection": w, "blocking_force": F, "rotation": np.abs(r.theta), "moment": np.abs(r.M_A),
-                   "I": np.abs(r.I), "work": w * F, "max_strain": np.asarray(r.max_strain, float)}
+                   "I": np.abs(r.I), "work": w * F, "max_strain": np.asarray(r.max_strain, float),
+                   "first_resonance": first_resonance(L, W, T, spec.material)}
             # a design stays inside the model: an output flagged by a failed model assumption (past a
             # quarter turn, strain above the material's limit, beyond the validated voltage, not
             # slender) counts as withheld here, so no design rests on it
@@ -506,7 +508,8 @@ def _point_report(problem: _Problem, x: dict) -> tuple[dict, dict, dict]:
     w, F = num(r.w), num(r.F_block)
     outputs = {"tip_deflection": w, "blocking_force": F, "rotation": num(r.theta), "moment": num(r.M_A),
                "I": num(r.I), "work": (abs(w) * abs(F)) if w is not None and F is not None else None,
-               "max_strain": num(r.max_strain), "footprint": float(x["length"][0] * x["width"][0])}
+               "max_strain": num(r.max_strain), "footprint": float(x["length"][0] * x["width"][0]),
+               "first_resonance": num(first_resonance(*(x[k] for k in INPUTS[:3]), spec.material))}
     checks = {c: bool(np.asarray(getattr(r, c)).reshape(-1)[0]) for c in CHECKS}
     checks["valid"] = bool(np.asarray(r.valid).reshape(-1)[0])
     checks["fidelity_used"] = str(np.asarray(r.fidelity_used).reshape(-1)[0])

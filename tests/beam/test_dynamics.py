@@ -251,3 +251,19 @@ def test_slow_drive_reaches_the_static_result_and_damping_from_a_ratio():
     tr = transfer(f, beam, "clamped-free")
     peak = np.max(np.abs(tr["dynamic_factor"]["w"]))
     assert 8.0 < peak < 12.0
+
+
+def test_first_resonance_vectorised_equals_the_modal_beam():
+    """first_resonance (arrays) = natural_frequencies of Beam.from_strip (scalar), and the
+    textbook f1 = (1.8751^2 / 2 pi L^2) sqrt(E I_p/(rho A)) of a cantilever."""
+    from ipmc_asym.beam.dynamics import Beam, first_resonance, hydrated_density, natural_frequencies
+    from ipmc_asym.model.params import NAFION_LI, second_moment
+
+    L = np.array([0.01, 0.02, 0.04])
+    f = first_resonance(L, 5e-3, 200e-6, NAFION_LI)
+    for Li, fi in zip(L, f):
+        assert fi == pytest.approx(natural_frequencies("clamped-free", Beam.from_strip(Li, 5e-3, 200e-6, NAFION_LI), 1)[0],
+                                   rel=1e-13)
+    EIp = NAFION_LI.E * second_moment(5e-3, 200e-6)
+    rhoA = hydrated_density(NAFION_LI) * 5e-3 * 200e-6
+    np.testing.assert_allclose(f, 1.8751040687**2 / (2 * np.pi * L**2) * np.sqrt(EIp / rhoA), rtol=1e-9)

@@ -175,3 +175,22 @@ def test_membrane_example_meets_every_constraint():
         ok = q.valid & (np.abs(q.F_block) >= 1e-3) & (L * 5e-3 <= 1.5e-4)
         best = max(best, float(np.max(np.where(ok, np.abs(q.F_block * q.w), 0.0))))
     assert res.objective["value"] >= best * (1 - 1e-6)
+
+
+def test_first_resonance_objective_against_a_grid():
+    """The stiffest-fastest strip: the highest first resonance with |w| >= 1 mm, against a dense grid
+    through the same forward model (the resonance is f1 ~ e/L^2, the deflection ~ L^2/e^2)."""
+    from ipmc_asym.beam.dynamics import first_resonance
+    from ipmc_asym.model.params import NAFION_LI
+
+    spec = {"model": "constant", "strip": {"width": "5mm", "voltage": "1V"},
+            "vary": {"length": ["1cm", "4cm"], "thickness": ["100um", "400um"]},
+            "objective": {"maximize": "first_resonance"}, "constraints": {"tip_deflection": {"min": "1mm"}}}
+    r = design(spec, pareto=False)
+    f_opt = r.optimum["outputs"]["first_resonance"]
+    L, T = np.meshgrid(np.linspace(0.01, 0.04, 300), np.linspace(100e-6, 400e-6, 300))
+    fw = forward(L, 5e-3, T, 1.0, model="constant", fidelity="corrected")
+    ok = (np.abs(fw.w) >= 1e-3) & np.asarray(fw.valid)
+    best = np.max(np.where(ok, first_resonance(L, 5e-3, T, NAFION_LI), -np.inf))
+    assert f_opt >= best * (1 - 1e-6)
+    assert abs(abs(r.optimum["outputs"]["tip_deflection"]) - 1e-3) <= 1e-6  # the constraint is active
