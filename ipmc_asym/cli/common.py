@@ -21,7 +21,7 @@ __all__ = ["UsageError", "Parser", "add_strip_options", "add_material_options", 
            "scene_with_material",
            "material_from_args", "strip_from_args",
            "arg_type", "count_type", "join_negative_values", "fmt_num", "c_moy_label", "length_type", "pressure_type",
-           "voltage_type", "tol_type", "first_run_notice", "diffusion_type", "add_size_option", "check_size_caps",
+           "voltage_type", "tol_type", "first_run_notice", "diffusion_type", "sidecar_path", "add_size_option", "check_size_caps",
            "seed_type", "model_help"]
 
 
@@ -345,6 +345,12 @@ def new_dir_removed_on_failure(path):
             with contextlib.suppress(OSError):
                 os.rmdir(path)
         raise
+
+
+def sidecar_path(out: str) -> str:
+    """The metadata file beside a CSV of time series: ``x.csv`` -> ``x.csv.json`` (tau, thickness,
+    model, units): the CSV keeps one header row, which ``pandas.read_csv`` reads as is."""
+    return out + ".json"
 
 
 def first_run_notice():

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import sys
 
 import numpy as np
@@ -16,10 +17,11 @@ from ipmc_asym.cli.common import (
     diffusion_type,
     first_run_notice,
     material_from_args,
+    sidecar_path,
     strip_from_args,
 )
 from ipmc_asym.dynamics.circuit import BEAM_CHOICES
-from ipmc_asym.dynamics.drive import DRIVE_COLUMNS, MAX_DRIVE_POINTS, drive_chunks, drive_info
+from ipmc_asym.dynamics.drive import CHECK_COLUMNS, DRIVE_COLUMNS, MAX_DRIVE_POINTS, drive_chunks, drive_info
 from ipmc_asym.dynamics.waveforms import parse_waveform
 from ipmc_asym.io.fileio import atomic_write, check_output_path
 from ipmc_asym.io.jsonio import dumps
@@ -73,17 +75,30 @@ def register(sub):
     p.add_argument("--diffusion", type=diffusion_type(), default=None,
                    help="cation diffusion coefficient D (1e-10m2/s, 1e-6cm2/s; a bare number is m^2/s)")
     add_beam_options(p, "dynamic")
-    p.add_argument("--out", default=None, help="CSV file, written as computed (columns " + ", ".join(DRIVE_COLUMNS) + ")")
+    p.add_argument("--out", default=None, help="CSV file, written as computed (columns " + ", ".join(DRIVE_COLUMNS)
+                   + ", then the forward model's check_* and valid per time point, 1 or 0)")
     p.add_argument("--json", action="store_true", help=f"print one JSON object (at most {MAX_JSON_POINTS:g} points)")
 
 
+COLUMNS = DRIVE_COLUMNS + CHECK_COLUMNS
+
+
 def _csv_rows(chunk):
-    cols = [("f", np.ascontiguousarray(chunk[c], dtype=float)) for c in DRIVE_COLUMNS]
+    cols = [("f", np.ascontiguousarray(chunk[c], dtype=float) + 0.0) for c in COLUMNS]  # + 0.0: no "-0"
     text = format_table(cols, [""] + [","] * (len(cols) - 1), 17, nonfinite="nan", row_end="\n", row_sep="")
     if text is None:  # a rounding too close to call for the compiled formatter: Python's repr
         n = chunk["t"].size
-        text = "".join(",".join(repr(float(chunk[c][i])) for c in DRIVE_COLUMNS) + "\n" for i in range(n))
+        text = "".join(",".join(repr(float(chunk[c][i]) + 0.0) for c in COLUMNS) + "\n" for i in range(n))
     return text
+
+
+def _note_warnings(ch, seen, counts):
+    """Collect a chunk's assumption warnings (first text of each) and count the failed points per check."""
+    for w in ch["warnings"]:
+        key = w.split(":")[0]
+        seen.setdefault(key, w)
+    for c in CHECK_COLUMNS[:-1]:
+        counts[c] = counts.get(c, 0) + int(np.count_nonzero(ch[c] == 0.0))
 
 
 def run(args):
@@ -93,6 +108,7 @@ def run(args):
         raise ValueError(f"--json holds every row in memory: --points at most {MAX_JSON_POINTS:g} (use --out F.csv)")
     if args.out:
         check_output_path(args.out, "file")
+        check_output_path(sidecar_path(args.out), "file")
     material = material_from_args(args)
     if args.diffusion is not None:
         material = material.with_(D=args.diffusion)
@@ -108,14 +124,16 @@ def run(args):
                        beam=args.beam, viscous_modulus=args.viscous_modulus)
     show = set(np.unique(np.linspace(0, args.points - 1, min(args.points, 11)).astype(int)).tolist())
     shown, kept = [], []
+    seen, counts = {}, {}
     i0 = 0
     if args.out:
+        # one header row (pandas.read_csv reads it as is); the metadata in the sidecar F.csv.json
+        with atomic_write(sidecar_path(args.out)) as fh:
+            fh.write(dumps({"csv": os.path.basename(args.out), **head}, indent=1) + "\n")
         with atomic_write(args.out) as fh:
-            fh.write(f"# drive {args.waveform.spec}; thickness_total = {strip.thickness!r} m; model = {info['model']}; "
-                     f"beam = {args.beam}; tau = {info['tau']!r} s; SI units; "
-                     f"{'; '.join(info['notes'][:1])}\n")
-            fh.write(",".join(DRIVE_COLUMNS) + "\n")
+            fh.write(",".join(COLUMNS) + "\n")
             for ch in gen:
+                _note_warnings(ch, seen, counts)
                 fh.write(_csv_rows(ch))
                 n = ch["t"].size
                 shown += [{c: float(ch[c][i - i0]) for c in DRIVE_COLUMNS} for i in range(i0, i0 + n) if i in show]
@@ -123,15 +141,22 @@ def run(args):
         sys.stderr.write(f"drive: {args.points} rows -> {args.out}\n")
     else:
         for ch in gen:
+            _note_warnings(ch, seen, counts)
             n = ch["t"].size
             if args.json:
                 kept.append(ch)
             shown += [{c: float(ch[c][i - i0]) for c in DRIVE_COLUMNS} for i in range(i0, i0 + n) if i in show]
             i0 += n
+    # the forward model's failed assumptions: one line each (kept numbers, flagged rows)
+    warn_lines = list(seen.values())
+    for w in warn_lines:
+        sys.stderr.write(f"drive: warning: {w}\n")
+    head["warnings"] = warn_lines
     if args.json:
         out = dict(head)
         if kept:
             out.update({c: np.concatenate([k[c] for k in kept]) for c in DRIVE_COLUMNS})
+            out.update({c: np.concatenate([k[c] for k in kept]).astype(bool) for c in CHECK_COLUMNS})
         print(dumps(out, indent=1))
         return 0
     print(f"drive {args.waveform.spec}, total thickness 2e = {fmt_length(strip.thickness)}, model {info['model']}, "

@@ -21,6 +21,7 @@ from ipmc_asym.cli.common import (
     fmt_num,
     material_from_args,
     model_help,
+    sidecar_path,
     strip_from_args,
     tol_type,
 )
@@ -41,10 +42,6 @@ MAX_POINTS = 10**5
 #: 1e5 points reach 1 GB); applies where --max-points is left at its default
 MAX_POINTS_PNP = 10**4
 
-
-def sidecar_path(out: str) -> str:
-    """The metadata file beside a step CSV: ``x.csv`` -> ``x.csv.json`` (tau, thickness, model, units)."""
-    return out + ".json"
 
 
 def _duration(text):

@@ -1,8 +1,9 @@
 """Response to any voltage waveform, computed and handed out in chunks (memory independent of the length).
 
 The reduced circuit (:class:`ipmc_asym.dynamics.circuit.CircuitStepper`), the quasi-static
-mechanics of each time point from the one forward model
-(:func:`ipmc_asym.dynamics.circuit.quasi_static_mechanics`) and, with ``beam="dynamic"``, the
+mechanics of each time point from the one forward model and its checks
+(:func:`ipmc_asym.dynamics.circuit.quasi_static_forward`; ``check_*`` and ``valid`` columns,
+one ``warnings`` list per chunk) and, with ``beam="dynamic"``, the
 strip's inertia and damping (:class:`ipmc_asym.dynamics.circuit.BeamDynamics`), each carrying
 its state from one chunk to the next: the rows are those of one run over the whole grid (the
 current's displacement part uses the same central differences, a row is handed out once its
@@ -16,6 +17,7 @@ import math
 import numpy as np
 
 from ipmc_asym.base.registry import check_choice
+from ipmc_asym.base.settings import VALIDATED_VOLTAGE
 from ipmc_asym.beam.dynamics import natural_frequencies
 from ipmc_asym.dynamics.circuit import (
     BEAM_CHOICES,
@@ -23,17 +25,20 @@ from ipmc_asym.dynamics.circuit import (
     BeamDynamics,
     CircuitStepper,
     dynamic_notes,
-    quasi_static_mechanics,
+    quasi_static_forward,
     waveform,
 )
 from ipmc_asym.dynamics.electrode import core_resistance, time_constant
 from ipmc_asym.dynamics.waveforms import Waveform, parse_waveform
+from ipmc_asym.forward.model import CHECKS, assumption_warnings, voltage_reason
 from ipmc_asym.model.params import NAFION_LI, Material, Strip, check_positive
 from ipmc_asym.model.permittivity import get_model
 
-__all__ = ["DRIVE_COLUMNS", "MAX_DRIVE_POINTS", "drive_info", "drive_chunks", "drive_response"]
+__all__ = ["DRIVE_COLUMNS", "CHECK_COLUMNS", "MAX_DRIVE_POINTS", "drive_info", "drive_chunks", "drive_response"]
 
 DRIVE_COLUMNS = ("t", "phi0", "sigma", "current_density", "layer_voltage", "M_A", "theta", "w", "F_block")
+#: the forward model's checks at each time point (1 passed, 0 failed), as in step and estimate
+CHECK_COLUMNS = tuple(f"check_{c}" for c in CHECKS) + ("valid",)
 
 #: cap on the number of output times of one run (each row is ~9 numbers; streamed to a file)
 MAX_DRIVE_POINTS = 100_000_000
@@ -109,11 +114,22 @@ def drive_chunks(wave, duration, points, *, strip: Strip | None = None, model="c
         t = idx * h
         t[-1] = d if stop == n - 1 else t[-1]
         u, ub, sigma = stepper.advance(t)
-        M, th, w, Fb = quasi_static_mechanics(u, s, perm, m)
+        # every time point through the forward model and its checks (the same as step's and estimate's)
+        fr = quasi_static_forward(u, s, perm, m)
+        M, th, w, Fb = (np.asarray(getattr(fr, k), dtype=float) for k in ("M_A", "theta", "w", "F_block"))
+        phi = fun(t)
+        checks = {c: np.asarray(getattr(fr, c), bool).reshape(-1) for c in CHECKS}
+        warns = assumption_warnings(fr)
+        over = np.abs(phi) > VALIDATED_VOLTAGE  # the applied voltage too: the layers' one lags behind it
+        if np.any(over & checks["voltage"]):
+            checks["voltage"] = checks["voltage"] & ~over
+            warns = [x for x in warns if "VALIDATED_VOLTAGE" not in x] + [voltage_reason(np.max(np.abs(phi)))]
+        valid = np.logical_and.reduce([checks[c] for c in CHECKS])
         if dyn is not None:
             th, w, Fb = dyn.advance(t, M, th, w, Fb)
-        cols = {"t": t, "phi0": fun(t), "sigma": sigma, "layer_voltage": u, "M_A": M, "theta": th, "w": w,
-                "F_block": Fb, "_ub": ub}
+        cols = {"t": t, "phi0": phi, "sigma": sigma, "layer_voltage": u, "M_A": M, "theta": th, "w": w,
+                "F_block": Fb, "_ub": ub, **{f"check_{c}": checks[c].astype(float) for c in CHECKS},
+                "valid": valid.astype(float)}
         if held is not None:  # the first row of this chunk repeats the held one
             cols = {k: v[1:] for k, v in cols.items()}
             cols = {k: np.concatenate(([held[k]], cols[k])) for k in cols}
@@ -128,14 +144,14 @@ def drive_chunks(wave, duration, points, *, strip: Strip | None = None, model="c
             g = g[1:]
         emit = slice(None) if last else slice(0, -1)
         J = uu / R + Cg * g
-        out = {k: cols[k][emit] for k in DRIVE_COLUMNS if k != "current_density"}
+        out = {k: cols[k][emit] for k in DRIVE_COLUMNS + CHECK_COLUMNS if k != "current_density"}
         out["current_density"] = J[emit]
         if not last:
             held = {k: v[-1] for k, v in cols.items()}
             prev = (tt[-2], uu[-2])
         else:
             held = {}
-        yield {k: out[k] for k in DRIVE_COLUMNS}
+        yield {**{k: out[k] for k in DRIVE_COLUMNS + CHECK_COLUMNS}, "warnings": warns}
         start = stop
         if last:
             break
@@ -144,4 +160,4 @@ def drive_chunks(wave, duration, points, *, strip: Strip | None = None, model="c
 def drive_response(wave, duration, points=1000, **kw):
     """All rows of :func:`drive_chunks` in memory (dict of arrays), for short runs and tests."""
     parts = list(drive_chunks(wave, duration, points, **kw))
-    return {k: np.concatenate([p[k] for p in parts]) for k in DRIVE_COLUMNS}
+    return {k: np.concatenate([p[k] for p in parts]) for k in DRIVE_COLUMNS + CHECK_COLUMNS}

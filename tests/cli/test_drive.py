@@ -3,9 +3,11 @@
 import csv
 import json
 
+import numpy as np
 import pytest
 
 from ipmc_asym.cli import main
+from ipmc_asym.forward.model import CHECKS
 
 
 def test_drive_csv_streamed(tmp_path, capsys):
@@ -13,11 +15,30 @@ def test_drive_csv_streamed(tmp_path, capsys):
     assert main(["drive", "--waveform", "dc:0.2V+sine:0.5V@10Hz", "--duration", "0.2s", "--points", "801",
                  "--out", str(f)]) == 0
     rows = list(csv.reader(f.read_text().splitlines()))
-    assert rows[0][0].startswith("# drive dc:0.2V+sine:0.5V@10Hz") and "Darcy" in ",".join(rows[0])
-    assert rows[1] == ["t", "phi0", "sigma", "current_density", "layer_voltage", "M_A", "theta", "w", "F_block"]
-    assert len(rows) == 803 and float(rows[-1][0]) == pytest.approx(0.2)
-    assert float(rows[2][1]) == pytest.approx(0.2)
+    meta = json.loads((tmp_path / "d.csv.json").read_text())  # the metadata beside the CSV
+    assert meta["waveform"] == "dc:0.2V+sine:0.5V@10Hz" and any("Darcy" in n for n in meta["notes"])
+    assert rows[0][:9] == ["t", "phi0", "sigma", "current_density", "layer_voltage", "M_A", "theta", "w", "F_block"]
+    assert rows[0][9:] == [f"check_{c}" for c in CHECKS] + ["valid"]
+    assert len(rows) == 802 and float(rows[-1][0]) == pytest.approx(0.2)
+    assert float(rows[1][1]) == pytest.approx(0.2)
+    assert all(r[-1] == "1" for r in rows[1:])  # a small drive: every time point inside the model
     assert not list(tmp_path.glob(".*part"))
+
+
+def test_drive_flags_time_points_like_estimate(capsys):
+    """A 5 V step on the affine strip: the drive's check columns are the forward model's at the
+    layer voltage (estimate's checks at the same voltage), and the warnings name the limits."""
+    from ipmc_asym.dynamics.drive import drive_response
+    from ipmc_asym.forward.model import forward
+
+    r = drive_response("step:5V", 1.0, 20, model="affine", beam="quasi-static")
+    f = forward(0.02, 5e-3, 200e-6, r["layer_voltage"], model="affine", fidelity="corrected")
+    for c in CHECKS:
+        assert np.array_equal(r[f"check_{c}"].astype(bool), np.asarray(getattr(f, c), bool)), c
+    assert main(["drive", "--waveform", "step:5V", "--duration", "1s", "--points", "20", "--model", "affine",
+                 "--beam", "quasi-static"]) == 0
+    err = capsys.readouterr().err
+    assert "drive: warning:" in err and "strain" in err and "quarter" in err
 
 
 def test_drive_json_and_step_model_all(capsys):
