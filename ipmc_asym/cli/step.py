@@ -26,15 +26,18 @@ from ipmc_asym.cli.common import (
     tol_type,
 )
 from ipmc_asym.cli.drive import add_beam_options
-from ipmc_asym.dynamics.circuit import STEP_FIDELITIES, step_response
+from ipmc_asym.dynamics.circuit import STEP_FIDELITIES, step_response, waveform
+from ipmc_asym.dynamics.drive import (
+    CHECK_COLUMNS,  # per time point: the forward model's checks, as drive
+    drive_chunks,
+    drive_info,
+)
 from ipmc_asym.dynamics.waveforms import parse_waveform
 from ipmc_asym.forward.model import CHECKS
 from ipmc_asym.io.fileio import atomic_write, check_output_path
 from ipmc_asym.io.jsonio import dumps
 
 COLUMNS = ("t", "phi0", "sigma", "current_density", "M_A", "theta", "w")
-#: per time point: the forward model's checks (forward.model.CHECKS), as in estimate and sweep
-CHECK_COLUMNS = tuple(f"check_{c}" for c in CHECKS) + ("valid",)
 #: output times of one run: the arrays of the integrator (~2 substeps per interval) and of the
 #: forward model stay ~100 MB; settable with --max-points
 MAX_POINTS = 10**5
@@ -54,6 +57,46 @@ def _duration(text):
 def _num(x, scale):
     """A withheld (NaN) value as n/a, like estimate."""
     return fmt_num(x * scale if np.isfinite(x) else None, ".4g")
+
+
+def _stream_csv(args, strip, material, models) -> int:
+    """``step --out F.csv`` at circuit fidelity with the quasi-static beam: each model's rows are
+    computed and written chunk by chunk (:func:`ipmc_asym.dynamics.drive.drive_chunks`: the same
+    circuit, the same forward model and checks per time point), so the memory does not grow with
+    ``--points``; the other cases (pnp, ``--tol``, the dynamic beam, ``--json``) run in memory."""
+    many = len(models) > 1
+    drive = "step" if args.waveform is None else args.waveform.spec
+    wave = args.waveform if args.waveform is not None else waveform("step", strip.voltage)
+    infos = {m: drive_info(strip, m, material, "quasi-static") for m in models}
+    seen, n_rows = {}, 0
+    with atomic_write(args.out) as fh:
+        wr = csv.writer(fh)
+        wr.writerow((("model",) if many else ()) + COLUMNS + CHECK_COLUMNS)
+        for mname in models:
+            duration = args.duration if args.duration is not None else 5.0 * infos[mname]["tau"]
+            for ch in drive_chunks(wave, duration, args.points, strip=strip, model=mname, material=material,
+                                   beam="quasi-static"):
+                for w in ch["warnings"]:
+                    seen.setdefault((mname, w.split(":")[0]), f"{mname}: {w}" if many else w)
+                cols = [np.asarray(ch[c], dtype=float) + 0.0 for c in COLUMNS]  # + 0.0: no "-0"
+                flags = [np.asarray(ch[c]) != 0.0 for c in CHECK_COLUMNS]
+                for i in range(ch["t"].size):
+                    wr.writerow(([mname] if many else []) + [repr(float(c[i])) for c in cols]
+                                + [str(bool(f[i])) for f in flags])
+                n_rows += ch["t"].size
+    i0 = infos[models[0]]
+    meta = {"csv": os.path.basename(args.out), "tau": {m: infos[m]["tau"] for m in models} if many else i0["tau"],
+            "thickness_total": strip.thickness, "half_thickness_e": strip.e, "voltage": strip.voltage,
+            "model": args.model, "fidelity": "circuit", "drive": drive, "beam": "quasi-static", "notes": i0["notes"],
+            "warnings": list(seen.values()),
+            "units": {"t": "s", "phi0": "V", "sigma": "C/m^2", "current_density": "A/m^2", "M_A": "N m",
+                      "theta": "rad", "w": "m"}}
+    with atomic_write(sidecar_path(args.out)) as fh:
+        fh.write(json.dumps(meta, indent=1) + "\n")
+    for w in seen.values():
+        sys.stderr.write(f"step: warning: {w}\n")
+    sys.stderr.write(f"step: {n_rows} rows -> {args.out} (streamed; metadata: {sidecar_path(args.out)})\n")
+    return 0
 
 
 def register(sub):
@@ -97,6 +140,8 @@ def run(args):
     strip = strip_from_args(args)
     first_run_notice()
     models = list(model_names()) if args.model == "all" else [args.model]
+    if args.out and args.fidelity == "circuit" and args.tol is None and args.beam == "quasi-static" and not args.json:
+        return _stream_csv(args, strip, material, models)
     kind = args.waveform if args.waveform is not None else "step"
     results = {}
     for mname in models:
