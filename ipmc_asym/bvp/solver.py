@@ -63,6 +63,7 @@ from ipmc_asym.bvp.problems import (
     eps_bar_custom,
     moment_y_linear,
 )
+from ipmc_asym.model import groups
 from ipmc_asym.model.params import NAFION_LI, Groups, Material, Strip, check_finite, check_positive
 from ipmc_asym.model.permittivity import Permittivity, get_model
 
@@ -249,10 +250,10 @@ def solve(strip: Strip, model="constant", material: Material = NAFION_LI, *, tol
     if int(max_nodes) < 10:
         raise ValueError(f"max_nodes must be an integer >= 10; got {max_nodes!r}")
     perm = get_model(model)
-    a2 = abs(float(strip.voltage)) * material.F / (material.R * material.T)
+    a2 = float(groups.A2(strip.voltage, material))
     if 0.0 < a2 < BVP_MIN_A2:
         raise ValueError(
-            f"voltage |phi0| = {abs(float(strip.voltage)):.3g} V is below the {BVP_MIN_A2 * material.R * material.T / material.F:.3g} V "
+            f"voltage |phi0| = {abs(float(strip.voltage)):.3g} V is below the {BVP_MIN_A2 * groups.thermal_voltage(material):.3g} V "
             "the BVP resolves (C - 1 ~ A2 is lost to rounding); the moment integral there is the "
             "Debye-Hueckel series of ipmc_asym.integral.api.moment (any fidelity)")
     g_signed = perm.groups(strip, material)
