@@ -88,7 +88,8 @@ def slender_warnings(length, width, thickness) -> list:
             lim = f">= {lo:g}" if lo is not None and v < lo else f"<= {hi:g}"
             n = int(bad.sum())
             where = "" if r.size == 1 else f" ({n} of {r.size} points)"
-            out.append(f"strip outside the slender-beam model: {k} = {v:.3g}{where}, needs {lim}: {why}; "
+            shown = f"{v:.3g}" if np.isfinite(v) else "> 1e300"  # a ratio that overflows (e.g. L = 5e-324 m)
+            out.append(f"strip outside the slender-beam model: {k} = {shown}{where}, needs {lim}: {why}; "
                        "numbers kept, flagged check_slender = false")
     return out
 

@@ -44,7 +44,9 @@ _NONFINITE = re.compile(r"(?<![A-Za-z_])[-+]?(nan|inf|infinity)(?![A-Za-z_])", r
 FAST = settings(max_examples=12, deadline=None, derandomize=True, database=None,
                 suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture,
                                        HealthCheck.filter_too_much, HealthCheck.data_too_large])
-SLOW = settings(FAST, max_examples=200, derandomize=False)
+#: the long profile is deterministic too: CI must not fail on a new random draw (explore with
+#: ``pytest --hypothesis-seed=<n>`` and a ``settings(derandomize=False)`` of your own)
+SLOW = settings(FAST, max_examples=200, derandomize=True)
 
 
 def _maxrss_bytes(who) -> int:

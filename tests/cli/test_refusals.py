@@ -391,8 +391,8 @@ SIZE_CASES = [
     (["uq", UQ_SCENE, "--samples", "1e12"], "--max-samples"),
     (["uq", UQ_SCENE, "--samples", "1e9"], "--max-samples"),
     (["fit", FIT_DATA, "--free", "modulus", "--multistart", "1e12"], "--max-multistart"),
-    (["figures", "--dpi", "5000", "--quick"], "--max-dpi"),
-    (["figures", "--dpi", "1e6", "--quick"], "--max-dpi"),
+    (["figures", "--dpi", "5000", "--quick", "--out", "figs"], "--max-dpi"),
+    (["figures", "--dpi", "1e6", "--quick", "--out", "figs"], "--max-dpi"),
 ]
 
 
