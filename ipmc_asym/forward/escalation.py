@@ -19,7 +19,7 @@ from ipmc_asym.integral.api import ANY_THICKNESS, check_fidelity, check_min_thic
 from ipmc_asym.model.params import NAFION_LI, Material
 from ipmc_asym.model.permittivity import get_model
 
-__all__ = ["moment_escalating", "Escalated", "check_tol", "rung_checks"]
+__all__ = ["moment_escalating", "Escalated", "check_tol", "rung_checks", "ladder_inputs"]
 
 
 def check_tol(tol, what="tol"):
@@ -74,6 +74,20 @@ class Escalated:
     message: str
 
 
+def ladder_inputs(thickness, voltage, fidelity, tol):
+    """The checked inputs of a ladder climb: ``(tol, limit, thickness, voltage, shape)`` with the
+    inputs broadcast and flattened, ``limit = min(tol, VALIDITY_LIMIT)``, the fidelity and the
+    thickness floor checked (one-line ``ValueError``)."""
+    check_fidelity(fidelity)
+    tol = check_tol(tol)
+    limit = VALIDITY_LIMIT if tol is None else min(tol, VALIDITY_LIMIT)
+    th, v = np.broadcast_arrays(np.asarray(thickness, float), np.asarray(voltage, float))
+    shape = th.shape
+    th, v = th.reshape(-1), v.reshape(-1)
+    check_min_thickness(th)
+    return tol, limit, th, v, shape
+
+
 def moment_escalating(thickness, voltage, model="constant", fidelity="quadrature",
                       material: Material = NAFION_LI, *, tol=None, escalate: bool = True,
                       progress: bool | None = None) -> Escalated:
@@ -99,13 +113,7 @@ def moment_escalating(thickness, voltage, model="constant", fidelity="quadrature
     -------
     Escalated
     """
-    check_fidelity(fidelity)
-    tol = check_tol(tol)
-    limit = VALIDITY_LIMIT if tol is None else min(tol, VALIDITY_LIMIT)
-    th, v = np.broadcast_arrays(np.asarray(thickness, float), np.asarray(voltage, float))
-    shape = th.shape
-    th, v = th.reshape(-1), v.reshape(-1)
-    check_min_thickness(th)
+    tol, limit, th, v, shape = ladder_inputs(thickness, voltage, fidelity, tol)
     perm = get_model(model)
     n = th.size
     I = np.full(n, np.nan)

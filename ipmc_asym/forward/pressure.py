@@ -11,9 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from ipmc_asym.base.registry import fidelity_names
-from ipmc_asym.base.settings import VALIDITY_LIMIT
-from ipmc_asym.forward.escalation import Escalated, check_tol
-from ipmc_asym.integral.api import check_fidelity, check_min_thickness
+from ipmc_asym.forward.escalation import Escalated, ladder_inputs
 from ipmc_asym.integral.pressure import PRESSURE_FIDELITIES, moment_pressure_term
 from ipmc_asym.model.params import NAFION_LI, Material
 
@@ -28,13 +26,7 @@ def moment_pressure_escalating(thickness, voltage, model="constant", fidelity="e
     ------
     ValueError   ``escalate=False`` with a rung that does not hold the pressure term.
     """
-    check_fidelity(fidelity)
-    tol = check_tol(tol)
-    limit = VALIDITY_LIMIT if tol is None else min(tol, VALIDITY_LIMIT)
-    th, v = np.broadcast_arrays(np.asarray(thickness, float), np.asarray(voltage, float))
-    shape = th.shape
-    th, v = th.reshape(-1), v.reshape(-1)
-    check_min_thickness(th)
+    tol, limit, th, v, shape = ladder_inputs(thickness, voltage, fidelity, tol)
     if fidelity not in PRESSURE_FIDELITIES:
         if not escalate:
             raise ValueError(f"pressure_term: fidelity {fidelity!r} does not hold the pressure term; use one of "
