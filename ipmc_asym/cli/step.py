@@ -59,6 +59,30 @@ def _num(x, scale):
     return fmt_num(x * scale if np.isfinite(x) else None, ".4g")
 
 
+#: units of the CSV columns (the sidecar's "units")
+UNITS = {"t": "s", "phi0": "V", "sigma": "C/m^2", "sigma_error": "C/m^2", "current_density": "A/m^2", "M_A": "N m",
+         "theta": "rad", "w": "m"}
+
+
+def _write_rows(wr, model, values, flags):
+    """CSV rows of one model: ``values`` and ``flags`` lists of column arrays (``model`` None: no
+    model column); ``+ 0.0``: no "-0"."""
+    vals = [np.asarray(a, dtype=float) + 0.0 for a in values]
+    for i in range(vals[0].size):
+        wr.writerow(([] if model is None else [model]) + [repr(float(a[i])) for a in vals]
+                    + [str(bool(f[i])) for f in flags])
+
+
+def _sidecar(args, strip, taus, fidelity, drive, beam, notes, **extra) -> None:
+    """The CSV's metadata beside it (one header row in the CSV: ``pandas.read_csv`` reads it as is)."""
+    meta = {"csv": os.path.basename(args.out), "tau": taus if len(taus) > 1 else next(iter(taus.values())),
+            "thickness_total": strip.thickness, "half_thickness_e": strip.e, "voltage": strip.voltage,
+            "model": args.model, "fidelity": fidelity, "drive": drive, "beam": beam, "notes": notes, **extra,
+            "units": UNITS}
+    with atomic_write(sidecar_path(args.out)) as fh:
+        fh.write(json.dumps(meta, indent=1) + "\n")
+
+
 def _stream_csv(args, strip, material, models) -> int:
     """``step --out F.csv`` at circuit fidelity with the quasi-static beam: each model's rows are
     computed and written chunk by chunk (:func:`ipmc_asym.dynamics.drive.drive_chunks`: the same
@@ -78,21 +102,11 @@ def _stream_csv(args, strip, material, models) -> int:
                                    beam="quasi-static"):
                 for w in ch["warnings"]:
                     seen.setdefault((mname, w.split(":")[0]), f"{mname}: {w}" if many else w)
-                cols = [np.asarray(ch[c], dtype=float) + 0.0 for c in COLUMNS]  # + 0.0: no "-0"
-                flags = [np.asarray(ch[c]) != 0.0 for c in CHECK_COLUMNS]
-                for i in range(ch["t"].size):
-                    wr.writerow(([mname] if many else []) + [repr(float(c[i])) for c in cols]
-                                + [str(bool(f[i])) for f in flags])
+                _write_rows(wr, mname if many else None, [ch[c] for c in COLUMNS],
+                            [np.asarray(ch[c]) != 0.0 for c in CHECK_COLUMNS])
                 n_rows += ch["t"].size
-    i0 = infos[models[0]]
-    meta = {"csv": os.path.basename(args.out), "tau": {m: infos[m]["tau"] for m in models} if many else i0["tau"],
-            "thickness_total": strip.thickness, "half_thickness_e": strip.e, "voltage": strip.voltage,
-            "model": args.model, "fidelity": "circuit", "drive": drive, "beam": "quasi-static", "notes": i0["notes"],
-            "warnings": list(seen.values()),
-            "units": {"t": "s", "phi0": "V", "sigma": "C/m^2", "current_density": "A/m^2", "M_A": "N m",
-                      "theta": "rad", "w": "m"}}
-    with atomic_write(sidecar_path(args.out)) as fh:
-        fh.write(json.dumps(meta, indent=1) + "\n")
+    _sidecar(args, strip, {m: infos[m]["tau"] for m in models}, "circuit", drive, "quasi-static",
+             infos[models[0]]["notes"], warnings=list(seen.values()))
     for w in seen.values():
         sys.stderr.write(f"step: warning: {w}\n")
     sys.stderr.write(f"step: {n_rows} rows -> {args.out} (streamed; metadata: {sidecar_path(args.out)})\n")
@@ -165,23 +179,13 @@ def run(args):
     drive = "step" if args.waveform is None else args.waveform.spec
     if args.out:
         many = len(models) > 1
-        # the CSV has one header row (pandas.read_csv reads it as is); the metadata goes to a
-        # sidecar JSON file beside it
-        meta = {"csv": os.path.basename(args.out), "tau": {m: results[m].tau for m in models} if many else r0.tau,
-                "thickness_total": strip.thickness, "half_thickness_e": strip.e, "voltage": strip.voltage,
-                "model": args.model, "fidelity": r0.fidelity, "drive": drive, "beam": args.beam, "notes": r0.notes,
-                "units": {"t": "s", "phi0": "V", "sigma": "C/m^2", "current_density": "A/m^2", "M_A": "N m",
-                          "theta": "rad", "w": "m"}}
         with atomic_write(args.out) as fh:
             wr = csv.writer(fh)
             wr.writerow((("model",) if many else ()) + columns + CHECK_COLUMNS)
             for mname in models:
                 cols, flags = cols_of(results[mname]), flags_of(results[mname])
-                for i in range(results[mname].t.size):
-                    wr.writerow(([mname] if many else []) + [repr(float(cols[c][i]) + 0.0) for c in columns]
-                                + [str(bool(flags[c][i])) for c in CHECK_COLUMNS])
-        with atomic_write(sidecar_path(args.out)) as fh:
-            fh.write(json.dumps(meta, indent=1) + "\n")
+                _write_rows(wr, mname if many else None, [cols[c] for c in columns], [flags[c] for c in CHECK_COLUMNS])
+        _sidecar(args, strip, {m: results[m].tau for m in models}, r0.fidelity, drive, args.beam, r0.notes)
         sys.stderr.write(f"step: {sum(r.t.size for r in results.values())} rows -> {args.out} "
                          f"(metadata: {sidecar_path(args.out)})\n")
 
