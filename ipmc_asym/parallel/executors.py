@@ -29,11 +29,17 @@ arrive warms it under a file lock and the others wait and read (no concurrent ca
 writes).  Chunks are sized by :func:`chunk_slices` to carry >= 100 ms of work each so
 scheduling overhead (~1 ms per dask task) stays below 1 %.
 
+``imap_chunks(func, tasks, scheduler=None)`` yields the same results one at a time, in
+order, with at most ``window`` tasks in flight: a caller that folds each result into an
+accumulator as it arrives (``studies/uq.py``) holds a bounded number of results whatever the
+number of tasks; ``tasks`` may be a generator.
+
 Importing this module imports neither dask nor distributed (deferred).
 """
 
 from __future__ import annotations
 
+import collections
 import contextlib
 import math
 import multiprocessing as mp
@@ -47,7 +53,7 @@ from ipmc_asym.base.registry import FIDELITIES, compiled_fidelities, model_names
 from ipmc_asym.integral.api import moment
 from ipmc_asym.integral.samples import moment_samples
 
-__all__ = ["run_chunks", "chunk_slices", "warm_kernels", "worker_setup", "BLAS_ENV", "MIN_CHUNK_SECONDS",
+__all__ = ["run_chunks", "imap_chunks", "chunk_slices", "warm_kernels", "worker_setup", "BLAS_ENV", "MIN_CHUNK_SECONDS",
            "check_scheduler", "worker_env"]
 
 #: environment of every worker process: one BLAS/OpenMP thread (the parallelism is the workers)
@@ -192,6 +198,83 @@ def run_chunks(func, tasks, scheduler=None, workers: int | None = None, threads:
         raise ValueError(f"--scheduler {scheduler}: cannot connect ({exc.__class__.__name__})") from None
     with client:
         return _on_client(client, func, tasks, threads, fidelities)
+
+
+def imap_chunks(func, tasks, scheduler=None, workers: int | None = None, threads: int = 1,
+                fidelities=COMPILED, window: int | None = None):
+    """Yield ``func(t)`` for ``t`` in ``tasks``, in order, on ``scheduler`` (as :func:`run_chunks`).
+
+    At most ``window`` tasks (default: twice the number of workers) are submitted ahead of
+    the one being yielded, so results not yet consumed, and the tasks themselves (``tasks``
+    is read lazily), stay bounded in number.
+
+    Parameters
+    ----------
+    func, scheduler, workers, threads, fidelities
+        As :func:`run_chunks`.
+    tasks : iterable
+    window : int, optional
+        Tasks in flight (>= 1).
+    """
+    scheduler = check_scheduler(scheduler)
+    tasks = iter(tasks)
+    if scheduler is None:
+        for t in tasks:
+            yield func(t)
+        return
+    warm_kernels(fidelities)  # parent: complete cache before any worker starts
+    nw = workers or os.cpu_count() or 1
+    if hasattr(scheduler, "submit"):
+        yield from _window_client(scheduler, func, tasks, threads, fidelities, window)
+        return
+    if scheduler == "local":
+        try:
+            import distributed  # deferred: heavy import (start-up), optional extra
+        except ImportError:
+            yield from _window_pool(func, tasks, nw, threads, fidelities, window or 2 * nw)
+            return
+        with distributed.LocalCluster(n_workers=nw, threads_per_worker=1, processes=True,
+                                      dashboard_address=":0", env=worker_env(threads)) as cluster, \
+                distributed.Client(cluster) as client:
+            yield from _window_client(client, func, tasks, threads, fidelities, window)
+        return
+    try:
+        import distributed  # deferred: heavy import (start-up), optional extra
+    except ImportError:
+        raise ValueError(f"--scheduler {scheduler}: dask.distributed is not installed "
+                         "(pip install \".[dask]\")") from None
+    try:
+        client = distributed.Client(scheduler, timeout="10s")
+    except (OSError, TimeoutError) as exc:
+        raise ValueError(f"--scheduler {scheduler}: cannot connect ({exc.__class__.__name__})") from None
+    with client:
+        yield from _window_client(client, func, tasks, threads, fidelities, window)
+
+
+def _windowed(submit, tasks, window):
+    """Results of ``submit(t).result()`` in order, ``window`` submissions ahead."""
+    pending = collections.deque()
+    for t in tasks:
+        pending.append(submit(t))
+        if len(pending) >= window:
+            yield pending.popleft().result()
+    while pending:
+        yield pending.popleft().result()
+
+
+def _window_client(client, func, tasks, threads, fidelities, window):
+    client.run(worker_setup, threads, fidelities)
+    nw = max(1, len(client.scheduler_info().get("workers", {})))
+    yield from _windowed(lambda t: client.submit(func, t, pure=False), tasks, window or 2 * nw)
+
+
+def _window_pool(func, tasks, nw, threads, fidelities, window):
+    # spawned workers inherit this environment (workers start on demand: kept while submitting)
+    with _env(worker_env(threads)):
+        ctx = mp.get_context("spawn")
+        with ProcessPoolExecutor(max_workers=nw, mp_context=ctx, initializer=worker_setup,
+                                 initargs=(threads, fidelities)) as ex:
+            yield from _windowed(lambda t: ex.submit(func, t), tasks, window)
 
 
 def _on_client(client, func, tasks, threads, fidelities):

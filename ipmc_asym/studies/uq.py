@@ -50,20 +50,22 @@ from __future__ import annotations
 import math
 import os
 import time
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from ipmc_asym.base.settings import CHUNK_ROWS
+from ipmc_asym.base.streamstats import SKETCH_K, Moments, QuantileSketch
 from ipmc_asym.base.units import parse_length, parse_pressure, parse_voltage
 from ipmc_asym.forward.model import CHECKS, SAMPLING_FIDELITIES, assumption_warnings, forward
 from ipmc_asym.io.datasets import VARIABLES
 from ipmc_asym.model.permittivity import get_model
-from ipmc_asym.parallel.executors import chunk_slices, run_chunks
+from ipmc_asym.parallel.executors import chunk_slices, imap_chunks
 from ipmc_asym.studies.scene_schema import load_scene, parse_scene
 
 __all__ = ["UNCERTAIN", "DISTRIBUTIONS", "OUTPUT_UNITS", "UQResult", "parse_uncertain", "run_uq",
-           "evaluate_samples", "uq_chunk"]
+           "evaluate_samples", "uq_chunk", "uq_stream_chunk", "QUANTILES", "STORE_SAMPLES"]
 
 #: uncertain names -> (unit, long name), as the datasets label them
 UNCERTAIN = {k: VARIABLES[k] for k in ("length", "width", "thickness", "voltage", "modulus", "c_moy")}
@@ -234,19 +236,26 @@ class UQResult:
     Attributes
     ----------
     summary : dict
-        output -> ``{"unit", "mean", "sd", "q2.5", "q50", "q97.5"}`` (SI).
+        output -> ``{"unit", "mean", "sd", "q2.5", "q50", "q97.5", "n"}`` (SI), with each
+        quantile's guaranteed interval ``"q2.5_interval"``, ... ``[low, high]`` (the exact
+        ``np.quantile`` of the same samples lies in it; a single point while the sketch
+        holds every value) and ``"quantile_rank_error"`` (the sketch's rank-error bound,
+        a fraction of ``n``; 0 when exact).
     sobol : dict
         output -> parameter -> ``{"S1", "S1_conf", "ST", "ST_conf"}`` (conf: half-width of
         the 95 % interval, batch means, :func:`_sobol_indices`); ``None`` for an output
         with zero variance.
     inputs : dict   name -> (dist, params) in SI
-    samples : dict  name -> array (n_samples,) of the inputs
-    outputs : dict  name -> array (n_samples,)
+    samples : dict  name -> array (n_stored,) of the inputs: the first ``n_stored`` runs
+        (whole Saltelli groups, at most ``store_samples`` of :func:`run_uq`)
+    outputs : dict  name -> array (n_stored,)
     n_samples, base_n : int
     fidelity : dict  rung -> number of samples settled there
-    checks : dict  check name (``forward.model.CHECKS``) -> bool array (n_samples,)
-    valid : ndarray of bool (n_samples,)   every check passed
-    n_outside : int   samples outside a model assumption (``~valid``)
+    checks : dict  check name (``forward.model.CHECKS``) -> bool array (n_stored,)
+    valid : ndarray of bool (n_stored,)   every check passed
+    n_stored : int  runs kept per sample (``n_samples`` when ``store_samples`` allows)
+    outside_by_check : dict  check name -> samples (of all ``n_samples``) failing it
+    n_outside : int   samples outside a model assumption (of all ``n_samples``)
     keep_invalid : bool   the statistics include the samples outside (else they are left out)
     n_used : int   samples in the quantiles and moments
     n_sobol : int  Saltelli base points (groups of D + 2 rows) in the Sobol' indices
@@ -276,13 +285,16 @@ class UQResult:
     n_sobol: int = 0
     warnings: list = field(default_factory=list)
     seed: int = 0
+    outside_by_check: dict = field(default_factory=dict)
+    n_stored: int = 0
 
     def as_dict(self) -> dict:
         return {"scene": self.scene, "model": self.model, "tolerance": self.tolerance,
                 "n_samples": self.n_samples, "base_n": self.base_n, "fidelity": self.fidelity,
                 "n_outside_model": self.n_outside, "keep_invalid": self.keep_invalid, "n_used": self.n_used,
                 "n_sobol_base_points": self.n_sobol, "seed": self.seed,
-                "outside_by_check": {c: int(np.count_nonzero(~v)) for c, v in self.checks.items()},
+                "n_samples_stored": self.n_stored,
+                "outside_by_check": {c: int(v) for c, v in self.outside_by_check.items()},
                 "warnings": self.warnings,
                 "inputs": {k: {"dist": d, "params": list(p), "unit": UNCERTAIN[k][0]}
                            for k, (d, p) in self.inputs.items()},
@@ -318,28 +330,43 @@ def _scene_parts(scene):
     return name, model, material, base, unc, outputs, tol
 
 
-def _saltelli(D, N, seed):
-    """Saltelli design for first/total indices in SALib's row layout (``N (D+2)`` x ``D``).
+def _design_rows(D, N, seed, g0, g1):
+    """Rows of the Saltelli design of base points ``g0 .. g1-1`` (``(g1-g0)(D+2)`` x ``D``).
 
     Rows per base point: ``A, AB_1 .. AB_D, B`` (``AB_j`` = ``A`` with column ``j`` from
     ``B``), exactly what ``SALib.sample.sobol.sample(..., calc_second_order=False)`` lays
     out and ``SALib.analyze.sobol.separate_output_values`` reads; built with numpy from a
     scrambled Sobol' sequence of dimension ``2D`` (``scipy.stats.qmc``) because SALib's
-    sampler loops in Python (4 s at 10^6 rows).  Values kept strictly inside (0, 1).
+    sampler loops in Python (4 s at 10^6 rows).  The engine is fast-forwarded to ``g0``, so
+    a range is the same rows as in the whole design of ``N`` base points (the scrambling is
+    drawn from ``seed`` alone).  Values kept strictly inside (0, 1) with the margin
+    ``0.25/N`` of the whole design.
     """
     from scipy.stats import qmc  # deferred: heavy import (start-up)
 
-    base = qmc.Sobol(d=2 * D, scramble=True, seed=seed).random_base2(int(round(math.log2(N))))
+    eng = qmc.Sobol(d=2 * D, scramble=True, seed=seed)
+    if g0:
+        eng.fast_forward(int(g0))
+    with warnings.catch_warnings():
+        # the balance warning is about one call; the whole design is N = 2^m points
+        warnings.simplefilter("ignore", UserWarning)
+        base = eng.random(int(g1 - g0))
     A, B = base[:, :D], base[:, D:]
-    U = np.empty((N, D + 2, D))
+    n = base.shape[0]
+    U = np.empty((n, D + 2, D))
     U[:, 0] = A
     U[:, D + 1] = B
     for j in range(D):
         U[:, j + 1] = A
         U[:, j + 1, j] = B[:, j]
-    U = U.reshape(N * (D + 2), D)
+    U = U.reshape(n * (D + 2), D)
     eps = 0.25 / N
     return np.clip(U, eps, 1.0 - eps)
+
+
+def _saltelli(D, N, seed):
+    """The whole Saltelli design of ``N`` base points (``N (D+2)`` x ``D``), :func:`_design_rows`."""
+    return _design_rows(D, N, seed, 0, N)
 
 
 #: rough cost of one sample (moment + beam) by fidelity, s: sizes scheduler chunks (>= 100 ms);
@@ -349,19 +376,31 @@ _SECONDS_PER_SAMPLE = {"leading": 2e-7, "corrected": 2.5e-7, "quadrature": 2e-6,
 
 #: batches of the batch-means confidence interval of the Sobol' indices
 SOBOL_BATCHES = 32
+#: model runs kept per sample in UQResult.samples/outputs/checks/valid (and the NetCDF): the
+#: first whole Saltelli groups of the design; the statistics use every run
+STORE_SAMPLES = 2**17
+#: probability levels of the reported quantiles (keys q2.5, q50, q97.5)
+QUANTILES = {"q2.5": 0.025, "q50": 0.5, "q97.5": 0.975}
 
 
-def _sobol_indices(y, names, N, batches=SOBOL_BATCHES):
+def _n_batches(base_n, batches=SOBOL_BATCHES):
+    """Batches of the batch-means interval for ``base_n`` base points (a power of two)."""
+    return batches if base_n >= 4 * batches else max(2, base_n // 4)
+
+
+def _sobol_indices(y, names, N, batches=SOBOL_BATCHES, groups=None, base_n=None):
     """First/total indices (SALib's Saltelli 2010 / Jansen estimators) and 95 % intervals.
 
     SALib's own ``sobol.analyze`` bootstraps with an ``N x 100`` index matrix per output
     (minutes and ~200 MB at 10^6 runs); the point estimates here are SALib's estimator
-    functions on all ``N`` rows, and the interval is by batch means: the rows split into
-    ``batches`` interleaved groups, the estimator applied to each, half-width
-    ``t_{0.975, K-1} sd / sqrt(K)`` -- the same estimator's sampling spread, O(N D).
+    functions on all ``N`` groups, and the interval is by batch means: the groups split into
+    ``K`` batches of contiguous base points of the design (``groups``: the design index of
+    each of the ``N`` groups, default ``0 .. N-1``, of ``base_n`` in all, default ``N``),
+    the estimator applied to each non-empty batch, half-width ``t_{0.975, K-1} sd / sqrt(K)``
+    -- the same estimator's sampling spread, O(N D).  In-memory form; :func:`run_uq`
+    accumulates the same sums chunk by chunk (:class:`_SobolSums`).
     """
     from SALib.analyze.sobol import separate_output_values  # deferred: heavy import (start-up)
-    from scipy import stats  # deferred: heavy import (start-up)
 
     D = len(names)
     y = np.asarray(y, float)
@@ -369,33 +408,227 @@ def _sobol_indices(y, names, N, batches=SOBOL_BATCHES):
     # shift invariant in its variance (an output with a large mean would swamp it)
     y = (y - y.mean()) / y.std()
     A, B, AB, _ = separate_output_values(y, D, N, False)
-    K = batches if N >= 4 * batches else max(2, N // 4)
-    m = (N // K) * K
-    tq = float(stats.t.ppf(0.975, K - 1))
+    base_n = N if base_n is None else int(base_n)
+    g = np.arange(N) if groups is None else np.asarray(groups)
+    K = _n_batches(base_n, batches)
+    # contiguous blocks of a Sobol' sequence are nets (representative); strided subsets are not
+    label = g // (base_n // K)
+
     # SALib's first_order / total_order (Saltelli 2010 CPC; Jansen), written out so that the
-    # variance of [A, B] is computed once for all parameters and batches (the functions
-    # recompute it per call); tests/studies/test_uq.py checks equality with SALib's functions.
-    def est(a, b, ab):  # a, b: (n, ...); ab: (n, ..., D) -> S1, ST of shape (..., D)
-        v = np.var(np.concatenate([a, b], axis=0), axis=0)[..., None]
-        s1 = np.mean(b[..., None] * (ab - a[..., None]), axis=0) / v
-        st = 0.5 * np.mean((a[..., None] - ab) ** 2, axis=0) / v
+    # variance of [A, B] is computed once for all parameters (the functions recompute it per
+    # call); tests/studies/test_uq.py checks equality with SALib's functions.
+    def est(a, b, ab):  # a, b: (n,); ab: (n, D) -> S1, ST of shape (D,)
+        v = np.var(np.concatenate([a, b]))
+        s1 = np.mean(b[:, None] * (ab - a[:, None]), axis=0) / v
+        st = 0.5 * np.mean((a[:, None] - ab) ** 2, axis=0) / v
         return s1, st
 
     with np.errstate(all="ignore"):
         s1, st = est(A, B, AB)
-        nb = m // K
-        # contiguous blocks of a Sobol' sequence are nets (representative); strided subsets are not
-        s1b, stb = est(A[:m].reshape(K, nb).T, B[:m].reshape(K, nb).T, AB[:m].reshape(K, nb, D).transpose(1, 0, 2))
-    h1 = tq * np.std(s1b, axis=0, ddof=1) / math.sqrt(K)
-    ht = tq * np.std(stb, axis=0, ddof=1) / math.sqrt(K)
-    out = {k: {"S1": float(s1[j]), "S1_conf": float(h1[j]), "ST": float(st[j]), "ST_conf": float(ht[j])}
-           for j, k in enumerate(names)}
-    return out
+        parts = [est(A[label == b], B[label == b], AB[label == b]) for b in range(K) if np.any(label == b)]
+    return _indices_dict(names, s1, st, np.array([p[0] for p in parts]), np.array([p[1] for p in parts]))
+
+
+def _indices_dict(names, s1, st, s1b, stb):
+    """Point estimates and batch-means half-widths -> ``{name: {S1, S1_conf, ST, ST_conf}}``."""
+    from scipy import stats  # deferred: heavy import (start-up)
+
+    K = s1b.shape[0]
+    if K >= 2:
+        tq = float(stats.t.ppf(0.975, K - 1))
+        h1 = tq * np.std(s1b, axis=0, ddof=1) / math.sqrt(K)
+        ht = tq * np.std(stb, axis=0, ddof=1) / math.sqrt(K)
+    else:
+        h1 = ht = np.full(len(names), math.nan)
+    return {k: {"S1": float(s1[j]), "S1_conf": float(h1[j]), "ST": float(st[j]), "ST_conf": float(ht[j])}
+            for j, k in enumerate(names)}
+
+
+class _GroupSums:
+    """Mergeable sums of the Saltelli estimators over a set of groups (rows ``A, AB_1..AB_D, B``).
+
+    With ``d_j = AB_j - A``: group count ``n``; mean of every row ``m_all``; mean and centred
+    second moment of ``[A, B]`` (``m_ab``, ``M2_ab``); means ``m_b``, ``m_d``; co-moment
+    ``c_bd = sum (B - m_b)(d_j - m_d_j)``; ``s_d2 = sum d_j^2``.  Merged by Chan et al.'s
+    pairwise update, so any split into chunks gives the in-memory sums to rounding.
+    """
+
+    __slots__ = ("n", "m_all", "ab", "m_b", "m_d", "c_bd", "s_d2")
+
+    @classmethod
+    def of(cls, Y):
+        """Sums of the groups ``Y`` (n, D+2)."""
+        s = cls()
+        D = Y.shape[1] - 2
+        A, B = Y[:, 0], Y[:, D + 1]
+        d = Y[:, 1:D + 1] - A[:, None]
+        s.n = Y.shape[0]
+        s.m_all = float(Y.mean())
+        s.ab = Moments.of(np.concatenate([A, B]))
+        s.m_b = float(B.mean())
+        s.m_d = d.mean(axis=0)
+        s.c_bd = ((B - s.m_b)[:, None] * (d - s.m_d)).sum(axis=0)
+        s.s_d2 = (d * d).sum(axis=0)
+        return s
+
+    def copy(self):
+        c = _GroupSums()
+        c.n, c.m_all, c.m_b, c.m_d, c.c_bd, c.s_d2 = self.n, self.m_all, self.m_b, self.m_d, self.c_bd, self.s_d2
+        c.ab = Moments(self.ab.n, self.ab.mean, self.ab.m2)
+        return c
+
+    def merge(self, o):
+        n = self.n + o.n
+        f = o.n / n
+        db, dd = o.m_b - self.m_b, o.m_d - self.m_d
+        self.c_bd = self.c_bd + o.c_bd + db * dd * (self.n * o.n / n)
+        self.m_all = self.m_all + (o.m_all - self.m_all) * f
+        self.ab.merge(o.ab)
+        self.m_b = self.m_b + db * f
+        self.m_d = self.m_d + dd * f
+        self.s_d2 = self.s_d2 + o.s_d2
+        self.n = n
+        return self
+
+    def indices(self, mu):
+        """S1, ST of these groups with the outputs centred on ``mu`` (the mean of every group's
+        rows, as :func:`_sobol_indices` centres; the scale cancels in the ratios)."""
+        v = self.ab.m2 / self.ab.n  # np.var of [A, B]
+        s1 = (self.c_bd + self.n * (self.m_b - mu) * self.m_d) / self.n / v
+        st = 0.5 * self.s_d2 / self.n / v
+        return s1, st
+
+
+class _SobolSums:
+    """Per-batch :class:`_GroupSums` of one output, and the range of its values (a constant
+    output has no indices)."""
+
+    __slots__ = ("batches", "min", "max")
+
+    def __init__(self, K):
+        self.batches = [None] * K
+        self.min, self.max = math.inf, -math.inf
+
+    def add(self, Y, label):
+        """Groups ``Y`` (n, D+2) in batches ``label`` (n,)."""
+        if Y.shape[0] == 0:
+            return self
+        self.min = min(self.min, float(Y.min()))
+        self.max = max(self.max, float(Y.max()))
+        for b in np.unique(label):
+            self._put(int(b), _GroupSums.of(Y[label == b]))
+        return self
+
+    def _put(self, b, s):
+        self.batches[b] = s if self.batches[b] is None else self.batches[b].merge(s)
+
+    def merge(self, o):
+        self.min, self.max = min(self.min, o.min), max(self.max, o.max)
+        for b, s in enumerate(o.batches):
+            if s is not None:
+                self._put(b, s)
+        return self
+
+    @property
+    def n(self):
+        return sum(s.n for s in self.batches if s is not None)
+
+    def result(self, names):
+        parts = [s for s in self.batches if s is not None]
+        if self.n < 2 or not self.max - self.min > 0:
+            return None
+        tot = parts[0].copy()
+        for s in parts[1:]:
+            tot.merge(s)
+        with np.errstate(all="ignore"):
+            s1, st = tot.indices(tot.m_all)
+            per = [s.indices(tot.m_all) for s in parts]
+        return _indices_dict(names, s1, st, np.array([p[0] for p in per]), np.array([p[1] for p in per]))
+
+
+@dataclass
+class _Spec:
+    """What every chunk needs (small: sent to the workers with each range of groups)."""
+
+    names: list
+    unc: dict
+    base: dict
+    base_n: int
+    seed: int
+    outputs: tuple
+    model: str
+    material: object
+    tol: float
+    fidelity: str | None
+    keep_invalid: bool
+    store_groups: int
+    sketch_k: int
+
+
+def _columns(spec, g0, g1):
+    """Sampled input columns (SI) of the design's base points ``g0 .. g1-1``."""
+    D = len(spec.names)
+    U = _design_rows(D, spec.base_n, spec.seed, g0, g1)
+    n = U.shape[0]
+    cols = {k: _transform(U[:, j], *spec.unc[k]) for j, k in enumerate(spec.names)}
+    for k, v in spec.base.items():
+        if k not in cols:
+            cols[k] = np.full(n, v)
+    for k in ("length", "width", "thickness", "modulus", "c_moy"):
+        bad = int(np.count_nonzero(cols[k] <= 0))
+        if bad:
+            raise ValueError(f"uq: sampled {k} <= 0 ({bad} samples among base points {g0}..{g1 - 1}); "
+                             "narrow its distribution")
+    return cols
+
+
+def uq_stream_chunk(task):
+    """Base points ``g0 .. g1-1`` of the design -> their partial statistics (module level: runs on
+    workers); the design rows are generated here, so a task is a few numbers."""
+    spec, g0, g1 = task
+    t0 = time.perf_counter()
+    D = len(spec.names)
+    cols = _columns(spec, g0, g1)
+    t1 = time.perf_counter()
+    outs, counts, checks, warns = evaluate_samples(cols, spec.outputs, spec.model, spec.material, spec.tol,
+                                                   spec.fidelity)
+    t2 = time.perf_counter()
+    n = cols["thickness"].size
+    valid = np.ones(n, bool)
+    for v in checks.values():
+        valid &= v
+    use = np.ones(n, bool) if spec.keep_invalid else valid
+    groups_use = use.reshape(-1, D + 2).all(axis=1)
+    K = _n_batches(spec.base_n)
+    label = np.arange(g0, g1) // (spec.base_n // K)
+    part = {"counts": counts, "warnings": warns, "n": n, "n_outside": int(np.count_nonzero(~valid)),
+            "outside_by_check": {c: int(np.count_nonzero(~v)) for c, v in checks.items()},
+            "n_used": int(np.count_nonzero(use)), "n_sobol": int(np.count_nonzero(groups_use)),
+            "moments": {}, "sketch": {}, "sobol": {}, "stored": None}
+    for o in spec.outputs:
+        y = outs[o]
+        fin = np.isfinite(y)
+        yu = y[use & fin]
+        part["moments"][o] = Moments.of(yu)
+        part["sketch"][o] = QuantileSketch(spec.sketch_k).add(yu)
+        Yg = y.reshape(-1, D + 2)
+        ok = groups_use & fin.reshape(-1, D + 2).all(axis=1)
+        part["sobol"][o] = _SobolSums(K).add(Yg[ok], label[ok])
+    if g0 < spec.store_groups:
+        r = (min(g1, spec.store_groups) - g0) * (D + 2)
+        part["stored"] = ({k: cols[k][:r] for k in spec.names}, {o: outs[o][:r] for o in spec.outputs},
+                          {c: checks[c][:r] for c in CHECKS}, valid[:r])
+    part["timings"] = {"sampling": t1 - t0, "evaluation": t2 - t1, "analysis": time.perf_counter() - t2}
+    return part
 
 
 def run_uq(scene, samples: int = 10**6, *, seed: int = 0, fidelity: str | None = None, scheduler=None,
-           chunk_rows: int | None = None, keep_invalid: bool = False) -> UQResult:
+           chunk_rows: int | None = None, keep_invalid: bool = False, store_samples: int = STORE_SAMPLES,
+           sketch_k: int = SKETCH_K) -> UQResult:
     """Quantiles, moments and Sobol' indices of a scene's outputs under its ``[uncertain]`` inputs.
+
+    Streams: the design is generated, evaluated and reduced chunk by chunk (whole Saltelli
+    groups), so memory does not grow with ``samples`` (module docstring).
 
     Parameters
     ----------
@@ -405,18 +638,26 @@ def run_uq(scene, samples: int = 10**6, *, seed: int = 0, fidelity: str | None =
         Model runs wanted; ``N (D+2)`` are run with ``N`` the power of two at or above
         ``samples/(D+2)`` (SALib's Sobol' design for first and total indices).
     seed : int
-        Seed of the scrambled Sobol' sequence and of the bootstrap (reproducible).
+        Seed of the scrambled Sobol' sequence (reproducible).
     fidelity : str, optional
         Force one rung (e.g. ``"leading"``); default: per-sample escalation by tolerance.
     scheduler : None, "local", "tcp://HOST:PORT" or Client
-        Where the chunks run (:func:`ipmc_asym.parallel.executors.run_chunks`); results identical.
+        Where the chunks run (:func:`ipmc_asym.parallel.executors.imap_chunks`); their partial
+        statistics are merged in order as they arrive.
     chunk_rows : int, optional
-        Samples per chunk.  Default: ``settings.CHUNK_ROWS`` in this process (bounds the
-        memory of the temporaries); on a scheduler, chunks of >= 100 ms of work (at most
-        4 per worker, at most 2^20 rows) by :func:`ipmc_asym.parallel.executors.chunk_slices`.
+        Samples per chunk (rounded down to whole groups of ``D + 2``, at least one group).
+        Default: ``settings.CHUNK_ROWS`` in this process (bounds the memory of the
+        temporaries); on a scheduler, chunks of >= 100 ms of work (at most 4 per worker, at
+        most 2^20 rows) by :func:`ipmc_asym.parallel.executors.chunk_slices`.  The same
+        ``chunk_rows`` gives the same result on every scheduler.
     keep_invalid : bool
         Keep the samples outside a model assumption in the statistics (default: left out,
         counted in ``n_outside``; the per-sample checks are in ``checks`` either way).
+    store_samples : int
+        Runs kept per sample in ``samples``, ``outputs``, ``checks``, ``valid`` (the first
+        whole groups of the design; >= 0); the statistics use every run.
+    sketch_k : int
+        Items per level of the quantile sketch (:class:`ipmc_asym.base.streamstats.QuantileSketch`).
 
     Returns
     -------
@@ -433,76 +674,87 @@ def run_uq(scene, samples: int = 10**6, *, seed: int = 0, fidelity: str | None =
     t0 = time.perf_counter()
     if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 1:
         raise ValueError(f"--samples must be an integer >= 1; got {samples!r}")
+    if isinstance(store_samples, bool) or not isinstance(store_samples, (int, np.integer)) or store_samples < 0:
+        raise ValueError(f"store_samples must be an integer >= 0; got {store_samples!r}")
+    if chunk_rows is not None and (isinstance(chunk_rows, bool) or not isinstance(chunk_rows, (int, np.integer))
+                                   or chunk_rows < 1):
+        raise ValueError(f"chunk_rows must be an integer >= 1; got {chunk_rows!r}")
     name, model, material, base, unc, outputs, tol = _scene_parts(scene)
     names = list(unc)
     D = len(names)
     base_n = 1 << max(1, math.ceil(math.log2(max(samples / (D + 2), 2))))
-    U = _saltelli(D, base_n, seed)
-    t_sample = time.perf_counter()
-    n = U.shape[0]
-    cols = {}
-    for j, k in enumerate(names):
-        cols[k] = _transform(U[:, j], *unc[k])
-    del U
-    for k in base:
-        if k not in cols:
-            cols[k] = np.full(n, base[k])
-    for k in ("length", "width", "thickness", "modulus", "c_moy"):
-        if np.any(cols[k] <= 0):
-            raise ValueError(f"uq: sampled {k} <= 0 ({int(np.sum(cols[k] <= 0))} samples); narrow its distribution")
-
+    n = base_n * (D + 2)
+    spec = _Spec(names=names, unc=unc, base=base, base_n=base_n, seed=int(seed), outputs=tuple(outputs),
+                 model=model, material=material, tol=tol, fidelity=fidelity, keep_invalid=bool(keep_invalid),
+                 store_groups=min(base_n, int(store_samples) // (D + 2)), sketch_k=int(sketch_k))
     if chunk_rows is not None:
-        slices = [slice(a, min(a + int(chunk_rows), n)) for a in range(0, n, int(chunk_rows))]
+        rows = int(chunk_rows)
     elif scheduler is None:
-        slices = [slice(a, min(a + CHUNK_ROWS, n)) for a in range(0, n, CHUNK_ROWS)]
+        rows = CHUNK_ROWS
     else:
+        sl = chunk_slices(n, _SECONDS_PER_SAMPLE.get(fidelity, 1e-6), os.cpu_count() or 1, max_items=2**20)
+        rows = sl[0].stop - sl[0].start
+    per = max(1, rows // (D + 2))
+    tasks = ((spec, g, min(g + per, base_n)) for g in range(0, base_n, per))
 
-        slices = chunk_slices(n, _SECONDS_PER_SAMPLE.get(fidelity, 1e-6), os.cpu_count() or 1, max_items=2**20)
-    tasks = [({k: cols[k][sl] for k in cols}, tuple(outputs), model, material, tol, fidelity) for sl in slices]
-
-    t_eval0 = time.perf_counter()
-    parts = run_chunks(uq_chunk, tasks, scheduler=scheduler)
-    t_eval1 = time.perf_counter()
-    outs = {o: np.concatenate([p[0][o] for p in parts]) for o in outputs}
-    counts = {}
-    for p in parts:
-        for k, c in p[1].items():
+    K = _n_batches(base_n)
+    counts, warns, outside = {}, [], dict.fromkeys(CHECKS, 0)
+    n_out = n_used = n_sobol = 0
+    moments = {o: Moments() for o in outputs}
+    sketches = {o: QuantileSketch(spec.sketch_k) for o in outputs}
+    sobols = {o: _SobolSums(K) for o in outputs}
+    stored = []
+    timings = {"sampling": 0.0, "evaluation": 0.0, "analysis": 0.0}
+    for p in imap_chunks(uq_stream_chunk, tasks, scheduler=scheduler):
+        for k, c in p["counts"].items():
             counts[k] = counts.get(k, 0) + c
-    checks = {c: np.concatenate([p[2][c] for p in parts]) for c in CHECKS}
-    valid = np.ones(n, bool)
-    for v in checks.values():
-        valid &= v
-    n_out = int(np.count_nonzero(~valid))
-    warns = []
-    for p in parts:  # one line per failed assumption (the first chunk's wording), total counts below
-        for w in p[3]:
+        for w in p["warnings"]:  # one line per failed assumption (the first chunk's wording)
             head = w.split(" [")[0]
             if not any(x.startswith(head[:40]) for x in warns):
                 warns.append(head)
-    # samples inside every model assumption (unless kept); whole Saltelli groups for the indices
-    use = np.ones(n, bool) if keep_invalid else valid
-    groups_ok = use.reshape(base_n, D + 2).all(axis=1)
-    n_sobol = int(np.count_nonzero(groups_ok))
+        for c, v in p["outside_by_check"].items():
+            outside[c] += v
+        n_out += p["n_outside"]
+        n_used += p["n_used"]
+        n_sobol += p["n_sobol"]
+        for o in outputs:
+            moments[o].merge(p["moments"][o])
+            sketches[o].merge(p["sketch"][o])
+            sobols[o].merge(p["sobol"][o])
+        if p["stored"] is not None:
+            stored.append(p["stored"])
+        for k, v in p["timings"].items():
+            timings[k] += v
+    t_eval1 = time.perf_counter()
+
     summary, sob = {}, {}
     for o in outputs:
-        y = outs[o][use & np.isfinite(outs[o])]
-        if y.size < 2:
-            raise ValueError(f"uq: {y.size} sample(s) of {o} inside the model ({n_out} of {n} outside a model "
+        m = moments[o]
+        if m.n < 2:
+            raise ValueError(f"uq: {m.n} sample(s) of {o} inside the model ({n_out} of {n} outside a model "
                              "assumption); narrow the distributions or pass keep_invalid (--keep-invalid)")
-        q = np.quantile(y, [0.025, 0.5, 0.975])
-        summary[o] = {"unit": OUTPUT_UNITS[o][0], "mean": float(np.mean(y)), "sd": float(np.std(y, ddof=1)),
-                      "q2.5": float(q[0]), "q50": float(q[1]), "q97.5": float(q[2]), "n": int(y.size)}
-        yg = outs[o].reshape(base_n, D + 2)[groups_ok & np.all(np.isfinite(outs[o].reshape(base_n, D + 2)), axis=1)]
-        if yg.shape[0] < 2 or not np.ptp(yg) > 0:
-            sob[o] = None
-            continue
-        sob[o] = _sobol_indices(yg.reshape(-1), names, yg.shape[0])
+        q, lo, hi = sketches[o].quantiles(list(QUANTILES.values()))
+        s = {"unit": OUTPUT_UNITS[o][0], "mean": float(m.mean), "sd": float(math.sqrt(m.var(ddof=1)))}
+        s.update({key: float(q[i]) for i, key in enumerate(QUANTILES)})
+        s["n"] = int(m.n)
+        # the exact sample quantile (np.quantile of the same samples) lies in this interval
+        s.update({key + "_interval": [float(lo[i]), float(hi[i])] for i, key in enumerate(QUANTILES)})
+        s["quantile_rank_error"] = float(sketches[o].rank_error)
+        summary[o] = s
+        sob[o] = sobols[o].result(names)
 
-    return UQResult(summary=summary, sobol=sob, inputs=unc, samples={k: cols[k] for k in names}, outputs=outs,
+    def cat(i, k):
+        return np.concatenate([s[i][k] for s in stored]) if stored else np.empty(0, bool if i == 2 else float)
+
+    samples_kept = {k: cat(0, k) for k in names}
+    outs_kept = {o: cat(1, o) for o in outputs}
+    checks_kept = {c: cat(2, c) for c in CHECKS}
+    valid_kept = np.concatenate([s[3] for s in stored]) if stored else np.empty(0, bool)
+    timings["analysis"] += time.perf_counter() - t_eval1
+    timings["wall"] = time.perf_counter() - t0
+    return UQResult(summary=summary, sobol=sob, inputs=unc, samples=samples_kept, outputs=outs_kept,
                     n_samples=n, base_n=base_n, fidelity=counts, model=get_model(model).name, tolerance=tol,
                     seconds=time.perf_counter() - t0, scene=name, base=base, material=material,
-                    timings={"sampling": t_sample - t0, "evaluation": t_eval1 - t_eval0,
-                             "analysis": time.perf_counter() - t_eval1},
-                    checks=checks, valid=valid, n_outside=n_out, keep_invalid=bool(keep_invalid),
-                    n_used=int(np.count_nonzero(use)), n_sobol=n_sobol, warnings=warns, seed=int(seed))
-
+                    timings=timings, checks=checks_kept, valid=valid_kept, n_outside=n_out,
+                    keep_invalid=bool(keep_invalid), n_used=n_used, n_sobol=n_sobol, warnings=warns, seed=int(seed),
+                    outside_by_check=outside, n_stored=int(valid_kept.size))

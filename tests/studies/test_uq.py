@@ -134,3 +134,125 @@ def test_samples_outside_the_model_are_counted_and_left_out():
     assert r.summary["rotation"]["q2.5"] >= -math.pi / 2  # the statistics hold inside samples only
     k = run_uq(sc, 3000, fidelity="leading", keep_invalid=True)
     assert k.summary["rotation"]["n"] == k.n_samples and k.summary["rotation"]["q2.5"] < r.summary["rotation"]["q2.5"]
+
+
+# ---- streaming: the chunked accumulators against the whole design in memory ------------------
+def _in_memory(sc, samples, seed=0, fidelity=None, keep_invalid=False):
+    """The whole design evaluated at once and numpy's statistics: the reference of the streamed run."""
+    from ipmc_asym.forward.model import CHECKS
+    from ipmc_asym.studies.uq import _saltelli, _scene_parts, _sobol_indices, _transform, evaluate_samples
+
+    name, model, material, base, unc, outputs, tol = _scene_parts(sc)
+    names = list(unc)
+    D = len(names)
+    base_n = 1 << max(1, math.ceil(math.log2(max(samples / (D + 2), 2))))
+    U = _saltelli(D, base_n, seed)
+    cols = {k: _transform(U[:, j], *unc[k]) for j, k in enumerate(names)}
+    cols.update({k: np.full(U.shape[0], v) for k, v in base.items() if k not in cols})
+    outs, counts, checks, _ = evaluate_samples(cols, outputs, model, material, tol, fidelity)
+    valid = np.logical_and.reduce([checks[c] for c in CHECKS])
+    use = np.ones_like(valid) if keep_invalid else valid
+    ref = {"cols": cols, "outs": outs, "checks": checks, "valid": valid, "counts": counts, "summary": {}, "sobol": {}}
+    for o in outputs:
+        y = outs[o][use & np.isfinite(outs[o])]
+        q = np.quantile(y, [0.025, 0.5, 0.975])
+        ref["summary"][o] = {"mean": np.mean(y), "sd": np.std(y, ddof=1), "q2.5": q[0], "q50": q[1], "q97.5": q[2],
+                             "n": y.size}
+        Y = outs[o].reshape(base_n, D + 2)
+        ok = use.reshape(base_n, D + 2).all(axis=1) & np.isfinite(Y).all(axis=1)
+        ref["sobol"][o] = _sobol_indices(Y[ok].reshape(-1), names, int(ok.sum()), groups=np.flatnonzero(ok),
+                                         base_n=base_n)
+    return ref
+
+
+_WIDE = {"modulus": {"dist": "lognormal", "median": "130MPa", "sigma": 0.4},
+         "thickness": {"dist": "normal", "mean": "200um", "sd": "10um"},
+         "length": {"dist": "uniform", "low": "1.8cm", "high": "2.2cm"}}
+
+
+def test_design_ranges_are_the_whole_design():
+    """A chunk's rows (fast-forwarded engine) are the whole design's rows; the whole design is
+    the SALib layout of one scrambled Sobol' sequence of dimension 2D."""
+    from scipy.stats import qmc
+
+    from ipmc_asym.studies.uq import _design_rows, _saltelli
+
+    D, N = 3, 2**9
+    U = _saltelli(D, N, 7)
+    base = qmc.Sobol(d=2 * D, scramble=True, seed=7).random_base2(9)
+    A, B = base[:, :D], base[:, D:]
+    ref = np.concatenate([A[:, None]] + [np.where(np.arange(D) == j, B, A)[:, None] for j in range(D)] + [B[:, None]],
+                         axis=1).reshape(-1, D)
+    np.testing.assert_array_equal(U, np.clip(ref, 0.25 / N, 1 - 0.25 / N))
+    for g0, g1 in ((0, 1), (3, 130), (511, 512)):
+        np.testing.assert_array_equal(_design_rows(D, N, 7, g0, g1), U[g0 * (D + 2):g1 * (D + 2)])
+
+
+@pytest.mark.parametrize("keep", [False, True])
+def test_streamed_statistics_equal_the_in_memory_ones(keep):
+    """Many chunks (groups split across batches and chunks, samples left out): moments and
+    Sobol' indices with their intervals equal numpy/_sobol_indices on the whole design to
+    rounding; quantiles exactly np.quantile (the sketch still holds every value); counts equal."""
+    sc = _scene(_WIDE, ["rotation", "tip_deflection", "blocking_force"])
+    ref = _in_memory(sc, 5000, seed=3, keep_invalid=keep)
+    r = run_uq(sc, 5000, seed=3, chunk_rows=703, keep_invalid=keep)
+    assert r.n_outside == int((~ref["valid"]).sum()) > 0
+    assert r.outside_by_check == {c: int((~v).sum()) for c, v in ref["checks"].items()}
+    assert {k: v for k, v in r.fidelity.items() if v} == {k: v for k, v in ref["counts"].items() if v}
+    for o, s in ref["summary"].items():
+        got = r.summary[o]
+        assert got["n"] == s["n"]
+        assert got["mean"] == pytest.approx(s["mean"], rel=1e-12)
+        assert got["sd"] == pytest.approx(s["sd"], rel=1e-9)
+        for q in ("q2.5", "q50", "q97.5"):
+            assert got[q] == s[q] and got[q + "_interval"] == [s[q], s[q]]
+        assert got["quantile_rank_error"] == 0
+        for k, v in ref["sobol"][o].items():
+            for key in ("S1", "S1_conf", "ST", "ST_conf"):
+                assert r.sobol[o][k][key] == pytest.approx(v[key], rel=1e-9, abs=1e-12), (o, k, key)
+
+
+def test_streamed_quantiles_within_their_stated_interval():
+    """A small sketch (compacted many times): the exact np.quantile of the same samples lies in
+    each reported interval, and the estimate within the stated rank error of it."""
+    sc = _scene(_WIDE, ["rotation", "moment"])
+    ref = _in_memory(sc, 20000, seed=1)
+    r = run_uq(sc, 20000, seed=1, chunk_rows=1500, sketch_k=64)
+    valid = ref["valid"]
+    for o, s in ref["summary"].items():
+        got = r.summary[o]
+        assert 0 < got["quantile_rank_error"] < 0.1
+        y = np.sort(ref["outs"][o][valid])
+        for q, p in (("q2.5", 0.025), ("q50", 0.5), ("q97.5", 0.975)):
+            lo, hi = got[q + "_interval"]
+            assert lo <= s[q] <= hi, (o, q)
+            e = got["quantile_rank_error"] + 1 / y.size
+            assert np.quantile(y, max(p - e, 0)) <= got[q] <= np.quantile(y, min(p + e, 1)), (o, q)
+
+
+def test_stored_rows_are_the_first_groups():
+    sc = _scene(_WIDE, ["rotation"])
+    ref = _in_memory(sc, 3000, seed=2)
+    r = run_uq(sc, 3000, seed=2, chunk_rows=100, store_samples=52)  # 10 whole groups of 5 rows
+    assert r.n_stored == 50 and r.n_samples > 50
+    for k in _WIDE:
+        np.testing.assert_array_equal(r.samples[k], ref["cols"][k][:50])
+    np.testing.assert_array_equal(r.outputs["rotation"], ref["outs"]["rotation"][:50])
+    np.testing.assert_array_equal(r.valid, ref["valid"][:50])
+    assert r.as_dict()["outside_by_check"] == {c: int((~v).sum()) for c, v in ref["checks"].items()}
+
+
+def test_peak_memory_does_not_grow_with_samples():
+    """tracemalloc peak of run_uq at N and 8N base points (leading, every per-sample row
+    beyond 4096 dropped): the chunks bound it, not N."""
+    import tracemalloc
+
+    sc = _scene({"thickness": {"dist": "normal", "mean": "200um", "sd": "8um"}}, ["I", "rotation"])
+    run_uq(sc, 3000, fidelity="leading")  # warm: kernels, imports
+    peaks = []
+    for n in (2**15 * 3, 2**18 * 3):  # 2 and 12 chunks of 2^16 rows
+        tracemalloc.start()
+        run_uq(sc, n, fidelity="leading", store_samples=4096)
+        peaks.append(tracemalloc.get_traced_memory()[1])
+        tracemalloc.stop()
+    assert peaks[1] < 1.5 * peaks[0], peaks
