@@ -19,11 +19,13 @@ from ipmc_asym.io.datasets import uq_dataset, write_netcdf
 from ipmc_asym.io.fileio import FIGURE_FORMATS, check_output_path
 from ipmc_asym.io.jsonio import dumps
 from ipmc_asym.parallel.executors import check_scheduler
-from ipmc_asym.studies.uq import SOBOL_BATCHES, run_uq
+from ipmc_asym.studies.uq import SOBOL_BATCHES, STORE_SAMPLES, run_uq
 
-#: model runs of one uq: inputs, outputs and the Saltelli design stay in memory for the exact
-#: quantiles (~200 B per run); settable with --max-samples
-MAX_SAMPLES = 10**6
+#: model runs of one uq: a time cap (memory does not grow with the runs: the design is streamed
+#: chunk by chunk; ~1e6 runs/s at leading in one process, so ~2 min here); settable with --max-samples
+MAX_SAMPLES = 10**8
+#: runs kept per sample for --out and --plot (~100 B each): a memory cap, settable with --max-store-samples
+MAX_STORE_SAMPLES = 2**21
 #: fewer runs give no usable 2.5 %/97.5 % quantile (a handful of samples beyond each) nor a
 #: Sobol' index with a batch-means interval
 MIN_SAMPLES = 100
@@ -35,14 +37,19 @@ def register(sub):
                                    "report quantiles 2.5/50/97.5 %, mean, sd and Sobol' first/total indices.")
     p.add_argument("scene", metavar="SCENE.toml", help="scene with an [uncertain] table (examples/uq_nominal.toml)")
     add_size_option(p, "--samples", default=10**5, maximum=MAX_SAMPLES, minimum=MIN_SAMPLES,
-                    help=f"model runs wanted (>= {MIN_SAMPLES}; rounded up to N(D+2), N a power of two)")
+                    help=f"model runs wanted (>= {MIN_SAMPLES}; rounded up to N(D+2), N a power of two; streamed: "
+                         "memory does not grow with it, the cap bounds the time)")
+    add_size_option(p, "--store-samples", default=STORE_SAMPLES, maximum=MAX_STORE_SAMPLES, minimum=0,
+                    help="runs kept per sample for --out and --plot: the first whole Saltelli groups of the design "
+                         "(the statistics use every run)")
     p.add_argument("--fidelity", default=None, choices=list(compiled_fidelities()),
                    help="force a fidelity (default: per sample, cheapest meeting the scene's tolerance)")
     p.add_argument("--seed", type=seed_type, default=0,
                    help="seed of the scrambled Sobol' sequence (integer >= 0, default 0; stored in the NetCDF)")
     p.add_argument("--scheduler", default=None, metavar="local|tcp://HOST:PORT",
                    help="run the chunks on dask.distributed (default: in this process)")
-    p.add_argument("--out", default=None, metavar="F.nc", help="NetCDF file (.nc) of samples, outputs and indices")
+    p.add_argument("--out", default=None, metavar="F.nc",
+                   help="NetCDF file (.nc) of the statistics, the indices and the first --store-samples runs")
     p.add_argument("--plot", default=None, metavar="F.png",
                    help=f"histograms of the outputs ({', '.join(FIGURE_FORMATS)})")
     p.add_argument("--keep-invalid", action="store_true",
@@ -63,7 +70,7 @@ def run(args) -> int:
         check_scheduler(args.scheduler)
     first_run_notice()
     res = run_uq(scene_with_material(args.scene, args), args.samples, seed=args.seed, fidelity=args.fidelity,
-                 scheduler=args.scheduler, keep_invalid=args.keep_invalid)
+                 scheduler=args.scheduler, keep_invalid=args.keep_invalid, store_samples=args.store_samples)
     if args.cite and res.material is not None:
         print_citations(res.material, json_mode=args.json)
     if res.n_outside:
@@ -81,7 +88,9 @@ def run(args) -> int:
         ds = uq_dataset(res)
         ds.attrs["seed"] = int(args.seed)  # the run is reproducible from the file alone
         eng = write_netcdf(ds, args.out)
-        sys.stderr.write(f"uq: {res.n_samples} samples -> {args.out} (NetCDF, engine {eng})\n")
+        kept = f"the first {res.n_stored} of {res.n_samples}" if res.n_stored < res.n_samples else f"{res.n_samples}"
+        sys.stderr.write(f"uq: {kept} samples -> {args.out} (NetCDF, engine {eng}; statistics over all "
+                         f"{res.n_samples})\n")
     if args.plot:
         from ipmc_asym.plotting.uq import plot_uq  # deferred: matplotlib (start-up)
 
@@ -96,6 +105,9 @@ def run(args) -> int:
     for o, s in res.summary.items():
         print(f"{o:15s} {s['unit']:5s} {s['mean']:11.5g} {s['sd']:10.3g} {s['q2.5']:11.5g} {s['q50']:11.5g} "
               f"{s['q97.5']:11.5g}")
+    rank = max(s["quantile_rank_error"] for s in res.summary.values())
+    if rank > 0:
+        print(f"quantiles from a sketch: rank error <= {rank:.2g} (each quantile's guaranteed interval in --json)")
     print("Sobol' indices (first S1 / total ST, ± 95 % half-width):")
     for o, sob in res.sobol.items():
         if sob is None:

@@ -110,8 +110,11 @@ def uq_dataset(result):
     """Dataset of a :class:`ipmc_asym.studies.uq.UQResult`.
 
     Dim ``sample``: the uncertain inputs are coordinates along it, the outputs data
-    variables; ``S1``, ``S1_conf``, ``ST``, ``ST_conf`` on (``output``, ``parameter``);
-    ``quantile_value`` on (``output``, ``quantile``); ``mean``, ``sd`` on ``output``.
+    variables (the runs kept per sample: ``n_samples_stored`` of ``n_samples``, the first
+    whole Saltelli groups); ``S1``, ``S1_conf``, ``ST``, ``ST_conf`` on (``output``,
+    ``parameter``); ``quantile_value`` on (``output``, ``quantile``) with its guaranteed
+    interval ``quantile_low``, ``quantile_high`` and ``quantile_rank_error`` on ``output``
+    when the result has them; ``mean``, ``sd`` on ``output``.
     """
     import xarray as xr  # deferred: heavy import (start-up)
 
@@ -141,6 +144,17 @@ def uq_dataset(result):
     q = np.array([[result.summary[o][k] for k in ("q2.5", "q50", "q97.5")] for o in outs])
     dv["quantile_value"] = xr.DataArray(q, dims=("output", "quantile"),
                                         attrs={"units": "see output_units", "long_name": "quantile of each output"})
+    if all("q50_interval" in result.summary[o] for o in outs):
+        for i, k in enumerate(("quantile_low", "quantile_high")):
+            a = np.array([[result.summary[o][q + "_interval"][i] for q in ("q2.5", "q50", "q97.5")] for o in outs])
+            dv[k] = xr.DataArray(a, dims=("output", "quantile"),
+                                 attrs={"units": "see output_units",
+                                        "long_name": f"{k.split('_')[1]} end of the interval holding the exact "
+                                                     "sample quantile"})
+        dv["quantile_rank_error"] = xr.DataArray([result.summary[o]["quantile_rank_error"] for o in outs],
+                                                 dims=("output",),
+                                                 attrs={"units": "1", "long_name": "bound on the rank error of the "
+                                                                                   "quantiles (fraction of n)"})
     for k in ("mean", "sd"):
         dv[k] = xr.DataArray([result.summary[o][k] for o in outs], dims=("output",),
                              attrs={"units": "see output_units", "long_name": f"{k} of each output"})
@@ -150,6 +164,7 @@ def uq_dataset(result):
     ds.attrs.update(_common_attrs(result.model, json.dumps(result.fidelity), None, result.material,
                                   {"kind": "uq", "scene": result.scene, "tolerance": result.tolerance,
                                    "n_samples": result.n_samples, "base_n": result.base_n,
+                                   "n_samples_stored": getattr(result, "n_stored", result.n_samples),
                                    "n_outside_model": getattr(result, "n_outside", 0),
                                    "keep_invalid": int(getattr(result, "keep_invalid", False)),
                                    "n_used": getattr(result, "n_used", result.n_samples),

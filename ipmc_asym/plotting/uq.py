@@ -17,6 +17,10 @@ def plot_uq(result, path) -> str:
     """One panel per output: histogram (density), the 2.5/50/97.5 % quantiles (dashed), and
     the Sobol' total indices of the two most influential inputs in the title.
 
+    The histogram is of the runs kept per sample (``result.outputs``: the first whole groups
+    of the design, all of them unless ``n_stored < n_samples``); the quantiles, mean and sd
+    are the statistics of every run.
+
     Parameters
     ----------
     result : ipmc_asym.studies.uq.UQResult
@@ -57,7 +61,9 @@ def plot_uq(result, path) -> str:
     outside = getattr(result, "n_outside", 0)
     note = (f" ({outside} outside a model assumption, " + ("kept)" if getattr(result, "keep_invalid", False)
                                                              else "left out)")) if outside else ""
-    fig.suptitle(f"UQ of scene {result.scene!r} [{result.model}]: {result.n_samples} runs{note}"
+    stored = getattr(result, "n_stored", result.n_samples)
+    hist = f"; histogram of the first {stored}" if stored < result.n_samples else ""
+    fig.suptitle(f"UQ of scene {result.scene!r} [{result.model}]: {result.n_samples} runs{note}{hist}"
                  "\ndashed: 2.5 / 97.5 %, solid: median (thickness = total 2e)", fontsize=10)
     fig.tight_layout()
     return savefig(fig, path, dpi=110)

@@ -64,12 +64,37 @@ def test_uq_json_out_plot(tmp_path, capsys):
     scene = os.path.join(ROOT, "examples", "uq_nominal.toml")
     assert main(["uq", scene, "--samples", "2000", "--json", "--out", str(nc), "--plot", str(png)]) == 0
     out = json.loads(capsys.readouterr().out)
-    assert set(out["summary"]["tip_deflection"]) == {"unit", "mean", "sd", "q2.5", "q50", "q97.5", "n"}
+    assert set(out["summary"]["tip_deflection"]) == {"unit", "mean", "sd", "q2.5", "q50", "q97.5", "n",
+                                                      "q2.5_interval", "q50_interval", "q97.5_interval",
+                                                      "quantile_rank_error"}
     assert set(out["sobol"]["rotation"]["modulus"]) == {"S1", "S1_conf", "ST", "ST_conf"}
     xr = pytest.importorskip("xarray")
     with xr.open_dataset(nc) as ds:
         assert ds.sizes["sample"] == out["n_samples"]
     assert png.stat().st_size > 10_000
+
+
+def test_uq_store_samples_bounds_the_file_not_the_statistics(tmp_path, capsys):
+    """--store-samples keeps the first whole groups in the NetCDF; the statistics and counts
+    are over every run, and each quantile's interval holds it."""
+    nc = tmp_path / "u.nc"
+    scene = os.path.join(ROOT, "examples", "uq_nominal.toml")
+    assert main(["uq", scene, "--samples", "2000", "--fidelity", "leading", "--json", "--out", str(nc),
+                 "--store-samples", "100"]) == 0
+    cap = capsys.readouterr()
+    out = json.loads(cap.out)
+    D = len(out["inputs"])
+    assert out["n_samples_stored"] == (100 // (D + 2)) * (D + 2) < out["n_samples"]
+    assert "the first" in cap.err
+    for s in out["summary"].values():
+        assert s["q2.5_interval"][0] <= s["q2.5"] <= s["q2.5_interval"][1]
+    xr = pytest.importorskip("xarray")
+    with xr.open_dataset(nc) as ds:
+        assert ds.sizes["sample"] == out["n_samples_stored"]
+        assert ds.attrs["n_samples"] == out["n_samples"]
+        assert ds["quantile_low"].shape == ds["quantile_value"].shape
+    assert main(["uq", scene, "--samples", "2000", "--store-samples", "1e9"]) == 2
+    assert "--max-store-samples" in capsys.readouterr().err
 
 
 def test_uq_bad_scene_exit_2(tmp_path, capsys):
