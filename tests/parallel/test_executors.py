@@ -6,7 +6,7 @@ import sys
 import numpy as np
 import pytest
 
-from ipmc_asym.parallel.executors import check_scheduler, chunk_slices, run_chunks
+from ipmc_asym.parallel.executors import check_scheduler, chunk_slices, imap_chunks, run_chunks
 from ipmc_asym.studies.sweep_chunks import sweep_chunked
 from ipmc_asym.studies.sweeps import sweep
 
@@ -66,6 +66,34 @@ def test_uq_identical_on_cluster(client):
     assert a.sobol == b.sobol and a.summary == b.summary and a.fidelity == b.fidelity
 
 
+def test_uq_streamed_on_cluster_keeps_few_tasks_in_flight(client):
+    """imap_chunks yields in task order with at most ``window`` tasks submitted ahead: a lazy
+    task generator is read only as results are consumed."""
+    read = []
+
+    def tasks():
+        for t in range(12):
+            read.append(t)
+            yield -t
+
+    it = imap_chunks(abs, tasks(), scheduler=client, window=3)
+    assert next(it) == 0 and len(read) == 3
+    assert list(it) == list(range(1, 12)) and len(read) == 12
+
+
+def test_imap_chunks_serial_is_lazy():
+    read = []
+
+    def tasks():
+        for t in range(5):
+            read.append(t)
+            yield t
+
+    it = imap_chunks(abs, tasks())
+    assert next(it) == 0 and read == [0]
+    assert list(it) == [1, 2, 3, 4]
+
+
 def test_run_chunks_order_and_serial():
     tasks = list(range(7))
     assert run_chunks(abs, [-t for t in tasks]) == tasks
@@ -122,6 +150,15 @@ def test_process_pool_fallback_sets_threads():
     from ipmc_asym.parallel.executors import _on_pool
 
     out = _on_pool(_env_of_worker, [0, 1, 2], 2, 1, ("leading",))
+    assert out == [("1", "1", 1)] * 3
+
+
+@pytest.mark.slow
+def test_windowed_process_pool_sets_threads():
+    """The streamed variant of the pool fallback: same worker settings, results in order."""
+    from ipmc_asym.parallel.executors import _window_pool
+
+    out = list(_window_pool(_env_of_worker, iter([0, 1, 2]), 2, 1, ("leading",), 2))
     assert out == [("1", "1", 1)] * 3
 
 
