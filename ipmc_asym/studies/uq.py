@@ -616,8 +616,9 @@ def uq_stream_chunk(task):
         part["sobol"][o] = _SobolSums(K).add(Yg[ok], label[ok])
     if g0 < spec.store_groups:
         r = (min(g1, spec.store_groups) - g0) * (D + 2)
-        part["stored"] = ({k: cols[k][:r] for k in spec.names}, {o: outs[o][:r] for o in spec.outputs},
-                          {c: checks[c][:r] for c in CHECKS}, valid[:r])
+        # copies: a view would keep the whole chunk's arrays alive
+        part["stored"] = ({k: cols[k][:r].copy() for k in spec.names}, {o: outs[o][:r].copy() for o in spec.outputs},
+                          {c: checks[c][:r].copy() for c in CHECKS}, valid[:r].copy())
     part["timings"] = {"sampling": t1 - t0, "evaluation": t2 - t1, "analysis": time.perf_counter() - t2}
     return part
 
