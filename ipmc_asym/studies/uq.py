@@ -692,6 +692,8 @@ def run_uq(scene, samples: int = 10**6, *, seed: int = 0, fidelity: str | None =
     Returns
     -------
     UQResult
+        ``timings``: seconds of sampling, evaluation and analysis summed over the chunks
+        (on a scheduler, worker time; the merges count as analysis) and ``wall``.
 
     Examples
     --------
@@ -709,6 +711,8 @@ def run_uq(scene, samples: int = 10**6, *, seed: int = 0, fidelity: str | None =
     if chunk_rows is not None and (isinstance(chunk_rows, bool) or not isinstance(chunk_rows, (int, np.integer))
                                    or chunk_rows < 1):
         raise ValueError(f"chunk_rows must be an integer >= 1; got {chunk_rows!r}")
+    if isinstance(sketch_k, bool) or not isinstance(sketch_k, (int, np.integer)) or sketch_k < 2:
+        raise ValueError(f"sketch_k must be an integer >= 2; got {sketch_k!r}")
     name, model, material, base, unc, outputs, tol = _scene_parts(scene)
     names = list(unc)
     D = len(names)

@@ -66,6 +66,27 @@ def test_uq_identical_on_cluster(client):
     assert a.sobol == b.sobol and a.summary == b.summary and a.fidelity == b.fidelity
 
 
+def test_uq_default_chunks_on_cluster(client):
+    """The scheduler's own chunk sizes (chunk_slices, whole groups): the same statistics as
+    in-process chunks, to rounding (moments and Sobol' sums merge in another grouping)."""
+    from ipmc_asym.studies.uq import run_uq
+
+    sc = {"name": "t", "voltage": "1V", "tolerance": 1e-2, "outputs": ["I", "rotation"],
+          "uncertain": {"thickness": {"dist": "normal", "mean": "200um", "sd": "10um"},
+                        "modulus": {"dist": "lognormal", "median": "130MPa", "sigma": 0.4}}}
+    a = run_uq(sc, 8000, fidelity="leading", chunk_rows=1000)
+    b = run_uq(sc, 8000, fidelity="leading", scheduler=client)
+    assert a.n_outside == b.n_outside > 0 and a.fidelity == b.fidelity and a.n_stored == b.n_stored
+    for o in a.summary:
+        for k in ("q2.5", "q50", "q97.5", "n"):  # exact while the sketch holds every value
+            assert a.summary[o][k] == b.summary[o][k]
+        assert b.summary[o]["mean"] == pytest.approx(a.summary[o]["mean"], rel=1e-13)
+        assert b.summary[o]["sd"] == pytest.approx(a.summary[o]["sd"], rel=1e-9)
+        for p, v in a.sobol[o].items():
+            for k, x in v.items():
+                assert b.sobol[o][p][k] == pytest.approx(x, rel=1e-9, abs=1e-12), (o, p, k)
+
+
 def test_uq_streamed_on_cluster_keeps_few_tasks_in_flight(client):
     """imap_chunks yields in task order with at most ``window`` tasks submitted ahead: a lazy
     task generator is read only as results are consumed."""
