@@ -25,7 +25,7 @@ from ipmc_asym.studies.uq import SOBOL_BATCHES, STORE_SAMPLES, run_uq
 #: chunk by chunk; ~1e6 runs/s at leading in one process, so ~2 min here); settable with --max-samples
 MAX_SAMPLES = 10**8
 #: runs kept per sample for --out and --plot (~100 B each): a memory cap, settable with --max-store-samples
-MAX_STORE_SAMPLES = 2**21
+MAX_STORE_SAMPLES = 2 * 10**6
 #: fewer runs give no usable 2.5 %/97.5 % quantile (a handful of samples beyond each) nor a
 #: Sobol' index with a batch-means interval
 MIN_SAMPLES = 100
