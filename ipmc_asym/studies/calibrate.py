@@ -177,6 +177,35 @@ def _parse_cell(col, text):
     raise ValueError(f"column {col!r} not readable")  # pragma: no cover - filtered earlier
 
 
+def read_rows(path, max_rows: int | None = MAX_DATA_ROWS) -> list:
+    """The non-empty, non-comment rows of a CSV (header first), at most ``max_rows`` data rows.
+
+    A UTF-8 byte-order mark (Excel's "CSV UTF-8") is skipped; a line whose first cell starts
+    with ``#`` is a comment.  One-line ``ValueError`` for an unreadable, empty or too long file.
+    """
+    p = os.fspath(path)
+    name = os.path.basename(p)
+    if max_rows is not None and (isinstance(max_rows, bool) or int(max_rows) < 1):
+        raise ValueError(f"max_rows must be an integer >= 1 or None; got {max_rows!r}")
+    rows = []
+    try:
+        # utf-8-sig: a byte-order mark (Excel's "CSV UTF-8") is not part of the first header name
+        with open(p, newline="", encoding="utf-8-sig") as fh:
+            for r in csv.reader(fh):
+                if not any(c.strip() for c in r) or r[0].lstrip().startswith("#"):
+                    continue
+                rows.append(r)
+                # header + max_rows data rows; one more is refused before the rest is read
+                if max_rows is not None and len(rows) > int(max_rows) + 1:
+                    raise ValueError(f"{name}: more than {int(max_rows)} data rows (the cap; --max-rows "
+                                     f"on the command line)")
+    except (OSError, UnicodeDecodeError, csv.Error) as exc:
+        raise ValueError(f"data file {p!r}: cannot read ({exc.__class__.__name__})") from None
+    if not rows:
+        raise ValueError(f"{name}: empty file (need a header row and data rows)")
+    return rows
+
+
 def read_data(path, base: Strip | None = None, max_rows: int | None = MAX_DATA_ROWS) -> CalibrationData:
     """Read a calibration CSV (header row; SI numbers or values with units).
 
@@ -206,22 +235,7 @@ def read_data(path, base: Strip | None = None, max_rows: int | None = MAX_DATA_R
     name = os.path.basename(p)
     if max_rows is not None and (isinstance(max_rows, bool) or int(max_rows) < 1):
         raise ValueError(f"max_rows must be an integer >= 1 or None; got {max_rows!r}")
-    rows = []
-    try:
-        # utf-8-sig: a byte-order mark (Excel's "CSV UTF-8") is not part of the first header name
-        with open(p, newline="", encoding="utf-8-sig") as fh:
-            for r in csv.reader(fh):
-                if not any(c.strip() for c in r) or r[0].lstrip().startswith("#"):
-                    continue
-                rows.append(r)
-                # header + max_rows data rows; one more is refused before the rest is read
-                if max_rows is not None and len(rows) > int(max_rows) + 1:
-                    raise ValueError(f"{name}: more than {int(max_rows)} data rows (the cap; --max-rows "
-                                     f"on the command line)")
-    except (OSError, UnicodeDecodeError, csv.Error) as exc:
-        raise ValueError(f"data file {p!r}: cannot read ({exc.__class__.__name__})") from None
-    if not rows:
-        raise ValueError(f"{name}: empty file (need a header row and data rows)")
+    rows = read_rows(p, max_rows)
     header = [h.strip().lower() for h in rows[0]]
     allowed = list(GEOMETRY) + list(MEASURED) + [f"sigma_{m}" for m in MEASURED]
     for j, h in enumerate(header, 1):
