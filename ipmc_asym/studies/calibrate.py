@@ -39,6 +39,11 @@ worst-case linearised shift of every estimate is below a tenth of its standard e
 forms exist for the paper's permittivity pairs only, so a free ``eps0``/``deps`` starts at
 ``quadrature``.
 
+Time series and impedance spectra (with or without static rows; free ``diffusion``,
+``viscous_modulus``, ``sheet_resistance``) are fitted by
+:mod:`ipmc_asym.studies.calibrate_dynamic`, which shares this module's profile, statuses and
+report (:func:`_report`) and its rule of which data see which parameter (:data:`VISIBLE_TO`).
+
 Layer rule: stdlib + numpy at import; SciPy's optimiser and statistics deferred.
 """
 
@@ -596,7 +601,10 @@ def fit(data: CalibrationData, free, model="constant", material: Material = NAFI
     data : CalibrationData
     free : str, list or dict
         Names from :data:`FREE_PARAMETERS` (``modulus``, ``c_moy``, ``eps0``, ``deps``), or
-        ``{name: (lo, hi)}`` bounds in SI (default bounds otherwise).
+        ``{name: (lo, hi)}`` bounds in SI (default bounds otherwise).  ``diffusion``,
+        ``viscous_modulus`` and ``sheet_resistance`` are refused here (static rows do not
+        depend on them): time series and spectra go to
+        :func:`ipmc_asym.studies.calibrate_dynamic.fit_dynamic`.
     model : {"constant", "linear", "affine"}
         Permittivity model (its eps0/deps are the start/fixed values).
     material : Material

@@ -39,9 +39,9 @@ series or a spectrum, ``viscous_modulus`` a time series of deflection or force w
 dynamic beam, ``sheet_resistance`` a spectrum (the electrode line exists in the frequency
 domain only), ``modulus`` deflection or force data; a parameter the data given cannot see is
 refused before any work, in one line naming the data that would identify it.  What the data
-then determine is the profile's answer: a spectrum sees ``eps0`` and ``deps`` only through
-``eps_moy = eps0 + deps`` (about 0 V the layers linearise about the core), so both free on a
-spectrum alone are ``not_identifiable``.
+then determine is the profile's answer: a spectrum sees ``eps0`` and ``deps`` through
+``eps_moy = eps0 + deps`` (about 0 V the layers linearise about the core; the split moves ``Z``
+by ~1e-5 relative), so both free on a spectrum alone are ``not_identifiable``.
 
 Fidelity: static rows climb the static ladder as in the static fit; time series start with the
 reduced circuit, whose error at the optimum is its difference from the PNP solver run at a
@@ -658,6 +658,10 @@ def fit_dynamic(datasets, free, model="constant", material: Material = NAFION_LI
         raise ValueError("--free viscous_modulus: the quasi-static beam has no damping; use --beam dynamic")
     has_time = any(isinstance(d, TimeData) for d in parts)
     has_static = any(isinstance(d, CalibrationData) for d in parts)
+    if has_time and ("sheet_resistance" in names or material.sheet_resistance > 0):
+        raise ValueError("time series with an electrode sheet resistance: the time-domain model has ideal electrodes "
+                         "(the electrode line is modelled in the frequency domain only); fit sheet_resistance on "
+                         "spectra without the time series")
     perm = get_model(model)
     if has_time and perm.eps0 == 0.0 and "eps0" not in names:
         raise ValueError("time series with the linear model: it has no PNP rung (eps -> 0 at the anode), so the "
