@@ -737,12 +737,13 @@ def _fit_joint(parts, names, bounds, lo, hi, starts, s_ladder, t_ladder, has_sta
         bias_bad = bool(np.any(bias >= 0.1))
         if not fails and not bias_bad:
             break
-        why = ", ".join(f"{k} rows: model error {worst[k]:.2g} of the weight scale" for k in fails)
+        why = ", ".join(f"{k} rows: model error up to {worst[k]:.2g} x the weight scale" for k in fails)
         if bias_bad:
             j = int(np.argmax(bias))
             why += (", " if why else "") + f"model error could shift {names[j]} by {bias[j]:.2g} standard errors"
+        need = "0.1 sigma" if has_sigma else f"0.1 x the estimated relative noise s = {rel:.2g}"
         notes.append(f"at {', '.join(f'{k} {v}' for k, v in fid.items() if v and k != 'pnp_tol')}: {why} "
-                     f"(need < 0.1 x the noise {rel:.2g})")
+                     f"(need < {need})")
         # escalate the kinds that fail (the bias alone: every kind that carries model error)
         up = set(fails) or {k for k, w in worst.items() if w > 0}
         moved = False

@@ -258,3 +258,27 @@ def test_time_series_drive_from_a_waveform(tmp_path):
     (tmp_path / "v.csv").write_text("t,voltage,current\n1ms,0.5V,1mA\n2ms,0.5V,0.8mA\n")
     with pytest.raises(ValueError, match="the drive is given twice"):
         read_file(tmp_path / "v.csv", waveform="step:0.5V")
+
+
+@pytest.fixture(scope="module")
+def precise_charge(tmp_path_factory):
+    """A step charge from the PNP solver (tol 1e-7) with 2e-4 noise: finer than the circuit's error."""
+    t = np.linspace(0.0, 0.05, 21)[1:]
+    truth = _step_truth(t, "pnp", pnp_options={"tol": 1e-7})
+    return read_file(_step_csv(tmp_path_factory.mktemp("precise") / "s.csv", t, truth, 3, ("charge",), noise=2e-4))
+
+
+def test_circuit_refused_on_data_finer_than_its_error(precise_charge):
+    """The circuit's difference from the PNP exceeds a tenth of sigma: forced to the circuit, the fit refuses."""
+    with pytest.raises(ValueError, match="no rung is accurate enough .* time rows: model error .* leave the fidelity "
+                                         "unset") as e:
+        fit_dynamic(precise_charge, "diffusion", material=MAT, strip=STRIP, time_fidelity="circuit")
+    assert "\n" not in str(e.value)
+
+
+@pytest.mark.slow
+def test_precise_data_escalate_to_pnp(precise_charge):
+    """Left to choose, the fit climbs to the PNP rung and recovers D inside its interval."""
+    r = fit_dynamic(precise_charge, "diffusion", material=MAT.with_(D=2e-10), strip=STRIP)
+    assert r.fidelity.startswith("time series pnp"), r.fidelity
+    _inside(r, {"diffusion": TRUE["diffusion"]}, 0.003)
