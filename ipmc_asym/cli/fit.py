@@ -106,8 +106,6 @@ def run(args) -> int:
     strip = strip_from_args(args)
     files = [read_file(d, strip, waveform=args.waveform, max_rows=args.max_rows) for d in args.data]
     static_only = len(files) == 1 and isinstance(files[0], CalibrationData)
-    if args.plot and not all(isinstance(d, CalibrationData) for d in files):
-        raise ValueError("--plot draws static rows only; leave it out with time series or spectra")
     if static_only:
         for opt, val in (("--waveform", args.waveform), ("--beam", args.beam), ("--time-fidelity", args.time_fidelity)):
             if val is not None:
@@ -124,9 +122,12 @@ def run(args) -> int:
                           scheduler=args.scheduler, progress=False if args.no_progress else None)
     source = ", ".join(d.source for d in files)
     if args.plot:
-        from ipmc_asym.plotting.calibrate import plot_fit  # deferred: matplotlib (start-up)
+        from ipmc_asym.plotting.calibrate import plot_fit, plot_fit_dynamic  # deferred: matplotlib (start-up)
 
-        plot_fit(res, args.plot)
+        if static_only:
+            plot_fit(res, args.plot)
+        else:
+            plot_fit_dynamic(res, args.plot)
     if args.json:
         print(dumps(res.as_dict(), indent=2))
     else:

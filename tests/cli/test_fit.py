@@ -144,5 +144,8 @@ def test_fit_spectrum_and_static_files_together(data_csv, tmp_path, capsys):
     assert main(["fit", str(bad), "--free", "D"]) == 2
     err = capsys.readouterr().err
     assert "negate that column" in err and err.count("\n") == 1
-    assert main(["fit", str(imp), "--free", "D", "--plot", str(tmp_path / "f.png")]) == 2
+    png = tmp_path / "f.png"
+    assert main(["fit", data_csv, str(imp), "--free", "c_moy,D", "--length", "1.5cm", "--modulus", "90MPa",
+                 "--plot", str(png)]) == 0
+    assert png.stat().st_size > 10_000
     assert main(["fit", data_csv, "--free", "modulus", "--waveform", "step:1V"]) == 2
