@@ -282,3 +282,11 @@ def test_precise_data_escalate_to_pnp(precise_charge):
     r = fit_dynamic(precise_charge, "diffusion", material=MAT.with_(D=2e-10), strip=STRIP)
     assert r.fidelity.startswith("time series pnp"), r.fidelity
     _inside(r, {"diffusion": TRUE["diffusion"]}, 0.003)
+
+
+def test_multistart_on_a_spectrum(tmp_path):
+    Z = z_exact(FREQ, MAT, get_model("constant").eps_moy)
+    d = read_file(_spectrum_csv(tmp_path / "imp.csv", Z, seed=1))
+    r = fit_dynamic(d, "diffusion,c_moy", strip=STRIP, multistart=2, seed=3)
+    assert "multistart: best of 3 starts" in r.message
+    _inside(r, TRUE, 0.03)
