@@ -14,11 +14,11 @@ Kinds of files (the header decides; each file is one kind):
 * **time series** (a ``t`` column, s): the strip from the strip options (TOTAL thickness 2e),
   charged from rest at ``t = 0`` by the drive: a ``voltage`` column (the applied voltage at each
   ``t``, linear between rows and the first row's value from ``t = 0``: a constant column is a
-  step of that height at ``t = 0``), or a waveform SPEC (:func:`ipmc_asym.dynamics.waveforms.
-  parse_waveform`, ``--waveform``).  Measured, signed: ``current`` (A, total current into the
-  face at ``phi0``), ``charge`` (C, charge of that face), ``deflection`` (m, tip deflection,
-  positive in the direction a positive voltage bends the strip, i.e. ``-w``), ``blocking_force``
-  (N, positive for a positive voltage).  The model is
+  step of that height at ``t = 0``), or a waveform SPEC
+  (:func:`ipmc_asym.dynamics.waveforms.parse_waveform`, ``--waveform``).  Measured, signed:
+  ``current`` (A, total current into the face at ``phi0``), ``charge`` (C, charge of that
+  face), ``deflection`` (m, tip deflection, positive in the direction a positive voltage bends
+  the strip, i.e. ``-w``), ``blocking_force`` (N, positive for a positive voltage).  The model is
   :func:`ipmc_asym.dynamics.circuit.step_response` (reduced circuit or PNP, quasi-static or
   dynamic beam; the mechanics through the forward model).
 * **impedance spectrum** (an ``f`` column, Hz): ``Z_re, Z_im`` (Ohm, the strip's impedance,
