@@ -290,3 +290,30 @@ def test_multistart_on_a_spectrum(tmp_path):
     r = fit_dynamic(d, "diffusion,c_moy", strip=STRIP, multistart=2, seed=3)
     assert "multistart: best of 3 starts" in r.message
     _inside(r, TRUE, 0.03)
+
+
+def test_two_static_files_equal_the_static_fit_of_their_rows(tmp_path):
+    """The joint path on static rows split over two files gives the static fit of one file with all rows."""
+    from ipmc_asym.forward.estimate import evaluate
+
+    mat = NAFION_LI.with_(E=9e7, c_moy=2900.0)
+    rng = np.random.default_rng(5)
+    head = "voltage,thickness,deflection,blocking_force,sigma_deflection,sigma_blocking_force"
+    rows = {}
+    for name, t in (("a", 150e-6), ("b", 250e-6)):
+        rows[name] = []
+        for v in np.linspace(0.2, 0.8, 6):
+            r = evaluate(Strip(length=0.015, thickness=t, voltage=float(v)), "constant", "quadrature", mat)
+            w, f = abs(r["w"]), abs(r["F_block"])
+            rows[name].append(f"{v:.4f}V,{t},{w * (1 + 0.02 * rng.standard_normal())},"
+                              f"{f * (1 + 0.02 * rng.standard_normal())},{0.02 * w},{0.02 * f}")
+        (tmp_path / f"{name}.csv").write_text("\n".join([head] + rows[name]) + "\n")
+    (tmp_path / "ab.csv").write_text("\n".join([head] + rows["a"] + rows["b"]) + "\n")
+    base = Strip(length=0.015)
+    one = fit(read_data(tmp_path / "ab.csv", base), "modulus,c_moy")
+    two = fit_dynamic([read_file(tmp_path / "a.csv", base), read_file(tmp_path / "b.csv", base)], "modulus,c_moy")
+    assert two.fidelity == f"static rows {one.fidelity}"
+    assert two.chi2_red == pytest.approx(one.chi2_red, rel=1e-9)
+    for k in ("modulus", "c_moy"):
+        assert two.parameters[k]["value"] == pytest.approx(one.parameters[k]["value"], rel=1e-6)
+        assert two.parameters[k]["ci95"] == pytest.approx(one.parameters[k]["ci95"], rel=1e-6)
