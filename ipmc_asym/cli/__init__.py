@@ -57,7 +57,8 @@ SUMMARIES = {
     "sweep": "evaluate the strip on a grid of parameters",
     "validate": "each claim of the paper vs our numbers, with a verdict",
     "figures": "regenerate the paper's Figs 4-10 (+ speed/accuracy) as PNG",
-    "fit": "calibrate modulus, c_moy, permittivity on measured deflection/force (profile intervals)",
+    "fit": "calibrate modulus, c_moy, permittivity, D, damping, sheet resistance on deflection/force, time series "
+           "and impedance spectra (profile intervals)",
     "uq": "uncertainty quantiles and Sobol' indices of a scene's [uncertain] inputs",
     "charge": "electrode charge, differential capacitance and apparent permittivity (static)",
     "step": "charging transient after a voltage step: sigma, current, moment, w vs time",

@@ -1,4 +1,5 @@
-"""``ipmc-asym fit``: calibrate free parameters on measured deflection / blocking force."""
+"""``ipmc-asym fit``: calibrate free parameters on measured deflection / blocking force, time series and
+impedance spectra (one or several files; each file's header decides its kind)."""
 
 from __future__ import annotations
 
@@ -9,34 +10,72 @@ from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import (
     add_size_option,
     add_strip_options,
+    arg_type,
     count_type,
+    diffusion_type,
     fmt_num,
     material_from_args,
     model_help,
     seed_type,
     strip_from_args,
 )
+from ipmc_asym.cli.drive import _waveform, viscous_modulus_type
+from ipmc_asym.cli.freq import _sheet
+from ipmc_asym.dynamics.circuit import BEAM_CHOICES
 from ipmc_asym.io.fileio import FIGURE_FORMATS, check_output_path
 from ipmc_asym.io.jsonio import dumps
 from ipmc_asym.parallel.executors import check_scheduler
-from ipmc_asym.studies.calibrate import FREE_PARAMETERS, MAX_DATA_ROWS, fit, parse_free, read_data
+from ipmc_asym.studies.calibrate import FREE_PARAMETERS, MAX_DATA_ROWS, CalibrationData, fit, parse_free
+from ipmc_asym.studies.calibrate_dynamic import TIME_FIDELITIES, fit_dynamic, read_file
+
+#: data files of one fit (each read into memory, at most --max-rows rows)
+MAX_FILES = 100
+
+DESCRIPTION = (
+    "Weighted least squares of one or several data files together, 95 % profile-likelihood intervals, "
+    "identifiability. The header of each file decides its kind. STATIC rows: columns length, width, thickness "
+    "(TOTAL 2e), voltage; measured deflection, blocking_force (magnitudes). TIME SERIES (a t column, s; the strip "
+    "of --length/--width/--thickness, at rest at t = 0): the drive as a voltage column (V at each t, linear between "
+    "rows; a constant column is a step at t = 0) or --waveform SPEC; measured, signed: current (A), charge (C), "
+    "deflection (m, positive where a positive voltage bends the strip), blocking_force (N); model: the reduced "
+    "circuit, checked at the optimum against the PNP solver and escalated to it where its error is not below a "
+    "tenth of the noise. IMPEDANCE SPECTRA (an f column, Hz): Z_re, Z_im (Ohm, Z_im < 0) or Z_abs (Ohm), Z_phase "
+    "(deg), about 0 V; model: the exact linearised PNP through the electrode line. Optional sigma_<measured> "
+    "(one standard deviation) in every file or in none (then one relative noise scale is estimated). Free "
+    "parameters: modulus, c_moy, eps0, deps (any data), diffusion (alias D; time series or spectra), "
+    "viscous_modulus (time series of deflection/force, --beam dynamic), sheet_resistance (spectra); a parameter "
+    "the data cannot see is refused naming the data that would identify it. Water transport is outside the model.")
 
 #: extra starts of a multistart (each a full least-squares solve); settable with --max-multistart
 MAX_MULTISTART = 1000
 
 
 def register(sub):
-    p = sub.add_parser("fit", help=SUMMARIES["fit"],
-                       description="Weighted least squares of DATA.csv (columns length, width, thickness "
-                                   "(TOTAL 2e), voltage; measured deflection, blocking_force; optional "
-                                   "sigma_<measured>), 95 % profile-likelihood intervals, identifiability.")
-    p.add_argument("data", metavar="DATA.csv", help="measurements (header row; SI or values with units)")
+    p = sub.add_parser("fit", help=SUMMARIES["fit"], description=DESCRIPTION)
+    p.add_argument("data", metavar="DATA.csv", nargs="+",
+                   help="measurements (header row; SI or values with units); several files are fitted together")
     p.add_argument("--free", required=True, metavar="NAME[,NAME...]",
-                   help=f"free parameters among {', '.join(FREE_PARAMETERS)}; optional bounds NAME=LO:HI")
+                   help=f"free parameters among {', '.join(FREE_PARAMETERS)} (D = diffusion); optional bounds "
+                        f"NAME=LO:HI with units (modulus=50MPa:500MPa, D=1e-11m2/s:1e-9m2/s)")
     p.add_argument("--model", default="constant", choices=list(model_names()), help=model_help("constant"))
     p.add_argument("--fidelity", default=None, choices=list(fidelity_names()),
                    help="force a fidelity (default: cheapest with error < 1/10 of the data's)")
     add_strip_options(p)
+    p.add_argument("--waveform", type=arg_type(_waveform, "--waveform"), default=None, metavar="SPEC",
+                   help="drive of the time series without a voltage column (as drive --waveform: 'step:0.5V', "
+                        "'sine:1V@2Hz', 'csv:V.csv')")
+    p.add_argument("--diffusion", type=diffusion_type(), default=None,
+                   help="cation diffusion coefficient D when not free, and the start when free (1e-10m2/s)")
+    p.add_argument("--sheet-resistance", dest="sheet_resistance", type=_sheet, default=None,
+                   help="electrode sheet resistance (Ohm/sq) of the spectra when not free, the start when free")
+    p.add_argument("--beam", default=None, choices=BEAM_CHOICES,
+                   help="mechanics of the time series (default: dynamic when viscous_modulus is free, else "
+                        "quasi-static)")
+    p.add_argument("--viscous-modulus", dest="viscous_modulus", type=viscous_modulus_type(), default=0.0,
+                   help="Kelvin-Voigt viscous modulus (Pa s) when not free, the start when free (default 0)")
+    p.add_argument("--time-fidelity", default=None, choices=TIME_FIDELITIES,
+                   help="force the time series' rung (default: circuit, escalated to pnp where its error is too "
+                        "large; its error is checked either way)")
     add_size_option(p, "--multistart", default=0, maximum=MAX_MULTISTART, minimum=0, metavar="N",
                     help="N extra starts, log-uniform in the bounds; the best is kept")
     p.add_argument("--max-rows", type=count_type("--max-rows"), default=MAX_DATA_ROWS,
@@ -57,15 +96,38 @@ def run(args) -> int:
     if args.scheduler is not None:
         check_scheduler(args.scheduler)
     parse_free(args.free)
+    if len(args.data) > MAX_FILES:
+        raise ValueError(f"DATA.csv: {len(args.data)} files; at most {MAX_FILES}")
     material = material_from_args(args)
-    data = read_data(args.data, strip_from_args(args), max_rows=args.max_rows)
-    res = fit(data, args.free, model=args.model, material=material, fidelity=args.fidelity,
-              multistart=args.multistart, seed=args.seed, scheduler=args.scheduler,
-              progress=False if args.no_progress else None)
+    if args.diffusion is not None:
+        material = material.with_(D=args.diffusion)
+    if args.sheet_resistance is not None:
+        material = material.with_(sheet_resistance=args.sheet_resistance)
+    strip = strip_from_args(args)
+    files = [read_file(d, strip, waveform=args.waveform, max_rows=args.max_rows) for d in args.data]
+    static_only = len(files) == 1 and isinstance(files[0], CalibrationData)
+    if static_only:
+        for opt, val in (("--waveform", args.waveform), ("--beam", args.beam), ("--time-fidelity", args.time_fidelity)):
+            if val is not None:
+                raise ValueError(f"{opt}: only for time series (a file with a t column); {files[0].source} holds "
+                                 f"static rows")
+        data = files[0]
+        res = fit(data, args.free, model=args.model, material=material, fidelity=args.fidelity,
+                  multistart=args.multistart, seed=args.seed, scheduler=args.scheduler,
+                  progress=False if args.no_progress else None)
+    else:
+        res = fit_dynamic(files, args.free, model=args.model, material=material, strip=strip, beam=args.beam,
+                          viscous_modulus=args.viscous_modulus, fidelity=args.fidelity,
+                          time_fidelity=args.time_fidelity, multistart=args.multistart, seed=args.seed,
+                          scheduler=args.scheduler, progress=False if args.no_progress else None)
+    source = ", ".join(d.source for d in files)
     if args.plot:
-        from ipmc_asym.plotting.calibrate import plot_fit  # deferred: matplotlib (start-up)
+        from ipmc_asym.plotting.calibrate import plot_fit, plot_fit_dynamic  # deferred: matplotlib (start-up)
 
-        plot_fit(res, args.plot)
+        if static_only:
+            plot_fit(res, args.plot)
+        else:
+            plot_fit_dynamic(res, args.plot)
     if args.json:
         print(dumps(res.as_dict(), indent=2))
     else:
@@ -74,9 +136,9 @@ def run(args) -> int:
         else:
             gof = (f"noise scale s = {res.noise_scale:.3g} (relative, estimated from the residuals; no sigma_ "
                    f"columns, so no chi2 goodness of fit)")
-        print(f"fit of {data.source}: {res.n_points} measured values, model {res.model}, fidelity {res.fidelity}, "
+        print(f"fit of {source}: {res.n_points} measured values, model {res.model}, fidelity {res.fidelity}, "
               f"{gof}")
-        print(f"{'parameter':10s} {'value':>12s} {'stderr':>10s} {'95% interval (profile)':>28s}  unit")
+        print(f"{'parameter':16s} {'value':>12s} {'stderr':>10s} {'95% interval (profile)':>28s}  unit")
         for n, p in res.parameters.items():
             unit = FREE_PARAMETERS[n][0]
             lo, hi = p["ci95"]
@@ -87,7 +149,7 @@ def run(args) -> int:
                 side = " ".join(x for x in ((f">= {lo:.4g}" if lo is not None else ""),
                                             (f"<= {hi:.4g}" if hi is not None else "")) if x)
                 ci = ("AT THE BOUND " if p.get("status") == "at_bound" else "NOT IDENTIFIABLE ") + side
-            print(f"{n:10s} {p['value']:12.6g} {se} {ci:>28s}  {unit}")
+            print(f"{n:16s} {p['value']:12.6g} {se} {ci:>28s}  {unit}")
         names = list(res.parameters)
         if len(names) > 1:
             print("correlation: " + "; ".join(

@@ -1,4 +1,4 @@
-"""Data vs fitted model with residuals (``ipmc-asym fit --plot F.png``)."""
+"""Data vs fitted model with residuals (``ipmc-asym fit --plot F.png``; several files: :func:`plot_fit_dynamic`)."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ import numpy as np
 from ipmc_asym.base.quantities import unit_and_long_name
 from ipmc_asym.plotting import pyplot, savefig
 
-__all__ = ["plot_fit"]
+__all__ = ["plot_fit", "plot_fit_dynamic"]
 
 #: geometry column -> (display scale, unit, label)
 _AXIS = {"voltage": (1.0, "V", "voltage φ0"), "thickness": (1e6, "µm", "total thickness 2e"),
@@ -88,3 +88,75 @@ def plot_fit(result, path) -> str:
     fig.suptitle(f"fit [{result.model}, {result.fidelity}]: {pars}; {gof}", fontsize=10)
     fig.tight_layout()
     return savefig(fig, path, dpi=120)
+
+
+#: measured column -> (label, display scale) of the time series and spectra
+_DYN_LABEL = {"current": ("current [mA]", 1e3), "charge": ("charge [µC]", 1e6),
+              "deflection": ("tip deflection [mm]", 1e3), "blocking_force": ("blocking force [mN]", 1e3),
+              "Z_re": ("Re Z [Ω]", 1.0), "Z_im": ("Im Z [Ω]", 1.0), "Z_abs": ("|Z| [Ω]", 1.0),
+              "Z_phase": ("phase of Z [deg]", 180.0 / np.pi)}
+
+
+def plot_fit_dynamic(result, path) -> str:
+    """Every file of a joint fit (:func:`ipmc_asym.studies.calibrate_dynamic.fit_dynamic`): one column
+    per measured quantity of each file, data (points, 1-sigma bars if given) and the fitted model
+    (line) against the time (ms), the frequency (Hz, log) or the voltage (static rows); below, the
+    weighted residuals.
+
+    Parameters
+    ----------
+    result : ipmc_asym.studies.calibrate.CalibrationResult   (``data``, ``predictions``: lists)
+    path : str   PNG path (written atomically)
+    """
+    plt = pyplot()
+    panels = []
+    for d, pr in zip(result.data, result.predictions):
+        for k in d.measured:
+            panels.append((d, k, pr[k]))
+    n = len(panels)
+    fig, axes = plt.subplots(2, n, figsize=(4.2 * n, 5.4), squeeze=False, gridspec_kw={"height_ratios": [3, 1.3]})
+    for j, (d, k, pred) in enumerate(panels):
+        ax, axr = axes[0, j], axes[1, j]
+        y = d.measured[k]
+        m = np.isfinite(y)
+        if hasattr(d, "t"):
+            x, xl, logx = d.t[m] * 1e3, "time t [ms]", False
+        elif hasattr(d, "f"):
+            x, xl, logx = d.f[m], "frequency f [Hz]", True
+        else:
+            x, xl, logx = d.geometry["voltage"][m], "voltage φ0 [V]", False
+        lab, f = _DYN_LABEL.get(k, _LABEL.get(k, (k, 1.0)))
+        sig = d.sigma[k]
+        o = np.argsort(x)
+        ax.errorbar(x, f * y[m], yerr=None if sig is None else f * sig[m], fmt="o", ms=3, color="C0", label="data")
+        ax.plot(x[o], f * pred[o], "-", color="C3", lw=1.2, label="fit")
+        # the fit's own weights: sigma, else the relative scale of each kind (calibrate_dynamic docstring)
+        if sig is not None:
+            scale = sig[m]
+        elif k in ("Z_re", "Z_im"):
+            scale = np.hypot(d.measured["Z_re"], d.measured["Z_im"])[m]
+        elif k == "Z_phase":
+            scale = np.ones(x.size)
+        elif hasattr(d, "t"):
+            scale = np.full(x.size, np.sqrt(np.mean(y[m] ** 2)))
+        else:
+            scale = np.abs(y[m])
+        axr.plot(x, (y[m] - pred) / scale, "o", ms=3, color="C0")
+        axr.axhline(0, color="k", lw=0.8)
+        if logx:
+            ax.set_xscale("log")
+            axr.set_xscale("log")
+        if k == "Z_abs":
+            ax.set_yscale("log")
+        ax.set_ylabel(lab)
+        ax.set_title(f"{d.source}: {k.replace('_', ' ')}", fontsize=9)
+        ax.legend(fontsize=7)
+        axr.set_ylabel("(data − fit)/σ" if sig is not None else "(data − fit)/weight")
+        axr.set_xlabel(xl)
+    pars = ", ".join(f"{nm} = {p['value']:.4g}" + ("" if p["status"] == "ok" else f" ({p['status']})")
+                     for nm, p in result.parameters.items())
+    gof = (f"χ²_red = {result.chi2_red:.3g}" if result.chi2_red is not None
+           else f"noise s = {result.noise_scale:.2g} (relative, estimated)")
+    fig.suptitle(f"fit [{result.model}]: {pars}; {gof}", fontsize=10)
+    fig.tight_layout()
+    return savefig(fig, path, dpi=110)

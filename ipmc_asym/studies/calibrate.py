@@ -39,6 +39,11 @@ worst-case linearised shift of every estimate is below a tenth of its standard e
 forms exist for the paper's permittivity pairs only, so a free ``eps0``/``deps`` starts at
 ``quadrature``.
 
+Time series and impedance spectra (with or without static rows; free ``diffusion``,
+``viscous_modulus``, ``sheet_resistance``) are fitted by
+:mod:`ipmc_asym.studies.calibrate_dynamic`, which shares this module's profile, statuses and
+report (:func:`_report`) and its rule of which data see which parameter (:data:`VISIBLE_TO`).
+
 Layer rule: stdlib + numpy at import; SciPy's optimiser and statistics deferred.
 """
 
@@ -52,7 +57,15 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ipmc_asym.base.registry import closed_form_fidelities, fidelity_names
-from ipmc_asym.base.units import parse_force, parse_length, parse_pressure, parse_voltage
+from ipmc_asym.base.units import (
+    parse_diffusion,
+    parse_force,
+    parse_length,
+    parse_pressure,
+    parse_quantity,
+    parse_sheet_resistance,
+    parse_voltage,
+)
 from ipmc_asym.beam.statics import blocking_force_ratio
 from ipmc_asym.model.params import NAFION_LI, Material, Strip
 from ipmc_asym.model.permittivity import Permittivity, get_model
@@ -75,7 +88,43 @@ FREE_PARAMETERS = {
     "c_moy": ("mol/m^3", (10.0, 1e5), "mean cation concentration C_moy"),
     "eps0": ("F/m", (1e-10, 1.0), "permittivity at C = 0, eps0"),
     "deps": ("F/m", (1e-10, 1.0), "eps_moy - eps0"),
+    # seen by time series and impedance spectra only (calibrate_dynamic.fit_dynamic; VISIBLE_TO)
+    "diffusion": ("m^2/s", (1e-14, 1e-7), "cation diffusion coefficient D"),
+    "viscous_modulus": ("Pa s", (1.0, 1e9), "viscous modulus eta_E = E tau_v of the Kelvin-Voigt law (eq. (3))"),
+    "sheet_resistance": ("Ohm/sq", (1e-3, 1e4), "sheet resistance R_s of each electrode"),
 }
+#: other names a --free item may take (the key) for a name of FREE_PARAMETERS (the value)
+FREE_ALIASES = {"D": "diffusion", "E": "modulus", "R_s": "sheet_resistance", "eta_E": "viscous_modulus"}
+#: which kinds of data rows see each free parameter (static: deflection/blocking force at rest;
+#: time: a transient t -> current/charge/deflection/force; impedance: a spectrum f -> Z), and
+#: for a parameter no kind present sees, the data that would identify it
+VISIBLE_TO = {
+    "modulus": (("static", "time_mech"), "deflection or blocking-force data (static rows or a time series)"),
+    "c_moy": (("static", "time", "time_mech", "impedance"), "any data"),
+    "eps0": (("static", "time", "time_mech", "impedance"), "any data"),
+    "deps": (("static", "time", "time_mech", "impedance"), "any data"),
+    "diffusion": (("time", "time_mech", "impedance"),
+                  "a time series (t, current/charge/deflection) or an impedance spectrum (f, Z_re, Z_im): the "
+                  "static state does not depend on D"),
+    "viscous_modulus": (("time_mech",), "a time series of deflection or blocking force (the beam's damping; "
+                                        "beam dynamic)"),
+    "sheet_resistance": (("impedance",), "an impedance spectrum (f, Z_re, Z_im): the electrode line is modelled in "
+                                         "the frequency domain only"),
+}
+
+
+def check_visible(names, kinds) -> None:
+    """Refuse (one-line ``ValueError``) a free parameter that none of the data ``kinds`` depends on.
+
+    ``kinds``: the kinds of rows present (``static``, ``time`` for current/charge, ``time_mech``
+    for a time series of deflection/force, ``impedance``); the message names the data that
+    would identify the parameter (:data:`VISIBLE_TO`).
+    """
+    for k in names:
+        seen, need = VISIBLE_TO[k]
+        if not set(seen) & set(kinds):
+            have = ", ".join(sorted(kinds)) or "none"
+            raise ValueError(f"--free {k}: the data given ({have} rows) do not depend on it; it needs {need}")
 #: measured columns -> unit (magnitudes)
 MEASURED = {"deflection": "m", "blocking_force": "N"}
 GEOMETRY = ("length", "width", "thickness", "voltage")
@@ -133,6 +182,35 @@ def _parse_cell(col, text):
     raise ValueError(f"column {col!r} not readable")  # pragma: no cover - filtered earlier
 
 
+def read_rows(path, max_rows: int | None = MAX_DATA_ROWS) -> list:
+    """The non-empty, non-comment rows of a CSV (header first), at most ``max_rows`` data rows.
+
+    A UTF-8 byte-order mark (Excel's "CSV UTF-8") is skipped; a line whose first cell starts
+    with ``#`` is a comment.  One-line ``ValueError`` for an unreadable, empty or too long file.
+    """
+    p = os.fspath(path)
+    name = os.path.basename(p)
+    if max_rows is not None and (isinstance(max_rows, bool) or int(max_rows) < 1):
+        raise ValueError(f"max_rows must be an integer >= 1 or None; got {max_rows!r}")
+    rows = []
+    try:
+        # utf-8-sig: a byte-order mark (Excel's "CSV UTF-8") is not part of the first header name
+        with open(p, newline="", encoding="utf-8-sig") as fh:
+            for r in csv.reader(fh):
+                if not any(c.strip() for c in r) or r[0].lstrip().startswith("#"):
+                    continue
+                rows.append(r)
+                # header + max_rows data rows; one more is refused before the rest is read
+                if max_rows is not None and len(rows) > int(max_rows) + 1:
+                    raise ValueError(f"{name}: more than {int(max_rows)} data rows (the cap; --max-rows "
+                                     f"on the command line)")
+    except (OSError, UnicodeDecodeError, csv.Error) as exc:
+        raise ValueError(f"data file {p!r}: cannot read ({exc.__class__.__name__})") from None
+    if not rows:
+        raise ValueError(f"{name}: empty file (need a header row and data rows)")
+    return rows
+
+
 def read_data(path, base: Strip | None = None, max_rows: int | None = MAX_DATA_ROWS) -> CalibrationData:
     """Read a calibration CSV (header row; SI numbers or values with units).
 
@@ -162,22 +240,7 @@ def read_data(path, base: Strip | None = None, max_rows: int | None = MAX_DATA_R
     name = os.path.basename(p)
     if max_rows is not None and (isinstance(max_rows, bool) or int(max_rows) < 1):
         raise ValueError(f"max_rows must be an integer >= 1 or None; got {max_rows!r}")
-    rows = []
-    try:
-        # utf-8-sig: a byte-order mark (Excel's "CSV UTF-8") is not part of the first header name
-        with open(p, newline="", encoding="utf-8-sig") as fh:
-            for r in csv.reader(fh):
-                if not any(c.strip() for c in r) or r[0].lstrip().startswith("#"):
-                    continue
-                rows.append(r)
-                # header + max_rows data rows; one more is refused before the rest is read
-                if max_rows is not None and len(rows) > int(max_rows) + 1:
-                    raise ValueError(f"{name}: more than {int(max_rows)} data rows (the cap; --max-rows "
-                                     f"on the command line)")
-    except (OSError, UnicodeDecodeError, csv.Error) as exc:
-        raise ValueError(f"data file {p!r}: cannot read ({exc.__class__.__name__})") from None
-    if not rows:
-        raise ValueError(f"{name}: empty file (need a header row and data rows)")
+    rows = read_rows(p, max_rows)
     header = [h.strip().lower() for h in rows[0]]
     allowed = list(GEOMETRY) + list(MEASURED) + [f"sigma_{m}" for m in MEASURED]
     for j, h in enumerate(header, 1):
@@ -266,6 +329,7 @@ def parse_free(spec) -> dict:
                 items.append((s, None))
     out = {}
     for k, b in items:
+        k = FREE_ALIASES.get(k, k)
         if k not in FREE_PARAMETERS:
             raise ValueError(f"--free: unknown parameter {k!r}; allowed: {', '.join(FREE_PARAMETERS)}")
         if k in out:
@@ -283,9 +347,24 @@ def parse_free(spec) -> dict:
     return out
 
 
+#: units accepted on the bounds of --free (besides a bare SI number)
+_BOUND_UNITS = {
+    "c_moy": ({"mol/m^3": 1.0, "mol/m3": 1.0, "mM": 1.0, "M": 1e3, "mol/L": 1e3}, "concentration"),
+    "eps0": ({"F/m": 1.0}, "permittivity"),
+    "deps": ({"F/m": 1.0}, "permittivity"),
+    "viscous_modulus": ({"Pa s": 1.0, "Pa*s": 1.0, "Pa.s": 1.0, "kPa s": 1e3, "MPa s": 1e6}, "viscous modulus"),
+}
+
+
 def _bound(k, x):
     if k == "modulus":
         return parse_pressure(k, x)
+    if k == "diffusion":
+        return parse_diffusion(f"--free {k}", x)
+    if k == "sheet_resistance":
+        return parse_sheet_resistance(f"--free {k}", x)
+    if k in _BOUND_UNITS:
+        return parse_quantity(f"--free {k}", x, *_BOUND_UNITS[k])
     try:
         return float(x)
     except (TypeError, ValueError):
@@ -307,6 +386,10 @@ def _material(material: Material, values) -> Material:
         kw["E"] = float(values["modulus"])
     if "c_moy" in values:
         kw["c_moy"] = float(values["c_moy"])
+    if "diffusion" in values:
+        kw["D"] = float(values["diffusion"])
+    if "sheet_resistance" in values:
+        kw["sheet_resistance"] = float(values["sheet_resistance"])
     return material.with_(**kw) if kw else material
 
 
@@ -446,6 +529,16 @@ class _Problem:
         d["bar"] = None  # workers of a multistart get no bar
         return d
 
+    def sub(self, names, fixed):
+        """The same data with ``names`` free and ``fixed`` held (a profile's inner problem)."""
+        out = _Problem(self.data, names, self.model, self.material, self.fidelity, fixed)
+        out.bar = self.bar
+        return out
+
+    def labels(self):
+        """What each residual is, for warnings: ``"row N"`` (data rows count from 2, header 1)."""
+        return [f"row {int(i) + 2}" for i in _row_of_residual(self)]
+
     def values(self, x):
         v = dict(self.fixed)
         v.update({n: math.exp(float(xi)) for n, xi in zip(self.names, x)})
@@ -508,7 +601,10 @@ def fit(data: CalibrationData, free, model="constant", material: Material = NAFI
     data : CalibrationData
     free : str, list or dict
         Names from :data:`FREE_PARAMETERS` (``modulus``, ``c_moy``, ``eps0``, ``deps``), or
-        ``{name: (lo, hi)}`` bounds in SI (default bounds otherwise).
+        ``{name: (lo, hi)}`` bounds in SI (default bounds otherwise).  ``diffusion``,
+        ``viscous_modulus`` and ``sheet_resistance`` are refused here (static rows do not
+        depend on them): time series and spectra go to
+        :func:`ipmc_asym.studies.calibrate_dynamic.fit_dynamic`.
     model : {"constant", "linear", "affine"}
         Permittivity model (its eps0/deps are the start/fixed values).
     material : Material
@@ -549,6 +645,7 @@ def fit(data: CalibrationData, free, model="constant", material: Material = NAFI
         raise ValueError(f"seed must be an integer >= 0; got {seed!r}")
     bounds = parse_free(free)
     names = list(bounds)
+    check_visible(names, ("static",))
     p = len(names)
     n = data.n_points
     need = p + (0 if data.has_sigma else 1)
@@ -628,16 +725,45 @@ def _fit(data, bounds, names, p, n, lo, hi, x0, ladder, starts, model, material,
         raise ValueError(f"no fidelity is accurate enough for data this precise ({'; '.join(notes)})")
     prob = _Problem(data, names, model, material, chosen)
     prob.bar = bar
+    params, corr, chi2_red, noise_scale = _report(prob, res, lo, hi, n, data.has_sigma, stats, notes, warns)
+    out, _, _, chk = predict(prob.values(res.x), data.geometry, model, chosen, material, with_checks=True)
+    flagged = {c: [int(i) for i in np.flatnonzero(~ok)] for c, ok in chk.items() if not np.all(ok)}
+    warns.extend(_assumption_warnings(flagged, data))
+    msg = (f"fidelity {chosen} (cheapest with error estimate < 1/10 of the data's relative error and a model-error "
+           f"shift < 0.1 standard error on every estimate)")
+    if notes:
+        msg += "; " + "; ".join(notes)
+    if flagged:  # the rows' fitted states outside a model assumption (kept in the fit, said here)
+        msg += "; at the fit, data rows outside a model assumption: " + "; ".join(
+            f"{c}: rows {', '.join(map(str, rows[:10]))}{' ...' if len(rows) > 10 else ''}" for c, rows in flagged.items())
+
+    return CalibrationResult(parameters=params, correlation=corr, chi2_red=chi2_red, n_points=n,
+                             fidelity=chosen, model=get_model(model).name, success=bool(res.success),
+                             message=msg, names=names, predictions=out, data=data, flagged_rows=flagged,
+                             noise_scale=noise_scale, warnings=warns)
+
+
+def _report(prob, res, lo, hi, n, has_sigma, stats, notes, warns):
+    """Estimates, profile intervals, statuses and correlations at the optimum ``res`` of ``prob``.
+
+    The one place that decides what is reported (``ok`` / ``at_bound`` / ``not_identifiable``,
+    standard error only where the profile is locally quadratic) for the static fit and the
+    joint fit of :mod:`ipmc_asym.studies.calibrate_dynamic`.  ``prob`` is a residual problem
+    (``names``, ``residuals``, ``sub``, ``labels``); appends to ``notes`` and ``warns``.
+    Returns ``(parameters, correlation, chi2_red, noise_scale)``.
+    """
+    names = prob.names
+    p = len(names)
     chi2 = 2.0 * float(res.cost)
     dof = n - p
     s2_hat = chi2 / dof if dof > 0 else float("nan")
     # chi2_red is a goodness of fit only with known sigma; without it the scale is estimated
     # (s^2 = chi^2/(n - p)) and chi2/(s^2 (n - p)) = 1 identically
-    chi2_red = s2_hat if data.has_sigma else None
-    noise_scale = None if data.has_sigma else math.sqrt(s2_hat)
-    s2 = 1.0 if data.has_sigma else s2_hat
-    thr = float(stats.chi2.ppf(0.95, 1)) if data.has_sigma else float(stats.t.ppf(0.975, dof) ** 2)
-    if data.has_sigma and dof > 0:
+    chi2_red = s2_hat if has_sigma else None
+    noise_scale = None if has_sigma else math.sqrt(s2_hat)
+    s2 = 1.0 if has_sigma else s2_hat
+    thr = float(stats.chi2.ppf(0.95, 1)) if has_sigma else float(stats.t.ppf(0.975, dof) ** 2)
+    if has_sigma and dof > 0:
         pval = float(stats.chi2.sf(chi2, dof))
         if pval < 1e-3:
             warns.append(_outlier_warning(prob, res.x, chi2_red, pval, dof))
@@ -700,21 +826,7 @@ def _fit(data, bounds, names, p, n, lo, hi, x0, ladder, starts, model, material,
             else:
                 row.append(None)
         corr.append(row)
-    out, _, _, chk = predict(prob.values(res.x), data.geometry, model, chosen, material, with_checks=True)
-    flagged = {c: [int(i) for i in np.flatnonzero(~ok)] for c, ok in chk.items() if not np.all(ok)}
-    warns.extend(_assumption_warnings(flagged, data))
-    msg = (f"fidelity {chosen} (cheapest with error estimate < 1/10 of the data's relative error and a model-error "
-           f"shift < 0.1 standard error on every estimate)")
-    if notes:
-        msg += "; " + "; ".join(notes)
-    if flagged:  # the rows' fitted states outside a model assumption (kept in the fit, said here)
-        msg += "; at the fit, data rows outside a model assumption: " + "; ".join(
-            f"{c}: rows {', '.join(map(str, rows[:10]))}{' ...' if len(rows) > 10 else ''}" for c, rows in flagged.items())
-
-    return CalibrationResult(parameters=params, correlation=corr, chi2_red=chi2_red, n_points=n,
-                             fidelity=chosen, model=get_model(model).name, success=bool(res.success),
-                             message=msg, names=names, predictions=out, data=data, flagged_rows=flagged,
-                             noise_scale=noise_scale, warnings=warns)
+    return params, corr, chi2_red, noise_scale
 
 
 #: the profile is "locally quadratic" when each of its 95 % ends lies within this fraction of
@@ -738,9 +850,9 @@ def _row_of_residual(prob) -> np.ndarray:
 
 def _outlier_warning(prob, x, chi2_red, pval, dof) -> str:
     r = prob.residuals(x)
-    rows = _row_of_residual(prob)
+    labels = prob.labels()
     worst = np.argsort(-np.abs(r))[:3]
-    which = ", ".join(f"row {int(rows[i]) + 2} ({r[i]:+.1f} sigma)" for i in worst)
+    which = ", ".join(f"{labels[i]} ({r[i]:+.1f} sigma)" for i in worst)
     pv = f"= {pval:.1g}" if pval > 0 else "< 1e-300"
     return (f"chi2_red = {chi2_red:.3g} with the given sigma (p {pv}, {dof} degrees of freedom): outliers "
             f"or underestimated sigma; largest standardised residuals: {which}; the intervals assume the model "
@@ -810,9 +922,7 @@ def _profile(prob, xhat, j, lo, hi, chi2min, s2, thr, sd):
         if others:
             fixed = dict(prob.fixed)
             fixed[prob.names[j]] = math.exp(xj)
-            sub = _Problem(prob.data, [prob.names[i] for i in others], prob.model, prob.material, prob.fidelity,
-                           fixed)
-            sub.bar = prob.bar
+            sub = prob.sub([prob.names[i] for i in others], fixed)
             r = _solve(sub, warm[side], sub_lo, sub_hi)
             warm[side] = r.x
             c = 2.0 * float(r.cost)

@@ -135,3 +135,42 @@ def test_sweep_scheduler_local_identical_csv(tmp_path, capsys):
     assert main(common + ["--out", str(b), "--scheduler", "local"]) == 0
     assert a.read_text() == b.read_text()
     assert main(common + ["--scheduler", "udp://x"]) == 2
+
+
+def test_fit_spectrum_and_static_files_together(data_csv, tmp_path, capsys):
+    """Two files of two kinds (static rows + a spectrum from the linearised PNP at D = 3e-10) on one command."""
+    from ipmc_asym.dynamics.circuit import frequency_response
+
+    strip = Strip(length=0.015)
+    mat = NAFION_LI.with_(E=9e7, c_moy=2900.0, D=3e-10)
+    f = np.geomspace(0.1, 1e5, 20)
+    Z = frequency_response(f, strip=strip, material=mat).Z
+    rng = np.random.default_rng(11)
+    lines = ["f,Z_re,Z_im,sigma_Z_re,sigma_Z_im"]
+    for fi, z in zip(f, Z):
+        s = 0.01 * abs(z)
+        lines.append(f"{fi:.17g}Hz,{z.real + s * rng.standard_normal():.17g},{z.imag + s * rng.standard_normal():.17g},"
+                     f"{s:.17g},{s:.17g}")
+    imp = tmp_path / "imp.csv"
+    imp.write_text("\n".join(lines) + "\n")
+    assert main(["fit", data_csv, str(imp), "--free", "modulus,c_moy,D=1e-11m2/s:1e-9m2/s", "--length", "1.5cm",
+                 "--json", "--no-progress"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["n_points"] == 24 + 40
+    for k, true in (("modulus", 9e7), ("c_moy", 2900.0), ("diffusion", 3e-10)):
+        p = out["parameters"][k]
+        assert p["status"] == "ok" and p["ci95"][0] <= true <= p["ci95"][1], (k, p)
+    # a parameter the files cannot see, a bad spectrum file, the plot of dynamic data: one line, exit 2
+    assert main(["fit", str(imp), "--free", "viscous_modulus"]) == 2
+    err = capsys.readouterr().err
+    assert "viscous_modulus" in err and "deflection or blocking force" in err and err.count("\n") == 1
+    bad = tmp_path / "bad.csv"
+    bad.write_text("f,Z_re,Z_im\n1Hz,5,30\n")
+    assert main(["fit", str(bad), "--free", "D"]) == 2
+    err = capsys.readouterr().err
+    assert "negate that column" in err and err.count("\n") == 1
+    png = tmp_path / "f.png"
+    assert main(["fit", data_csv, str(imp), "--free", "c_moy,D", "--length", "1.5cm", "--modulus", "90MPa",
+                 "--plot", str(png)]) == 0
+    assert png.stat().st_size > 10_000
+    assert main(["fit", data_csv, "--free", "modulus", "--waveform", "step:1V"]) == 2

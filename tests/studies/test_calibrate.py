@@ -289,3 +289,16 @@ def test_four_free_parameters_no_misleading_stderr():
             h = 1.959964 * p["stderr"] / p["value"]
             assert abs(math.log(p["value"] / p["ci95"][0]) - h) <= 0.2 * h
     assert r.parameters["c_moy"]["stderr"] is None and "not locally quadratic" in r.parameters["c_moy"]["note"]
+
+
+def test_free_bounds_with_units_and_aliases():
+    """The dynamic names take units on their bounds; D, E, R_s, eta_E are other names of them."""
+    from ipmc_asym.studies.calibrate import parse_free
+
+    b = parse_free("D=1e-11m2/s:1e-5cm2/s,viscous_modulus=1kPa s:1MPa s,R_s=0.01ohm/sq:2kohm/sq,c_moy=1M:3M")
+    assert b["diffusion"] == pytest.approx((1e-11, 1e-9))
+    assert b["viscous_modulus"] == pytest.approx((1e3, 1e6))
+    assert b["sheet_resistance"] == pytest.approx((1e-2, 2e3))
+    assert b["c_moy"] == pytest.approx((1e3, 3e3))
+    with pytest.raises(ValueError, match="unknown unit"):
+        parse_free("D=1e-11furlong:1e-9")
