@@ -320,3 +320,31 @@ def test_cli_sheet_resistance(capsys):
             main(["freq", "--from", "1Hz", "--to", "2Hz", "--sheet-resistance", bad])
         assert e.value.code == 2
         assert "--sheet-resistance" in capsys.readouterr().err
+
+
+def test_cli_sheet_resistance_with_the_dynamic_beam_a_bias_and_an_export(capsys, tmp_path):
+    f = np.geomspace(0.1, 1e3, 6)
+    base = ["freq", "--from", "0.1Hz", "--to", "1kHz", "--points", "6", "--sheet-resistance", "2.5ohm/sq", "--json"]
+    assert main(base + ["--viscous-modulus", "2e3"]) == 0  # --beam dynamic is freq's default
+    out = json.loads(capsys.readouterr().out)
+    r = line_response(f, sheet_resistance=2.5, beam="dynamic", viscous_modulus=2e3)
+    assert out["beam"] == "dynamic" and out["resonances"]["clamped-free"] == r.resonances["clamped-free"]
+    assert np.allclose(out["w_amp"], r.w_amp, rtol=1e-15) and np.allclose(out["F_amp"], np.abs(r.H_F), rtol=1e-15)
+    assert 0.0 <= out["beam_error_max"] < 1e-6
+    # with a DC bias (circuit): the small-signal line about the biased static state
+    assert main(base + ["--method", "circuit", "--voltage", "0.4V", "--beam", "quasi-static"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    r = line_response(f, sheet_resistance=2.5, method="circuit", voltage=0.4)
+    assert np.allclose(out["Z_re"], r.Z.real, rtol=1e-15) and out["voltage"] == 0.4 and "error" not in out
+    # the reduced-order model of the line, its stated error measured here against the full line
+    path = tmp_path / "tf.json"
+    assert main(base + ["--viscous-modulus", "2e3", "--export", str(path), "--export-tol", "1e-3"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    doc = json.loads(path.read_text())
+    m = doc["models"]["w"]
+    fc = np.geomspace(0.1, 1e3, 301)
+    fit = m["d"] + np.sum(np.array([complex(*p) for p in m["residues"]])
+                          / (2j * np.pi * fc[:, None] - np.array([complex(*p) for p in m["poles"]])), axis=1)
+    full = line_response(fc, sheet_resistance=2.5, beam="dynamic", viscous_modulus=2e3).H_w
+    assert np.max(rel(fit, full)) <= 1.5 * m["max_rel_error"] and m["max_rel_error"] <= 1e-3
+    assert "order" in out["export"]["w"]
