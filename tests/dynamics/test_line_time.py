@@ -1,0 +1,103 @@
+"""The time-domain electrode line (a ladder of reduced circuits) against the inverse Laplace transform
+of the exact line, a finer ladder, the uniform strip at 0 Ohm/sq, and its refusals."""
+
+import mpmath as mp
+import numpy as np
+import pytest
+
+from ipmc_asym.dynamics.circuit import quasi_static_forward, waveform
+from ipmc_asym.dynamics.drive import drive_response
+from ipmc_asym.dynamics.electrode import capacitance_scale, core_resistance
+from ipmc_asym.dynamics.line_time import LineStepper
+from ipmc_asym.model import groups
+from ipmc_asym.model.params import NAFION_LI, Strip
+from ipmc_asym.model.permittivity import get_model
+
+S = Strip()
+PERM = get_model("constant")
+R = float(core_resistance(S.thickness, NAFION_LI))
+C = 0.5 * capacitance_scale(PERM, NAFION_LI)
+TAU = R * C
+CG = float(groups.geometric_capacitance(S.thickness, PERM.eps_moy))
+
+
+def _exact(F, t):
+    mp.mp.dps = 30
+    return np.array([float(mp.invertlaplace(F, float(x), method="talbot")) for x in t])
+
+
+def _g(p, Rs):
+    return S.length * mp.sqrt(2 * Rs / (R + 1 / (p * C)))
+
+
+@pytest.mark.parametrize("Rs", [2.5, 25.0])
+def test_small_signal_step_against_the_inverse_laplace_transform_of_the_exact_line(Rs):
+    # 1 uV: the layers are linear to (V/(R T/F))^2 ~ 1e-9.  The exact line (derivations/line.py) with
+    # the time model's shunt, conduction R in series with C_d(0), and the bulk's displacement charge
+    # C_g (v - u) added to sigma: sigma_mean(s) = (V0/s) (tanh g/g) (1 + s R C_g)/(s (R + 1/(s C)))
+    V0 = 1e-6
+    t = np.linspace(0.0, 5 * TAU, 51)
+    o = LineStepper(waveform("step", V0), S, PERM, NAFION_LI, Rs, segments=16).advance(t)
+
+    def F(p):
+        g = _g(p, Rs)
+        return V0 / p * mp.tanh(g) / g * (1 + p * R * CG) / (p * (R + 1 / (p * C)))
+
+    idx = [2, 5, 10, 20, 50]
+    ref = _exact(F, t[idx])
+    assert np.all(np.abs(o["sigma_mean"][idx] - ref) <= o["sigma_error"][idx])
+    # and the estimate is not vacuous: the 32-segment line is within a few 1e-3 of the exact one
+    assert np.max(o["sigma_error"]) < 5e-3 * np.max(np.abs(ref))
+
+
+def test_small_signal_deflection_against_the_exact_line():
+    # w(s) = (V0/s) k_w F_w(g)/(1 + s R C): the layers' moment follows u = sigma_L/C_d(0), the line's
+    # deflection factor F_w (derivations/line.py item 3), k_w the static deflection per volt
+    V0, Rs = 1e-6, 2.5
+    t = np.linspace(0.0, 4 * TAU, 41)
+    r = drive_response(f"step:{V0}V", float(t[-1]), t.size, beam="quasi-static", sheet_resistance=Rs, line_segments=16)
+    kw = float(np.asarray(quasi_static_forward(np.array([V0]), S, PERM, NAFION_LI).w)[0]) / V0
+
+    def F(p):
+        g = _g(p, Rs)
+        fw = 2 * (g * mp.sinh(g) - mp.cosh(g) + 1) / (g**2 * mp.cosh(g))
+        return V0 / p * kw * fw / (1 + p * R * C)
+
+    idx = [4, 10, 20, 40]
+    ref = _exact(F, t[idx])
+    assert np.all(np.abs(r["w"][idx] - ref) <= r["w_error"][idx] + 1e-12 * np.max(np.abs(ref)))
+    assert np.max(r["w_error"]) < 2e-3 * np.max(np.abs(ref))
+
+
+def test_large_signal_against_a_finer_ladder_within_the_stated_errors():
+    # 1 V step (nonlinear layers): 16 reported segments against 64, each with its own stated error
+    kw = dict(beam="quasi-static", sheet_resistance=25.0)
+    a = drive_response("step:1V", 5 * TAU, 201, line_segments=8, **kw)
+    b = drive_response("step:1V", 5 * TAU, 201, line_segments=32, **kw)
+    for k, e in (("sigma", "sigma_error"), ("w", "w_error")):
+        assert np.all(np.abs(a[k] - b[k]) <= a[e] + b[e] + 1e-14 * np.max(np.abs(b[k])))
+        assert np.max(b[e]) < np.max(a[e]) / 8  # second order: 4x per halving of h, twice halved
+    # the line is slower than the uniform strip; the uniform strip is 0 Ohm/sq exactly
+    u = drive_response("step:1V", 5 * TAU, 201, beam="quasi-static")
+    assert np.all(np.abs(b["sigma"][1:50]) < np.abs(u["sigma"][1:50]))
+    z = drive_response("step:1V", 5 * TAU, 201, beam="quasi-static", sheet_resistance=0.0)
+    assert all(np.array_equal(z[k], u[k]) for k in u) and "sigma_error" not in z
+
+
+def test_line_chunks_are_one_run():
+    kw = dict(beam="quasi-static", sheet_resistance=2.5, line_segments=4)
+    a = drive_response("sine:0.5V@20Hz", 0.05, 301, **kw)
+    b = drive_response("sine:0.5V@20Hz", 0.05, 301, chunk=37, **kw)
+    for k in a:
+        assert np.allclose(a[k], b[k], rtol=1e-12, atol=1e-15 * np.max(np.abs(a[k]) + 1e-300)), k
+
+
+def test_refusals():
+    with pytest.raises(ValueError, match="beam 'quasi-static'"):
+        drive_response("step:1V", 0.01, 11, sheet_resistance=2.5)  # drive's default beam is dynamic
+    with pytest.raises(ValueError, match="sheet_resistance"):
+        drive_response("step:1V", 0.01, 11, beam="quasi-static", sheet_resistance=-1.0)
+    with pytest.raises(ValueError, match="line segments"):
+        drive_response("step:1V", 0.01, 11, beam="quasi-static", sheet_resistance=1.0, line_segments=10**6)
+    with pytest.raises(ValueError, match="sheet_resistance"):
+        LineStepper(waveform("step", 1.0), S, PERM, NAFION_LI, 0.0)
