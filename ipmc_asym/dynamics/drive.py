@@ -30,7 +30,7 @@ from ipmc_asym.dynamics.circuit import (
     waveform,
 )
 from ipmc_asym.dynamics.electrode import core_resistance, time_constant
-from ipmc_asym.dynamics.line_time import DEFAULT_SEGMENTS, ERROR_FACTOR, LineStepper, line_weights
+from ipmc_asym.dynamics.line_time import DEFAULT_SEGMENTS, ERROR_FACTOR, MAX_SEGMENTS, LineStepper, line_weights
 from ipmc_asym.dynamics.waveforms import Waveform, parse_waveform
 from ipmc_asym.forward.model import CHECKS, assumption_warnings, voltage_reason
 from ipmc_asym.model.params import NAFION_LI, SHEET_RESISTANCE_SOURCE, Material, Strip, check_finite, check_positive
@@ -53,6 +53,10 @@ LINE_NOTE = ("electrodes: sheet resistance R_s = {Rs:g} Ohm/sq each: the RC line
              "moments of equal tip rotation (theta, M_A = its mean) and of equal tip deflection (w, F_block): exact "
              "for small displacements and for a uniform moment; the bulk's geometric capacitance is instantaneous "
              "(its displacement charge is added to sigma)")
+
+#: the electrode line's stated error may reach this fraction of the largest |sigma| and |w| so far;
+#: beyond it the run is refused (more segments hold it): the numbers are not handed out
+LINE_TOL = 1e-2
 
 #: cap on the number of output times of one run (each row is ~9 numbers; streamed to a file)
 MAX_DRIVE_POINTS = 100_000_000
@@ -113,7 +117,8 @@ def drive_chunks(wave, duration, points, *, strip: Strip | None = None, model="c
         ``R_s`` of each electrode (Ohm/sq, default 0: the uniform strip, exactly).  > 0: the
         discretised RC line (:class:`ipmc_asym.dynamics.line_time.LineStepper`, ``2 line_segments``
         segments reported, ``line_segments`` for the error), the forward model at every node,
-        quasi-static beam only; the chunks also hold :data:`LINE_COLUMNS`.
+        quasi-static beam only; the chunks also hold :data:`LINE_COLUMNS`.  A stated error above
+        :data:`LINE_TOL` of the largest response so far is refused (``ValueError``: more segments).
     line_segments : int   ``N`` of the coarser line
 
     Notes
@@ -145,6 +150,7 @@ def drive_chunks(wave, duration, points, *, strip: Strip | None = None, model="c
     R = float(core_resistance(s.thickness, m))
     Cg = stepper.Cg
     lcols = LINE_COLUMNS if line is not None else ()
+    peak = {"sigma": 0.0, "w": 0.0}
     held = None  # last computed row, waiting for its successor (central difference of phi0 - u)
     prev = None  # (t, ub) of the row before it
     start = 0
@@ -171,6 +177,16 @@ def drive_chunks(wave, duration, points, *, strip: Strip | None = None, model="c
             u = o["u"] @ line_weights(2 * line.segments, s.length)[1] / s.length
             ub, sigma = o["ub_mean"], o["sigma_mean"]
             lc = {"sigma_error": o["sigma_error"], "w_error": ERROR_FACTOR * np.abs(w - wc)}
+            for k, v in (("sigma", sigma), ("w", w)):
+                # the error bound against the largest response so far (a numerical check: refuse, not flag)
+                scale = np.maximum.accumulate(np.maximum(np.abs(v), peak[k]))
+                over = lc[f"{k}_error"] > LINE_TOL * scale
+                if np.any(over):
+                    i = int(np.argmax(over))
+                    raise ValueError(f"line_segments: the electrode line's discretisation error on {k} exceeds "
+                                     f"{LINE_TOL:g} of the response at t = {t[i]:.4g} s with {2 * line.segments} "
+                                     f"segments; raise line_segments (now {line.segments}, at most {MAX_SEGMENTS})")
+                peak[k] = float(scale[-1])
         phi = fun(t)
         warns = assumption_warnings(fr)
         over = np.abs(phi) > VALIDATED_VOLTAGE  # the applied voltage too: the layers' one lags behind it

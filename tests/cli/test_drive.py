@@ -88,15 +88,15 @@ def test_drive_and_step_with_a_sheet_resistance(tmp_path, capsys):
     assert a == b and "sigma_error" not in b
     # the line: the library's rows, with their stated errors, in the CSV streamed by drive and by step --out
     f = tmp_path / "d.csv"
-    assert main(base[:-1] + ["--sheet-resistance", "2.5ohm/sq", "--line-segments", "4", "--out", str(f)]) == 0
+    assert main(base[:-1] + ["--sheet-resistance", "2.5ohm/sq", "--line-segments", "8", "--out", str(f)]) == 0
     capsys.readouterr()
     rows = list(csv.reader(f.read_text().splitlines()))
-    r = drive_response("step:0.5V", 0.02, 41, beam="quasi-static", sheet_resistance=2.5, line_segments=4)
+    r = drive_response("step:0.5V", 0.02, 41, beam="quasi-static", sheet_resistance=2.5, line_segments=8)
     assert rows[0][-2:] == ["sigma_error", "w_error"]
     assert np.allclose([float(x[rows[0].index("w")]) for x in rows[1:]], r["w"], rtol=1e-15, atol=0)
     g = tmp_path / "s.csv"
     step = ["step", "--voltage", "0.5V", "--duration", "20ms", "--points", "41", "--sheet-resistance", "2.5",
-            "--line-segments", "4"]
+            "--line-segments", "8"]
     assert main(step + ["--out", str(g)]) == 0
     srows = list(csv.reader(g.read_text().splitlines()))
     assert np.allclose([float(x[srows[0].index("sigma")]) for x in srows[1:]], r["sigma"], rtol=1e-15, atol=0)

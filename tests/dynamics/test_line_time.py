@@ -70,10 +70,10 @@ def test_small_signal_deflection_against_the_exact_line():
 
 
 def test_large_signal_against_a_finer_ladder_within_the_stated_errors():
-    # 1 V step (nonlinear layers): 16 reported segments against 64, each with its own stated error
+    # 1 V step (nonlinear layers): 64 reported segments against 256, each with its own stated error
     kw = dict(beam="quasi-static", sheet_resistance=25.0)
-    a = drive_response("step:1V", 5 * TAU, 201, line_segments=8, **kw)
-    b = drive_response("step:1V", 5 * TAU, 201, line_segments=32, **kw)
+    a = drive_response("step:1V", 5 * TAU, 201, line_segments=32, **kw)
+    b = drive_response("step:1V", 5 * TAU, 201, line_segments=128, **kw)
     for k, e in (("sigma", "sigma_error"), ("w", "w_error")):
         assert np.all(np.abs(a[k] - b[k]) <= a[e] + b[e] + 1e-14 * np.max(np.abs(b[k])))
         assert np.max(b[e]) < np.max(a[e]) / 8  # second order: 4x per halving of h, twice halved
@@ -85,7 +85,7 @@ def test_large_signal_against_a_finer_ladder_within_the_stated_errors():
 
 
 def test_line_chunks_are_one_run():
-    kw = dict(beam="quasi-static", sheet_resistance=2.5, line_segments=4)
+    kw = dict(beam="quasi-static", sheet_resistance=2.5, line_segments=8)
     a = drive_response("sine:0.5V@20Hz", 0.05, 301, **kw)
     b = drive_response("sine:0.5V@20Hz", 0.05, 301, chunk=37, **kw)
     for k in a:
@@ -101,3 +101,17 @@ def test_refusals():
         drive_response("step:1V", 0.01, 11, beam="quasi-static", sheet_resistance=1.0, line_segments=10**6)
     with pytest.raises(ValueError, match="sheet_resistance"):
         LineStepper(waveform("step", 1.0), S, PERM, NAFION_LI, 0.0)
+
+
+def test_an_underresolved_line_is_refused_not_printed(tmp_path):
+    # 1000 Ohm/sq at a 20 Hz square wave: the line's decay length is a few segments of 8
+    with pytest.raises(ValueError, match="raise line_segments"):
+        drive_response("square:2V@20Hz", 0.05, 201, beam="quasi-static", sheet_resistance=1e3, line_segments=4)
+    with pytest.raises(ValueError, match="raise line_segments"):  # ~1 % at 25 Ohm/sq with 16 segments
+        drive_response("step:1V", 5 * TAU, 201, beam="quasi-static", sheet_resistance=25.0, line_segments=8)
+    from ipmc_asym.cli import main
+
+    out = tmp_path / "d.csv"
+    assert main(["drive", "--waveform", "square:2V@20Hz", "--duration", "50ms", "--points", "201", "--beam",
+                 "quasi-static", "--sheet-resistance", "1000", "--line-segments", "4", "--out", str(out)]) == 2
+    assert not out.exists()  # written atomically: nothing of the refused run is left
