@@ -150,6 +150,9 @@ def drive_chunks(wave, duration, points, *, strip: Strip | None = None, model="c
     R = float(core_resistance(s.thickness, m))
     Cg = stepper.Cg
     lcols = LINE_COLUMNS if line is not None else ()
+    if line is not None:
+        # the forward model runs on every node of both ladders: keep its arrays at ~2e5 points a chunk
+        chunk = max(16, min(chunk, 200_000 // (3 * line.segments + 2)))
     peak = {"sigma": 0.0, "w": 0.0}
     held = None  # last computed row, waiting for its successor (central difference of phi0 - u)
     prev = None  # (t, ub) of the row before it
