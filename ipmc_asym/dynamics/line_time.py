@@ -23,8 +23,8 @@ The error of the discretisation is estimated by running ``N`` and ``2 N`` segmen
 side: for an error ``~ h^2`` the ``2 N`` line (whose values are reported) is off by
 ``|y_2N - y_N|/3`` (Richardson); the stated error is twice that (:data:`ERROR_FACTOR`), which
 covers the next order and the time stepping: measured against the inverse Laplace transform of
-the exact line (small signal, ``tests/dynamics/test_line_time.py``) the error is 0.96-1.03 times
-the Richardson estimate for ``N`` = 8-32 at 2.5 and 25 Ohm/sq.
+the exact line (small signal, ``tests/dynamics/test_line_time.py``) the error is at most 1.03 times
+the Richardson estimate for ``N`` = 8-32 at 2.5 and 25 Ohm/sq (0.85-1.03).
 """
 
 from __future__ import annotations
