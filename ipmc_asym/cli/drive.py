@@ -81,8 +81,8 @@ def add_line_options(p):
     p.add_argument("--sheet-resistance", dest="sheet_resistance", type=arg_type(_sheet_conv, "--sheet-resistance"),
                    default=0.0,
                    help="sheet resistance of each electrode (2.5ohm/sq; a bare number is Ohm/sq; default 0 = ideal "
-                        "electrodes, the uniform strip): the strip as a discretised RC line driven at the clamp, "
-                        "with --beam quasi-static; adds the columns sigma_error and w_error (its stated error)")
+                        "electrodes, the uniform strip): the strip as a discretised RC line driven at the clamp "
+                        "(circuit fidelity); adds the columns sigma_error and w_error (its stated error)")
     p.add_argument("--line-segments", dest="line_segments", type=arg_type(_segments_conv, "--line-segments"),
                    default=DEFAULT_SEGMENTS,
                    help=f"N: the line is run with 2N segments (reported) and N (its error estimate); default "

@@ -94,7 +94,10 @@ def _stream_csv(args, strip, material, models) -> int:
     drive = "step" if args.waveform is None else args.waveform.spec
     wave = args.waveform if args.waveform is not None else waveform("step", strip.voltage)
     line = dict(sheet_resistance=args.sheet_resistance, line_segments=args.line_segments)
-    infos = {m: drive_info(strip, m, material, "quasi-static", **line) for m in models}
+    # the uniform strip streams with the quasi-static beam only; the electrode line with either
+    beam = args.beam if args.sheet_resistance > 0.0 else "quasi-static"
+    dyn = dict(viscous_modulus=args.viscous_modulus) if beam == "dynamic" else {}
+    infos = {m: drive_info(strip, m, material, beam, **dyn, **line) for m in models}
     columns = COLUMNS + (LINE_COLUMNS if args.sheet_resistance > 0.0 else ())
     seen, n_rows = {}, 0
     with atomic_write(args.out) as fh:
@@ -103,13 +106,13 @@ def _stream_csv(args, strip, material, models) -> int:
         for mname in models:
             duration = args.duration if args.duration is not None else 5.0 * infos[mname]["tau"]
             for ch in drive_chunks(wave, duration, args.points, strip=strip, model=mname, material=material,
-                                   beam="quasi-static", **line):
+                                   beam=beam, **dyn, **line):
                 for w in ch["warnings"]:
                     seen.setdefault((mname, w.split(":")[0]), f"{mname}: {w}" if many else w)
                 _write_rows(wr, mname if many else None, [ch[c] for c in columns],
                             [np.asarray(ch[c]) != 0.0 for c in CHECK_COLUMNS])
                 n_rows += ch["t"].size
-    _sidecar(args, strip, {m: infos[m]["tau"] for m in models}, "circuit", drive, "quasi-static",
+    _sidecar(args, strip, {m: infos[m]["tau"] for m in models}, "circuit", drive, beam,
              infos[models[0]]["notes"], warnings=list(seen.values()),
              **({"sheet_resistance": args.sheet_resistance, "line_segments": 2 * args.line_segments}
                 if args.sheet_resistance > 0.0 else {}))
@@ -128,17 +131,17 @@ def _line_in_memory(args, strip, material, models) -> int:
     columns = COLUMNS + LINE_COLUMNS
     out = {}
     for mname in models:
-        info = drive_info(strip, mname, material, "quasi-static", **line)
+        info = drive_info(strip, mname, material, args.beam, args.viscous_modulus, **line)
         duration = args.duration if args.duration is not None else 5.0 * info["tau"]
         r = drive_response(wave, duration, args.points, strip=strip, model=mname, material=material,
-                           beam="quasi-static", **line)
+                           beam=args.beam, viscous_modulus=args.viscous_modulus, **line)
         out[mname] = (info, r)
     if args.json:
         def one(info, r):
             return {"tau": info["tau"], "R": info["R"], "model": info["model"], "fidelity": "circuit",
                     "voltage": strip.voltage, "thickness_total": strip.thickness, "half_thickness_e": strip.e,
                     "diffusion_coefficient": material.D, "notes": info["notes"], "waveform": drive,
-                    "beam": "quasi-static", "sheet_resistance": args.sheet_resistance,
+                    "beam": args.beam, "sheet_resistance": args.sheet_resistance,
                     "line_segments": info["line_segments"], **{c: r[c] for c in columns},
                     **{c: r[c].astype(bool) for c in CHECK_COLUMNS}}
         doc = (one(*out[models[0]]) if len(models) == 1 else
@@ -149,7 +152,7 @@ def _line_in_memory(args, strip, material, models) -> int:
         info, r = out[mname]
         what = f"step {strip.voltage:g} V" if args.waveform is None else f"waveform {drive}"
         print(f"{what}, total thickness 2e = {fmt_length(strip.thickness)}, model {info['model']}, fidelity circuit, "
-              f"beam quasi-static, electrode sheet resistance {args.sheet_resistance:g} Ohm/sq "
+              f"beam {args.beam}, electrode sheet resistance {args.sheet_resistance:g} Ohm/sq "
               f"({info['line_segments']} segments): tau = {info['tau']:.4g} s")
         idx = np.unique(np.linspace(0, r["t"].size - 1, min(r["t"].size, 11)).astype(int))
         print(f"{'t [s]':>11s} {'sigma [C/m^2]':>14s} {'+-':>9s} {'J [A/m^2]':>11s} {'M_A [N m]':>11s} {'theta':>9s} "
@@ -207,13 +210,13 @@ def run(args):
     first_run_notice()
     models = list(model_names()) if args.model == "all" else [args.model]
     if args.sheet_resistance > 0.0:
-        for bad, why in ((args.fidelity != "circuit", "--fidelity pnp"), (args.tol is not None, "--tol"),
-                         (args.beam != "quasi-static", "--beam dynamic")):
+        for bad, why in ((args.fidelity != "circuit", "--fidelity pnp"), (args.tol is not None, "--tol")):
             if bad:
                 raise ValueError(f"--sheet-resistance with {why}: the electrode line is a ladder of reduced circuits "
-                                 "driving the quasi-static beam (its error is stated); drop {why}".replace("{why}", why))
+                                 f"(its discretisation error is stated); drop {why}")
         if not args.out or args.json:
             return _line_in_memory(args, strip, material, models)
+        return _stream_csv(args, strip, material, models)
     if args.out and args.fidelity == "circuit" and args.tol is None and args.beam == "quasi-static" and not args.json:
         return _stream_csv(args, strip, material, models)
     kind = args.waveform if args.waveform is not None else "step"

@@ -30,7 +30,14 @@ from ipmc_asym.dynamics.circuit import (
     waveform,
 )
 from ipmc_asym.dynamics.electrode import core_resistance, time_constant
-from ipmc_asym.dynamics.line_time import DEFAULT_SEGMENTS, ERROR_FACTOR, MAX_SEGMENTS, LineStepper, line_weights
+from ipmc_asym.dynamics.line_time import (
+    DEFAULT_SEGMENTS,
+    ERROR_FACTOR,
+    MAX_SEGMENTS,
+    LineBeamDynamics,
+    LineStepper,
+    line_weights,
+)
 from ipmc_asym.dynamics.waveforms import Waveform, parse_waveform
 from ipmc_asym.forward.model import CHECKS, assumption_warnings, voltage_reason
 from ipmc_asym.model.params import NAFION_LI, SHEET_RESISTANCE_SOURCE, Material, Strip, check_finite, check_positive
@@ -49,10 +56,11 @@ LINE_COLUMNS = ("sigma_error", "w_error")
 LINE_NOTE = ("electrodes: sheet resistance R_s = {Rs:g} Ohm/sq each: the RC line along the strip discretised in "
              "{n2} segments (trapezoidal ladder, a reduced circuit at each node, driven at the clamp, open at the tip); "
              "sigma, current density and layer voltage are means over the electrode; sigma_error and w_error are twice "
-             "the Richardson estimate against {n} segments; the beam takes the distributed moment as the uniform "
-             "moments of equal tip rotation (theta, M_A = its mean) and of equal tip deflection (w, F_block): exact "
-             "for small displacements and for a uniform moment; the bulk's geometric capacitance is instantaneous "
-             "(its displacement charge is added to sigma)")
+             "the Richardson estimate against {n} segments; the quasi-static beam takes the distributed moment as the "
+             "uniform moments of equal tip rotation (theta, M_A = its mean) and of equal tip deflection (w, F_block): "
+             "exact for small displacements and for a uniform moment; with beam dynamics the node moments (linear "
+             "between nodes) drive the modes through int M phi_n'' dx; the bulk's geometric capacitance is "
+             "instantaneous (its displacement charge is added to sigma)")
 
 #: the electrode line's stated error may reach this fraction of the largest |sigma| and |w| so far;
 #: beyond it the run is refused (more segments hold it): the numbers are not handed out
@@ -74,9 +82,6 @@ def _sheet(sheet_resistance, beam):
     Rs = check_finite("sheet_resistance", sheet_resistance, "a finite number >= 0 Ohm/sq")
     if Rs < 0.0:
         raise ValueError(f"sheet_resistance must be a finite number >= 0 Ohm/sq; got {sheet_resistance!r}")
-    if Rs > 0.0 and beam == "dynamic":
-        raise ValueError("sheet_resistance with beam 'dynamic': in the time domain the line's distributed moment drives "
-                         "the quasi-static beam only; use beam 'quasi-static' (freq gives the line with the modal beam)")
     return Rs
 
 
@@ -117,7 +122,8 @@ def drive_chunks(wave, duration, points, *, strip: Strip | None = None, model="c
         ``R_s`` of each electrode (Ohm/sq, default 0: the uniform strip, exactly).  > 0: the
         discretised RC line (:class:`ipmc_asym.dynamics.line_time.LineStepper`, ``2 line_segments``
         segments reported, ``line_segments`` for the error), the forward model at every node,
-        quasi-static beam only; the chunks also hold :data:`LINE_COLUMNS`.  A stated error above
+        with ``beam="dynamic"`` the node moments drive the modes
+        (:class:`ipmc_asym.dynamics.line_time.LineBeamDynamics`); the chunks also hold :data:`LINE_COLUMNS`.  A stated error above
         :data:`LINE_TOL` of the largest response so far is refused (``ValueError``: more segments).
     line_segments : int   ``N`` of the coarser line
 
@@ -146,6 +152,11 @@ def drive_chunks(wave, duration, points, *, strip: Strip | None = None, model="c
         raise ValueError(f"points: the beam dynamics need >= 40 points per period of the first mode "
                          f"(T1 = {dyn.period:.4g} s): use --points >= {need} or beam quasi-static")
     line = LineStepper(fun, s, perm, m, Rs, line_segments) if Rs > 0.0 else None
+    ldyn = None
+    if line is not None and dyn is not None:
+        # the line's node moments drive the modes (both ladders: the coarse one for the error of w)
+        ldyn = (LineBeamDynamics(s, m, viscous_modulus, n_modes, line.x),
+                LineBeamDynamics(s, m, viscous_modulus, n_modes, line.x_coarse))
     stepper = line if line is not None else CircuitStepper(fun, s, perm, m)
     R = float(core_resistance(s.thickness, m))
     Cg = stepper.Cg
@@ -174,14 +185,21 @@ def drive_chunks(wave, duration, points, *, strip: Strip | None = None, model="c
             # every node at every time through the forward model; a time point passes a check where every node does
             fr = quasi_static_forward(o["u"].ravel(), s, perm, m)
             checks = {c: np.asarray(getattr(fr, c), bool).reshape(o["u"].shape).all(axis=1) for c in CHECKS}
-            M, th, w, Fb = _line_mechanics(np.asarray(fr.M_A, dtype=float).reshape(o["u"].shape), line.x, s, m)
+            Mn = np.asarray(fr.M_A, dtype=float).reshape(o["u"].shape)
+            M, th, w, Fb = _line_mechanics(Mn, line.x, s, m)
             frc = quasi_static_forward(o["u_coarse"].ravel(), s, perm, m)
-            wc = _line_mechanics(np.asarray(frc.M_A, dtype=float).reshape(o["u_coarse"].shape), line.x_coarse, s, m)[2]
+            Mc = np.asarray(frc.M_A, dtype=float).reshape(o["u_coarse"].shape)
+            _, thc, wc, Fc = _line_mechanics(Mc, line.x_coarse, s, m)
+            w_qs = w
+            if ldyn is not None:
+                th, w, Fb = ldyn[0].advance(t, Mn, (th, w), Fb)
+                wc = ldyn[1].advance(t, Mc, (thc, wc), Fc)[1]
             u = o["u"] @ line_weights(2 * line.segments, s.length)[1] / s.length
             ub, sigma = o["ub_mean"], o["sigma_mean"]
             lc = {"sigma_error": o["sigma_error"], "w_error": ERROR_FACTOR * np.abs(w - wc)}
-            for k, v in (("sigma", sigma), ("w", w)):
-                # the error bound against the largest response so far (a numerical check: refuse, not flag)
+            for k, v in (("sigma", sigma), ("w", np.maximum(np.abs(w), np.abs(w_qs)))):
+                # the error bound against the largest response so far (a numerical check: refuse, not flag);
+                # for w the quasi-static deflection too (the strip's inertia delays the dynamic one)
                 scale = np.maximum.accumulate(np.maximum(np.abs(v), peak[k]))
                 over = lc[f"{k}_error"] > LINE_TOL * scale
                 if np.any(over):
@@ -197,7 +215,7 @@ def drive_chunks(wave, duration, points, *, strip: Strip | None = None, model="c
             checks["voltage"] = checks["voltage"] & ~over
             warns = [x for x in warns if "VALIDATED_VOLTAGE" not in x] + [voltage_reason(np.max(np.abs(phi)))]
         valid = np.logical_and.reduce([checks[c] for c in CHECKS])
-        if dyn is not None:
+        if dyn is not None and line is None:
             th, w, Fb = dyn.advance(t, M, th, w, Fb)
         cols = {"t": t, "phi0": phi, "sigma": sigma, "layer_voltage": u, "M_A": M, "theta": th, "w": w,
                 "F_block": Fb, "_ub": ub, **{f"check_{c}": checks[c].astype(float) for c in CHECKS},

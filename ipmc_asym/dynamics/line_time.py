@@ -31,14 +31,15 @@ from __future__ import annotations
 
 import numpy as np
 
-from ipmc_asym.dynamics.circuit import _shat
+from ipmc_asym.beam.dynamics import _propagate, mode_shape, modes, moment_kernels, natural_frequencies
+from ipmc_asym.dynamics.circuit import _shat, strip_beam
 from ipmc_asym.dynamics.electrode import _GL_W, _GL_X, _model_id, charge_scale, core_resistance, time_constant
 from ipmc_asym.kernels.jit import jit
 from ipmc_asym.model import groups
 from ipmc_asym.model.params import Material, Strip, check_finite
 from ipmc_asym.model.permittivity import Permittivity
 
-__all__ = ["LineStepper", "line_weights", "DEFAULT_SEGMENTS", "MAX_SEGMENTS", "ERROR_FACTOR"]
+__all__ = ["LineStepper", "LineBeamDynamics", "line_weights", "DEFAULT_SEGMENTS", "MAX_SEGMENTS", "ERROR_FACTOR"]
 
 #: segments of the coarser of the two lines (the reported one has twice as many)
 DEFAULT_SEGMENTS = 16
@@ -264,3 +265,107 @@ class LineStepper:
         return {"u": u, "v": v, "sigma": sig, "sigma_mean": sm, "ub_mean": ub, "u_w": uw,
                 "sigma_error": ERROR_FACTOR * np.abs(sm - sm2), "u_w_error": ERROR_FACTOR * np.abs(uw - uw2),
                 "u_coarse": out["coarse"][0], "sigma_coarse": sm2}
+
+
+def _hat_integrals(x, fn, panel_points=8):
+    """``int_0^L hat_j(x) fn(x) dx`` for the piecewise-linear hats of the nodes ``x`` (Gauss-Legendre
+    per segment); ``fn(x)`` returns (k, n) at n positions.  Returns (nodes, k)."""
+    xg, wg = np.polynomial.legendre.leggauss(panel_points)
+    a, b = x[:-1, None], x[1:, None]
+    tq = 0.5 * (xg + 1.0)  # position in the segment, 0..1
+    xq = (a + (b - a) * tq[None, :]).ravel()
+    wq = (0.5 * (b - a) * wg[None, :])  # (segments, points)
+    f = np.atleast_2d(fn(xq)).reshape(-1, x.size - 1, panel_points)  # (k, segments, points)
+    left = np.einsum("ksp,sp,p->sk", f, wq, 1.0 - tq)
+    right = np.einsum("ksp,sp,p->sk", f, wq, tq)
+    out = np.zeros((x.size, f.shape[0]))
+    out[:-1] += left
+    out[1:] += right
+    return out
+
+
+class LineBeamDynamics:
+    """The strip's modes driven by the line's node moments ``M_j(t)`` (the time-domain counterpart of
+    :func:`ipmc_asym.beam.dynamics.distributed_transfer`), chunk by chunk.
+
+    The moment is linear between the nodes ``x`` and between the times (first-order hold); mode
+    ``n`` of each support is forced by ``Q_n(t) = int M phi_n'' dx = sum_j c_jn M_j(t)`` (``c_jn``
+    the hat integrals of ``phi_n''``) and propagated exactly by the transition matrices of
+    :class:`ipmc_asym.beam.dynamics.ModalIntegrator` (one mode at a time, ``P = 1``,
+    ``M = Q_n``).  The outputs are the quasi-static ones (``advance``'s ``statics``, through the
+    creep filter; forces unfiltered) plus the modal sums of ``q_n - q_n^qs``; the blocked tip's
+    force adds the modes past the kept ones as the second static of the distributed moment
+    (:func:`ipmc_asym.beam.dynamics.moment_kernels`) minus the kept modes' share, times ``EI``
+    and the second time derivative (as the uniform ModalIntegrator).
+    """
+
+    def __init__(self, strip: Strip, material: Material, viscous_modulus, n_modes, x):
+        self.beam = b = strip_beam(strip, material, viscous_modulus)
+        self.period = 1.0 / float(natural_frequencies("clamped-free", b, 1)[0])
+        L = b.length
+        self.sup = {}
+        for sup in ("clamped-free", "clamped-pinned"):
+            md = modes(sup, b, n_modes)
+            c = _hat_integrals(np.asarray(x, float), lambda xx, md=md, sup=sup: mode_shape(
+                sup, md.b[:, None], np.asarray(xx)[None, :] / L, 2) / (L * L))
+            st = {"md": md, "c": c, "q": np.zeros(md.b.size), "v": np.zeros(md.b.size), "y": None, "ys": None,
+                  "hist_t": np.zeros(0), "hist_y": np.zeros(0)}
+            if sup == "clamped-pinned":
+                k2 = moment_kernels(sup, b)["F"][1]  # kappa_2 of F = -EI w'''(L): -EI times that of w2'''(L)
+                ct = _hat_integrals(np.asarray(x, float), lambda xx: k2(np.asarray(xx) / L)[None, :])[:, 0]
+                # w2'''(L) of the moment minus the kept modes' sum_n g_n phi_n'''(L)/omega_n^4, g_n = -Q_n/(rho A L)
+                st["tail"] = -ct / b.EI + c @ (md.d3phi_L / (b.rhoA * L * md.omega**4))
+            self.sup[sup] = st
+
+    def _modal(self, st, t, Q, S):
+        b, md = self.beam, st["md"]
+        nt, nm = t.size, md.b.size
+        oq = np.empty((nt, nm))
+        odq = np.empty((nt, nm))
+        first = st["y"] is None
+        if first:
+            st["y"] = Q[0].copy()
+            st["ys"] = S[0].copy()
+        oys = np.empty((nt, S.shape[1]))
+        oy = np.empty(nt)
+        none = np.zeros((nt, 0))
+        oqn = np.empty((nt, 1))
+        odqn = np.empty((nt, 1))
+        for n in range(nm):
+            qn = np.ascontiguousarray(Q[:, n])
+            Sn = S if n == 0 else none
+            ys_in = st["ys"] if n == 0 else np.zeros(0)
+            q, v, y, ys = _propagate(t, qn, Sn, md.omega[n:n + 1], b.tau_v, np.ones(1), b.rhoA * b.length,
+                                     st["q"][n:n + 1], st["v"][n:n + 1], float(st["y"][n]), ys_in,
+                                     oqn, odqn, oy, oys if n == 0 else np.empty((nt, 0)))
+            oq[:, n], odq[:, n] = oqn[:, 0], odqn[:, 0]
+            st["q"][n], st["v"][n], st["y"][n] = q[0], v[0], y
+            if n == 0:
+                st["ys"] = np.asarray(ys)
+        return oq, odq, oys
+
+    def advance(self, t, M, statics_free, F_static):
+        """``(theta, w, F_block)`` at the times ``t`` (s) for node moments ``M`` (nt, nodes, N m) and the
+        quasi-static ``statics_free = (theta, w)`` and ``F_static`` at those times."""
+        t = np.ascontiguousarray(t, dtype=float)
+        M = np.asarray(M, dtype=float)
+        b = self.beam
+        fr = self.sup["clamped-free"]
+        oq, _, oys = self._modal(fr, t, M @ fr["c"], np.ascontiguousarray(np.column_stack(statics_free)))
+        theta = oys[:, 0] + oq @ fr["md"].dphi_L
+        w = oys[:, 1] + oq @ fr["md"].phi_L
+        bl = self.sup["clamped-pinned"]
+        tail = M @ bl["tail"]
+        oq, odq, oys = self._modal(bl, t, M @ bl["c"], np.ascontiguousarray(tail[:, None]))
+        # the filtered tail's second time derivative: backward second difference carried over chunks
+        th = np.concatenate((bl["hist_t"], t[1:] if bl["hist_t"].size else t))
+        yh = np.concatenate((bl["hist_y"], oys[1:, 0] if bl["hist_y"].size else oys[:, 0]))
+        ydd = np.zeros(th.size)
+        if th.size > 2:
+            h1, h0 = th[2:] - th[1:-1], th[1:-1] - th[:-2]
+            ydd[2:] = 2.0 * ((yh[2:] - yh[1:-1]) / h1 - (yh[1:-1] - yh[:-2]) / h0) / (h0 + h1)
+        ydd = ydd[th.size - t.size:]
+        bl["hist_t"], bl["hist_y"] = th[-2:], yh[-2:]
+        dd = oq + b.tau_v * odq if b.tau_v > 0.0 else oq
+        F = np.asarray(F_static, dtype=float) - b.EI * (dd @ bl["md"].d3phi_L) + b.EI * ydd
+        return theta, w, F
