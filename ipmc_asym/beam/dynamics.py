@@ -51,6 +51,7 @@ state of each mode is propagated by its transition matrix.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -62,7 +63,8 @@ from ipmc_asym.model.params import Material, check_positive, second_moment
 
 __all__ = ["SUPPORTS", "DEFAULT_MODES", "VISCOUS_MODULUS_SOURCE", "Beam", "Modes", "hydrated_density",
            "characteristic", "eigenvalues", "first_resonance", "mode_shape", "modes", "natural_frequencies", "transfer",
-           "ModalIntegrator", "viscous_modulus_from_damping_ratio"]
+           "ModalIntegrator", "viscous_modulus_from_damping_ratio", "moment_kernels", "distributed_transfer",
+           "DISTRIBUTED_OUTPUTS"]
 
 SUPPORTS = ("clamped-free", "clamped-pinned", "clamped-clamped")
 
@@ -164,6 +166,17 @@ def _scaled(support, b):
 
 
 def eigenvalues(support, n=DEFAULT_MODES):
+    """The first ``n`` roots ``b_k = beta_k L`` of the support's characteristic equation (see
+    :func:`_eigenvalues`; a fresh array each call, the roots computed once per support and ``n``)."""
+    _check_support(support)
+    n = int(n)
+    if not 1 <= n <= 2000:
+        raise ValueError(f"number of modes must be an integer in [1, 2000]; got {n!r}")
+    return _eigenvalues(support, n).copy()
+
+
+@functools.lru_cache(maxsize=32)
+def _eigenvalues(support, n):
     """The first ``n`` roots ``b_k = beta_k L`` of the support's characteristic equation.
 
     Bisection to the last bit on a bracket holding exactly one root: ``[(k-1) pi, k pi]``
@@ -379,6 +392,136 @@ def transfer(f, beam: Beam, support="clamped-free", n_modes=DEFAULT_MODES):
     out["dynamic_factor"] = {k: out[k] / v for k, v in out["static"].items() if v != 0.0}
     out["truncation"] = trunc
     out["modes"] = md
+    return out
+
+
+#: outputs of :func:`distributed_transfer` for each support
+DISTRIBUTED_OUTPUTS = {"clamped-free": ("w", "theta"), "clamped-pinned": ("F", "theta")}
+
+
+def moment_kernels(support, beam: Beam):
+    """Curvature kernels of the statics under a distributed active moment ``M_a(x)`` (full electrode).
+
+    Each output is a linear functional of ``M_a``: ``O_j = int_0^L M_a(x) kappa_j(x) dx`` for the
+    static part ``O_1`` and the second static ``O_2`` of :func:`transfer` (the sums over ALL modes
+    of ``g_n out(phi_n)/omega_n^{2j}``, ``g_n = -int M_a phi_n'' dx/(rho A L)``).  With the Green
+    function ``G`` of ``d^4/dx^4`` under the support's conditions and ``u(x) = out_y G(y, x)``
+    (the field of the output's dual load): ``kappa_1 = -u''/EI`` and ``kappa_2 = -(rho A/EI^2) U''``
+    with ``d^4U/dx^4 = u`` under the same conditions (the operator's inverse applied twice, as in
+    :func:`_second_static`).  ``u`` per output, ``xi = x/L``: clamped-free ``w(L)``:
+    ``L^3 (3 xi^2 - xi^3)/6`` (tip force), ``theta(L)``: ``L^2 xi^2/2`` (tip couple); clamped-pinned
+    ``theta(L)``: ``L^2 (xi^3 - xi^2)/4``, ``w'''(L)``: ``(3 xi^2 - xi^3)/2`` (the prop's influence
+    line), and the blocking force ``F = -EI w'''(L)``.  For a uniform moment the integrals are the
+    closed forms of :func:`_static_small` and :func:`_second_static` (tested).
+
+    Returns
+    -------
+    dict  output -> (kappa_1, kappa_2), each a :class:`numpy.polynomial.Polynomial` in ``xi = x/L``
+          whose value is the kernel in SI (output unit per N m, per m)
+    """
+    return dict(_moment_kernels(support, beam))
+
+
+@functools.lru_cache(maxsize=64)
+def _moment_kernels(support, beam: Beam):
+    _check_support(support)
+    if support not in DISTRIBUTED_OUTPUTS:
+        raise ValueError(f"a distributed moment is supported on {', '.join(DISTRIBUTED_OUTPUTS)}; got {support!r}")
+    L, EI, rhoA = beam.length, beam.EI, beam.rhoA
+    x2, x3 = P([0, 0, 1.0]), P([0, 0, 0, 1.0])
+    if support == "clamped-free":
+        duals = {"w": P([0, 0, 3.0, -1.0]) * (L**3 / 6.0), "theta": P([0, 0, 0.5]) * L**2}
+    else:
+        duals = {"F": P([0, 0, 1.5, -0.5]), "theta": P([0, 0, -0.25, 0.25]) * L**2}
+    out = {}
+    for k, u in duals.items():
+        part = (u * L**4).integ(4)  # d^4/dxi^4 = L^4 d^4/dx^4; zero value and slope at the clamp
+        if support == "clamped-free":
+            rows = [(x2.deriv(2)(1), x3.deriv(2)(1)), (x2.deriv(3)(1), x3.deriv(3)(1))]
+            rhs = [-part.deriv(2)(1), -part.deriv(3)(1)]
+        else:
+            rows = [(x2(1), x3(1)), (x2.deriv(2)(1), x3.deriv(2)(1))]
+            rhs = [-part(1), -part.deriv(2)(1)]
+        c2, c3 = np.linalg.solve(np.array(rows, dtype=float), np.array(rhs, dtype=float))
+        U = part + c2 * x2 + c3 * x3
+        k1 = -u.deriv(2) / (EI * L * L)
+        k2 = -U.deriv(2) * (rhoA / (EI * EI * L * L))
+        if k == "F":  # F = -EI w'''(L)
+            k1, k2 = -EI * k1, -EI * k2
+        out[k] = (k1, k2)
+    return out
+
+
+def distributed_transfer(f, beam: Beam, support, integrate, n_modes=DEFAULT_MODES):
+    """Tip responses to a distributed active moment ``M_a(x, s)`` at frequencies ``f`` (Hz).
+
+    The moment enters the modes through ``Q_n = int_0^L M_a phi_n'' dx`` (the two integrations by
+    parts of the module docstring; the boundary terms vanish at a clamp, a free or a pinned end)
+    in place of ``M_A P_n``; the static and second static parts are the integrals of
+    :func:`moment_kernels`, so the expansion of :func:`transfer` holds with the same tail.
+
+    Parameters
+    ----------
+    f : array_like   frequencies, Hz (>= 0)
+    beam : Beam      full electrode
+    support : {"clamped-free", "clamped-pinned"}
+    integrate : callable
+        ``integrate(c)`` -> complex array (len(f), k), or a pair (values, error estimates):
+        ``int_0^L M_a(x, s) c_i(x) dx`` at each frequency, for ``c(x)`` returning k curvatures (k, n) at n positions x (m), e.g.
+        :meth:`ipmc_asym.dynamics.line.LineResult.modal_forcing` (N m/V times m/m^2 per volt).
+    n_modes : int
+
+    Returns
+    -------
+    dict  clamped-free: ``w`` (m), ``theta`` (rad); clamped-pinned: ``F`` (N), ``theta``; complex
+          (len(f),) per unit of ``M_a``; ``truncation``: relative size of the last kept mode's term;
+          ``error`` (when ``integrate`` returns ``(values, errors)``, the errors >= 0 of its integrals):
+          dict output -> relative error bound of that output from the integrals' errors.
+    """
+    f = np.asarray(f, dtype=float)
+    if not np.all(np.isfinite(f)) or np.any(f < 0):
+        raise ValueError("frequencies must be finite and >= 0 Hz")
+    if beam.electrode is not None:
+        raise ValueError("a distributed moment with a partial electrode is not supported: give the moment on [0, L]")
+    ker = moment_kernels(support, beam)
+    names = list(ker)
+    md = modes(support, beam, n_modes)
+    L = beam.length
+    b = md.b
+
+    def curv(x):
+        xi = np.asarray(x, dtype=float) / L
+        k = [ker[n][j](xi) for n in names for j in (0, 1)]
+        return np.vstack(k + list(mode_shape(support, b[:, None], xi[None, :], 2) / (L * L)))
+
+    got = integrate(curv)
+    vals, errs = (np.asarray(got[0]), np.asarray(got[1])) if isinstance(got, tuple) else (np.asarray(got), None)
+    if vals.shape != (f.size, 2 * len(names) + b.size):
+        raise ValueError(f"integrate(c) must return an array (len(f), k) = ({f.size}, {2 * len(names) + b.size})")
+    nk = 2 * len(names)
+    s = 2j * math.pi * f[:, None]
+    kv = 1.0 + s * beam.tau_v
+    Dn = md.omega**2 * kv + s * s
+    coef = -s**4 / (beam.rhoA * L * md.omega**4 * kv * kv * Dn)  # of Q_n in each mode's remainder
+    k0, s0 = kv[:, 0], s[:, 0]
+    out = {}
+    trunc = 0.0
+    for i, n in enumerate(names):
+        # each output: a1 int(M kappa_1) + a2 int(M kappa_2) + sum_n c_n Q_n
+        if n == "F":  # -EI (1 + s tau_v) w'''(L): the static is not filtered, the second static once
+            a1, a2, cn = np.ones_like(k0), -s0 * s0 / k0, -beam.EI * kv * coef * md.d3phi_L
+        else:
+            a1, a2, cn = 1.0 / k0, -s0 * s0 / k0**2, coef * (md.phi_L if n == "w" else md.dphi_L)
+        t = cn * vals[:, nk:]
+        out[n] = a1 * vals[:, 2 * i] + a2 * vals[:, 2 * i + 1] + t.sum(axis=-1)
+        if errs is not None:
+            # the integrals' error estimates carried through the same linear map, in absolute values
+            bound = (np.abs(a1) * errs[:, 2 * i] + np.abs(a2) * errs[:, 2 * i + 1]
+                     + np.sum(np.abs(cn) * errs[:, nk:], axis=-1))
+            out.setdefault("error", {})[n] = bound / np.maximum(np.abs(out[n]), 1e-300)
+        if f.size:
+            trunc = max(trunc, float(np.max(np.abs(t[:, -1]) / np.maximum(np.abs(out[n]), 1e-300))))
+    out["truncation"] = trunc
     return out
 
 

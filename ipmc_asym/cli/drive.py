@@ -8,7 +8,7 @@ import sys
 import numpy as np
 
 from ipmc_asym.base.registry import model_names
-from ipmc_asym.base.units import fmt_length, parse_quantity, parse_time
+from ipmc_asym.base.units import fmt_length, parse_quantity, parse_sheet_resistance, parse_time
 from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import (
     add_strip_options,
@@ -21,7 +21,15 @@ from ipmc_asym.cli.common import (
     strip_from_args,
 )
 from ipmc_asym.dynamics.circuit import BEAM_CHOICES
-from ipmc_asym.dynamics.drive import CHECK_COLUMNS, DRIVE_COLUMNS, MAX_DRIVE_POINTS, drive_chunks, drive_info
+from ipmc_asym.dynamics.drive import (
+    CHECK_COLUMNS,
+    DRIVE_COLUMNS,
+    LINE_COLUMNS,
+    MAX_DRIVE_POINTS,
+    drive_chunks,
+    drive_info,
+)
+from ipmc_asym.dynamics.line_time import DEFAULT_SEGMENTS, MAX_SEGMENTS
 from ipmc_asym.dynamics.waveforms import parse_waveform
 from ipmc_asym.io.fileio import atomic_write, check_output_path
 from ipmc_asym.io.jsonio import dumps
@@ -54,6 +62,33 @@ def _waveform(text):
     return parse_waveform(text)
 
 
+def _sheet_conv(text):
+    v = parse_sheet_resistance("--sheet-resistance", text)
+    if v < 0:
+        raise ValueError(f"--sheet-resistance must be >= 0 Ohm/sq (e.g. 2.5ohm/sq); got {text!r}")
+    return v
+
+
+def _segments_conv(text):
+    v = count_type("--line-segments", 2)(text)
+    if v > MAX_SEGMENTS:
+        raise ValueError(f"--line-segments must be an integer in [2, {MAX_SEGMENTS}]; got {text!r}")
+    return v
+
+
+def add_line_options(p):
+    """``--sheet-resistance`` and ``--line-segments`` of the time-domain electrode line (step, drive)."""
+    p.add_argument("--sheet-resistance", dest="sheet_resistance", type=arg_type(_sheet_conv, "--sheet-resistance"),
+                   default=0.0,
+                   help="sheet resistance of each electrode (2.5ohm/sq; a bare number is Ohm/sq; default 0 = ideal "
+                        "electrodes, the uniform strip): the strip as a discretised RC line driven at the clamp "
+                        "(circuit fidelity); adds the columns sigma_error and w_error (its stated error)")
+    p.add_argument("--line-segments", dest="line_segments", type=arg_type(_segments_conv, "--line-segments"),
+                   default=DEFAULT_SEGMENTS,
+                   help=f"N: the line is run with 2N segments (reported) and N (its error estimate); default "
+                        f"{DEFAULT_SEGMENTS}, at most {MAX_SEGMENTS}")
+
+
 def add_beam_options(p, default):
     p.add_argument("--beam", default=default, choices=BEAM_CHOICES,
                    help=f"strip mechanics: dynamic (inertia, Kelvin-Voigt damping, resonances) or quasi-static "
@@ -75,6 +110,7 @@ def register(sub):
     p.add_argument("--diffusion", type=diffusion_type(), default=None,
                    help="cation diffusion coefficient D (1e-10m2/s, 1e-6cm2/s; a bare number is m^2/s)")
     add_beam_options(p, "dynamic")
+    add_line_options(p)
     p.add_argument("--out", default=None, help="CSV file, written as computed (columns " + ", ".join(DRIVE_COLUMNS)
                    + ", then the forward model's check_* and valid per time point, 1 or 0)")
     p.add_argument("--json", action="store_true", help=f"print one JSON object (at most {MAX_JSON_POINTS:g} points)")
@@ -83,12 +119,12 @@ def register(sub):
 COLUMNS = DRIVE_COLUMNS + CHECK_COLUMNS
 
 
-def _csv_rows(chunk):
-    cols = [("f", np.ascontiguousarray(chunk[c], dtype=float) + 0.0) for c in COLUMNS]  # + 0.0: no "-0"
+def _csv_rows(chunk, columns=COLUMNS):
+    cols = [("f", np.ascontiguousarray(chunk[c], dtype=float) + 0.0) for c in columns]  # + 0.0: no "-0"
     text = format_table(cols, [""] + [","] * (len(cols) - 1), 17, nonfinite="nan", row_end="\n", row_sep="")
     if text is None:  # a rounding too close to call for the compiled formatter: Python's repr
         n = chunk["t"].size
-        text = "".join(",".join(repr(float(chunk[c][i]) + 0.0) for c in COLUMNS) + "\n" for i in range(n))
+        text = "".join(",".join(repr(float(chunk[c][i]) + 0.0) for c in columns) + "\n" for i in range(n))
     return text
 
 
@@ -113,15 +149,19 @@ def run(args):
     if args.diffusion is not None:
         material = material.with_(D=args.diffusion)
     strip = strip_from_args(args)
-    info = drive_info(strip, args.model, material, args.beam, args.viscous_modulus)
+    info = drive_info(strip, args.model, material, args.beam, args.viscous_modulus, args.sheet_resistance,
+                      args.line_segments)
+    columns = COLUMNS + (LINE_COLUMNS if args.sheet_resistance > 0.0 else ())
     head = dict(info, waveform=args.waveform.spec, duration=args.duration, points=args.points,
                 thickness_total=strip.thickness, half_thickness_e=strip.e, diffusion_coefficient=material.D,
                 units={"t": "s", "phi0": "V", "sigma": "C/m^2 (face z = -e)", "current_density": "A/m^2",
                        "layer_voltage": "V", "M_A": "N m", "theta": "rad (free tip)", "w": "m (free tip)",
-                       "F_block": "N (blocked tip)"})
+                       "F_block": "N (blocked tip)", "sigma_error": "C/m^2 (electrode line, stated)",
+                       "w_error": "m (electrode line, stated)"})
     first_run_notice()
     gen = drive_chunks(args.waveform, args.duration, args.points, strip=strip, model=args.model, material=material,
-                       beam=args.beam, viscous_modulus=args.viscous_modulus)
+                       beam=args.beam, viscous_modulus=args.viscous_modulus, sheet_resistance=args.sheet_resistance,
+                       line_segments=args.line_segments)
     show = set(np.unique(np.linspace(0, args.points - 1, min(args.points, 11)).astype(int)).tolist())
     shown, kept = [], []
     seen, counts = {}, {}
@@ -131,10 +171,10 @@ def run(args):
         with atomic_write(sidecar_path(args.out)) as fh:
             fh.write(dumps({"csv": os.path.basename(args.out), **head}, indent=1) + "\n")
         with atomic_write(args.out) as fh:
-            fh.write(",".join(COLUMNS) + "\n")
+            fh.write(",".join(columns) + "\n")
             for ch in gen:
                 _note_warnings(ch, seen, counts)
-                fh.write(_csv_rows(ch))
+                fh.write(_csv_rows(ch, columns))
                 n = ch["t"].size
                 shown += [{c: float(ch[c][i - i0]) for c in DRIVE_COLUMNS} for i in range(i0, i0 + n) if i in show]
                 i0 += n
@@ -155,7 +195,7 @@ def run(args):
     if args.json:
         out = dict(head)
         if kept:
-            out.update({c: np.concatenate([k[c] for k in kept]) for c in DRIVE_COLUMNS})
+            out.update({c: np.concatenate([k[c] for k in kept]) for c in DRIVE_COLUMNS + columns[len(COLUMNS):]})
             out.update({c: np.concatenate([k[c] for k in kept]).astype(bool) for c in CHECK_COLUMNS})
         print(dumps(out, indent=1))
         return 0

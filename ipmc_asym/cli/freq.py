@@ -99,34 +99,24 @@ def run(args):
     f = np.geomspace(args.f1, args.f2, args.points)
     if args.voltage != 0.0 and args.method != "circuit":
         raise ValueError("--voltage (a DC bias) needs --method circuit: pnp-linear is the linearisation about 0 V")
-    if args.sheet_resistance is not None and args.export is not None:
-        raise ValueError("--export with --sheet-resistance: the reduced-order models are of the ideal-electrode strip "
-                         "for now; export without --sheet-resistance")
-    if args.sheet_resistance is not None and (args.beam != "quasi-static" or args.voltage != 0.0):
-        raise ValueError("--sheet-resistance needs --beam quasi-static and no --voltage bias: the distributed moment "
-                         "of the electrode line is not yet wired to the modal beam or the biased circuit")
-    r = frequency_response(f, strip=strip, model=args.model, material=material, method=args.method, beam=args.beam,
-                           viscous_modulus=args.viscous_modulus, voltage=args.voltage)
+    if args.sheet_resistance is not None:
+        # the electrode line: Z at the clamp, the distributed moment into the quasi-static or modal beam
+        r = line_response(f, strip=strip, model=args.model, material=material, method=args.method,
+                          sheet_resistance=args.sheet_resistance, beam=args.beam,
+                          viscous_modulus=args.viscous_modulus, voltage=args.voltage)
+    else:
+        r = frequency_response(f, strip=strip, model=args.model, material=material, method=args.method,
+                               beam=args.beam, viscous_modulus=args.viscous_modulus, voltage=args.voltage)
     cols = {"f": r.f, "Z_re": r.Z.real, "Z_im": r.Z.imag, "w_amp": r.w_amp, "w_phase": r.w_phase,
             "theta_amp": np.abs(r.H_theta), "theta_phase": np.angle(r.H_theta),
             "F_amp": np.abs(r.H_F), "F_phase": np.angle(r.H_F)}
     if r.error is not None:
         cols["error"] = r.error
-    if args.sheet_resistance is not None:
-        # the electrode line: Z at the clamp, w and theta of the distributed moment (no blocked-tip
-        # force for a distributed moment yet, and the circuit's error is that of the uniform strip)
-        ln = line_response(f, strip=strip, model=args.model, material=material, method=args.method,
-                           sheet_resistance=args.sheet_resistance)
-        cols.update({"Z_re": ln.Z.real, "Z_im": ln.Z.imag, "w_amp": ln.w_amp, "w_phase": ln.w_phase,
-                     "theta_amp": np.abs(ln.H_theta), "theta_phase": np.angle(ln.H_theta)})
-        for k in ("F_amp", "F_phase", "error"):
-            cols.pop(k, None)
-        r = ln
     head = {"tau": r.tau, "model": r.model, "method": r.method, "thickness_total": strip.thickness,
-            "f_d": getattr(r, "f_d", None), "voltage": args.voltage, "beam": args.beam,
+            "f_d": r.f_d, "voltage": args.voltage, "beam": args.beam,
             "viscous_modulus": args.viscous_modulus,
-            "resonances": getattr(r, "resonances", None),
-            "error_max": None if getattr(r, "error", None) is None else r.error_max,
+            "resonances": r.resonances,
+            "error_max": None if r.error is None else r.error_max,
             "reference": "pnp-linear (exact linearised Nernst-Planck/Gauss)",
             "electrode_area": strip.width * strip.length, "diffusion_coefficient": material.D,
             "units": {"f": "Hz", "Z": "Ohm (strip, electrode area 2l L)", "w_amp": "m/V", "w_phase": "rad",
@@ -136,10 +126,15 @@ def run(args):
     if args.sheet_resistance is not None:
         head["sheet_resistance"] = args.sheet_resistance
         head["units"]["sheet_resistance"] = "Ohm/sq (each electrode)"
+        if args.beam == "dynamic":
+            # the modal quadrature and truncation of the distributed moment (relative, on w, theta, F)
+            head["beam_error_max"] = float(np.max(r.beam_error)) if r.beam_error.size else 0.0
     if args.export is not None:
         fits = {o: transfer_function(args.f1, args.f2, strip=strip, model=args.model, material=material, output=o,
                                      method=args.method, tol=args.export_tol, beam=args.beam,
-                                     viscous_modulus=args.viscous_modulus, voltage=args.voltage)
+                                     viscous_modulus=args.viscous_modulus, voltage=args.voltage,
+                                     **({} if args.sheet_resistance is None else
+                                        {"sheet_resistance": args.sheet_resistance}))
                 for o in ("w", "charge")}
         doc = {"models": {o: t.to_dict() for o, t in fits.items()}, "thickness_total": strip.thickness,
                "electrode_area": strip.width * strip.length, "diffusion_coefficient": material.D,

@@ -25,12 +25,14 @@ from ipmc_asym.cli.common import (
     strip_from_args,
     tol_type,
 )
-from ipmc_asym.cli.drive import add_beam_options
+from ipmc_asym.cli.drive import add_beam_options, add_line_options
 from ipmc_asym.dynamics.circuit import STEP_FIDELITIES, step_response, waveform
 from ipmc_asym.dynamics.drive import (
     CHECK_COLUMNS,  # per time point: the forward model's checks, as drive
+    LINE_COLUMNS,
     drive_chunks,
     drive_info,
+    drive_response,
 )
 from ipmc_asym.dynamics.waveforms import parse_waveform
 from ipmc_asym.forward.model import CHECKS
@@ -61,7 +63,7 @@ def _num(x, scale):
 
 #: units of the CSV columns (the sidecar's "units")
 UNITS = {"t": "s", "phi0": "V", "sigma": "C/m^2", "sigma_error": "C/m^2", "current_density": "A/m^2", "M_A": "N m",
-         "theta": "rad", "w": "m"}
+         "theta": "rad", "w": "m", "w_error": "m"}
 
 
 def _write_rows(wr, model, values, flags):
@@ -91,25 +93,77 @@ def _stream_csv(args, strip, material, models) -> int:
     many = len(models) > 1
     drive = "step" if args.waveform is None else args.waveform.spec
     wave = args.waveform if args.waveform is not None else waveform("step", strip.voltage)
-    infos = {m: drive_info(strip, m, material, "quasi-static") for m in models}
+    line = dict(sheet_resistance=args.sheet_resistance, line_segments=args.line_segments)
+    # the uniform strip streams with the quasi-static beam only; the electrode line with either
+    beam = args.beam if args.sheet_resistance > 0.0 else "quasi-static"
+    dyn = dict(viscous_modulus=args.viscous_modulus) if beam == "dynamic" else {}
+    infos = {m: drive_info(strip, m, material, beam, **dyn, **line) for m in models}
+    columns = COLUMNS + (LINE_COLUMNS if args.sheet_resistance > 0.0 else ())
     seen, n_rows = {}, 0
     with atomic_write(args.out) as fh:
         wr = csv.writer(fh)
-        wr.writerow((("model",) if many else ()) + COLUMNS + CHECK_COLUMNS)
+        wr.writerow((("model",) if many else ()) + columns + CHECK_COLUMNS)
         for mname in models:
             duration = args.duration if args.duration is not None else 5.0 * infos[mname]["tau"]
             for ch in drive_chunks(wave, duration, args.points, strip=strip, model=mname, material=material,
-                                   beam="quasi-static"):
+                                   beam=beam, **dyn, **line):
                 for w in ch["warnings"]:
                     seen.setdefault((mname, w.split(":")[0]), f"{mname}: {w}" if many else w)
-                _write_rows(wr, mname if many else None, [ch[c] for c in COLUMNS],
+                _write_rows(wr, mname if many else None, [ch[c] for c in columns],
                             [np.asarray(ch[c]) != 0.0 for c in CHECK_COLUMNS])
                 n_rows += ch["t"].size
-    _sidecar(args, strip, {m: infos[m]["tau"] for m in models}, "circuit", drive, "quasi-static",
-             infos[models[0]]["notes"], warnings=list(seen.values()))
+    _sidecar(args, strip, {m: infos[m]["tau"] for m in models}, "circuit", drive, beam,
+             infos[models[0]]["notes"], warnings=list(seen.values()),
+             **({"sheet_resistance": args.sheet_resistance, "line_segments": 2 * args.line_segments}
+                if args.sheet_resistance > 0.0 else {}))
     for w in seen.values():
         sys.stderr.write(f"step: warning: {w}\n")
     sys.stderr.write(f"step: {n_rows} rows -> {args.out} (streamed; metadata: {sidecar_path(args.out)})\n")
+    return 0
+
+
+def _line_in_memory(args, strip, material, models) -> int:
+    """``step --sheet-resistance`` printed or as ``--json``: the electrode line (drive_response: the
+    ladder of reduced circuits, the forward model at every node, its stated error) per model."""
+    line = dict(sheet_resistance=args.sheet_resistance, line_segments=args.line_segments)
+    drive = "step" if args.waveform is None else args.waveform.spec
+    wave = args.waveform if args.waveform is not None else waveform("step", strip.voltage)
+    columns = COLUMNS + LINE_COLUMNS
+    out = {}
+    for mname in models:
+        info = drive_info(strip, mname, material, args.beam, args.viscous_modulus, **line)
+        duration = args.duration if args.duration is not None else 5.0 * info["tau"]
+        r = drive_response(wave, duration, args.points, strip=strip, model=mname, material=material,
+                           beam=args.beam, viscous_modulus=args.viscous_modulus, **line)
+        out[mname] = (info, r)
+    if args.json:
+        def one(info, r):
+            return {"tau": info["tau"], "R": info["R"], "model": info["model"], "fidelity": "circuit",
+                    "voltage": strip.voltage, "thickness_total": strip.thickness, "half_thickness_e": strip.e,
+                    "diffusion_coefficient": material.D, "notes": info["notes"], "waveform": drive,
+                    "beam": args.beam, "sheet_resistance": args.sheet_resistance,
+                    "line_segments": info["line_segments"], **{c: r[c] for c in columns},
+                    **{c: r[c].astype(bool) for c in CHECK_COLUMNS}}
+        doc = (one(*out[models[0]]) if len(models) == 1 else
+               {"model": "all", "thickness_total": strip.thickness, "models": {m: one(*out[m]) for m in models}})
+        print(dumps(doc, indent=1))
+        return 0
+    for mname in models:
+        info, r = out[mname]
+        what = f"step {strip.voltage:g} V" if args.waveform is None else f"waveform {drive}"
+        print(f"{what}, total thickness 2e = {fmt_length(strip.thickness)}, model {info['model']}, fidelity circuit, "
+              f"beam {args.beam}, electrode sheet resistance {args.sheet_resistance:g} Ohm/sq "
+              f"({info['line_segments']} segments): tau = {info['tau']:.4g} s")
+        idx = np.unique(np.linspace(0, r["t"].size - 1, min(r["t"].size, 11)).astype(int))
+        print(f"{'t [s]':>11s} {'sigma [C/m^2]':>14s} {'+-':>9s} {'J [A/m^2]':>11s} {'M_A [N m]':>11s} {'theta':>9s} "
+              f"{'w [mm]':>9s} {'+-':>9s} valid")
+        for i in idx:
+            print(f"{fmt_num(r['t'][i], '11.4g')} {fmt_num(r['sigma'][i], '14.6g')} {fmt_num(r['sigma_error'][i], '9.2g')} "
+                  f"{fmt_num(r['current_density'][i], '11.4g')} {fmt_num(r['M_A'][i], '11.4g')} "
+                  f"{_num(r['theta'][i], 1.0):>9s} {_num(r['w'][i], 1e3):>9s} {fmt_num(r['w_error'][i] * 1e3, '9.2g')} "
+                  f"{'yes' if r['valid'][i] else 'no'}")
+    for n in out[models[0]][0]["notes"]:
+        print(f"note: {n}")
     return 0
 
 
@@ -134,6 +188,7 @@ def register(sub):
                    help="instead of the step of --voltage: a SPEC such as 'sine:1V@10Hz' or 'step:1V+square:0.1V@5Hz' "
                         "(see ipmc-asym drive --help)")
     add_beam_options(p, "quasi-static")
+    add_line_options(p)
     p.add_argument("--out", default=None, metavar="F.csv",
                    help="CSV file (header row t, phi0, sigma, current_density, M_A, theta, w, check_* and valid per "
                         "time point; SI; a first column model with --model all), with the metadata (tau, total "
@@ -154,6 +209,14 @@ def run(args):
     strip = strip_from_args(args)
     first_run_notice()
     models = list(model_names()) if args.model == "all" else [args.model]
+    if args.sheet_resistance > 0.0:
+        for bad, why in ((args.fidelity != "circuit", "--fidelity pnp"), (args.tol is not None, "--tol")):
+            if bad:
+                raise ValueError(f"--sheet-resistance with {why}: the electrode line is a ladder of reduced circuits "
+                                 f"(its discretisation error is stated); drop {why}")
+        if not args.out or args.json:
+            return _line_in_memory(args, strip, material, models)
+        return _stream_csv(args, strip, material, models)
     if args.out and args.fidelity == "circuit" and args.tol is None and args.beam == "quasi-static" and not args.json:
         return _stream_csv(args, strip, material, models)
     kind = args.waveform if args.waveform is not None else "step"

@@ -19,6 +19,7 @@ import numpy as np
 from ipmc_asym.base.registry import check_choice
 from ipmc_asym.base.settings import VALIDATED_VOLTAGE
 from ipmc_asym.beam.dynamics import natural_frequencies
+from ipmc_asym.beam.statics import solve_beam
 from ipmc_asym.dynamics.circuit import (
     BEAM_CHOICES,
     TIME_MODES,
@@ -29,16 +30,41 @@ from ipmc_asym.dynamics.circuit import (
     waveform,
 )
 from ipmc_asym.dynamics.electrode import core_resistance, time_constant
+from ipmc_asym.dynamics.line_time import (
+    DEFAULT_SEGMENTS,
+    ERROR_FACTOR,
+    MAX_SEGMENTS,
+    LineBeamDynamics,
+    LineStepper,
+    line_weights,
+)
 from ipmc_asym.dynamics.waveforms import Waveform, parse_waveform
 from ipmc_asym.forward.model import CHECKS, assumption_warnings, voltage_reason
-from ipmc_asym.model.params import NAFION_LI, Material, Strip, check_positive
+from ipmc_asym.model.params import NAFION_LI, SHEET_RESISTANCE_SOURCE, Material, Strip, check_finite, check_positive
 from ipmc_asym.model.permittivity import get_model
 
-__all__ = ["DRIVE_COLUMNS", "CHECK_COLUMNS", "MAX_DRIVE_POINTS", "drive_info", "drive_chunks", "drive_response"]
+__all__ = ["DRIVE_COLUMNS", "CHECK_COLUMNS", "LINE_COLUMNS", "MAX_DRIVE_POINTS", "drive_info", "drive_chunks",
+           "drive_response", "LINE_NOTE"]
 
 DRIVE_COLUMNS = ("t", "phi0", "sigma", "current_density", "layer_voltage", "M_A", "theta", "w", "F_block")
 #: the forward model's checks at each time point (1 passed, 0 failed), as in step and estimate
 CHECK_COLUMNS = tuple(f"check_{c}" for c in CHECKS) + ("valid",)
+
+#: with a sheet resistance: the stated discretisation error of sigma (C/m^2) and w (m) of the line
+LINE_COLUMNS = ("sigma_error", "w_error")
+
+LINE_NOTE = ("electrodes: sheet resistance R_s = {Rs:g} Ohm/sq each: the RC line along the strip discretised in "
+             "{n2} segments (trapezoidal ladder, a reduced circuit at each node, driven at the clamp, open at the tip); "
+             "sigma, current density and layer voltage are means over the electrode; sigma_error and w_error are twice "
+             "the Richardson estimate against {n} segments; the quasi-static beam takes the distributed moment as the "
+             "uniform moments of equal tip rotation (theta, M_A = its mean) and of equal tip deflection (w, F_block): "
+             "exact for small displacements and for a uniform moment; with beam dynamics the node moments (linear "
+             "between nodes) drive the modes through int M phi_n'' dx; the bulk's geometric capacitance is "
+             "instantaneous (its displacement charge is added to sigma)")
+
+#: the electrode line's stated error may reach this fraction of the largest |sigma| and |w| so far;
+#: beyond it the run is refused (more segments hold it): the numbers are not handed out
+LINE_TOL = 1e-2
 
 #: cap on the number of output times of one run (each row is ~9 numbers; streamed to a file)
 MAX_DRIVE_POINTS = 100_000_000
@@ -52,12 +78,26 @@ def _resolve(wave):
     raise ValueError("waveform must be a SPEC string (e.g. 'sine:1V@10Hz') or a callable phi0(t) in volts")
 
 
-def drive_info(strip: Strip, model, material: Material, beam="dynamic", viscous_modulus=0.0):
+def _sheet(sheet_resistance, beam):
+    Rs = check_finite("sheet_resistance", sheet_resistance, "a finite number >= 0 Ohm/sq")
+    if Rs < 0.0:
+        raise ValueError(f"sheet_resistance must be a finite number >= 0 Ohm/sq; got {sheet_resistance!r}")
+    return Rs
+
+
+def drive_info(strip: Strip, model, material: Material, beam="dynamic", viscous_modulus=0.0, sheet_resistance=0.0,
+               line_segments=DEFAULT_SEGMENTS):
     """Header of a run: time constant, R, resonances, notes (what is modelled and what is not)."""
     perm = get_model(model)
+    Rs = _sheet(sheet_resistance, beam)
     info = {"tau": float(time_constant(strip.thickness, perm, material)),
             "R": float(core_resistance(strip.thickness, material)), "model": perm.name, "beam": beam,
             "viscous_modulus": float(viscous_modulus), "notes": dynamic_notes(beam, viscous_modulus)}
+    if Rs > 0.0:
+        info["sheet_resistance"] = Rs
+        info["line_segments"] = 2 * int(line_segments)
+        info["notes"] += [LINE_NOTE.format(Rs=Rs, n2=2 * int(line_segments), n=int(line_segments)),
+                          SHEET_RESISTANCE_SOURCE]
     if beam == "dynamic":
         b = BeamDynamics(strip, material, viscous_modulus, 1).beam
         info["resonances"] = {s: natural_frequencies(s, b, 3).tolist() for s in ("clamped-free", "clamped-pinned")}
@@ -66,7 +106,7 @@ def drive_info(strip: Strip, model, material: Material, beam="dynamic", viscous_
 
 def drive_chunks(wave, duration, points, *, strip: Strip | None = None, model="constant",
                  material: Material | None = None, beam="dynamic", viscous_modulus=0.0, n_modes=TIME_MODES,
-                 chunk=20_000):
+                 chunk=20_000, sheet_resistance=0.0, line_segments=DEFAULT_SEGMENTS):
     """Yield dicts of column arrays (:data:`DRIVE_COLUMNS`) over ``points`` equally spaced times in [0, duration].
 
     Parameters
@@ -78,6 +118,14 @@ def drive_chunks(wave, duration, points, *, strip: Strip | None = None, model="c
     strip, model, material : as in :func:`ipmc_asym.dynamics.circuit.step_response`
     beam : {"dynamic", "quasi-static"} ; viscous_modulus : float (Pa s) ; n_modes : int
     chunk : int        rows per chunk (memory ~ chunk, not points)
+    sheet_resistance : float
+        ``R_s`` of each electrode (Ohm/sq, default 0: the uniform strip, exactly).  > 0: the
+        discretised RC line (:class:`ipmc_asym.dynamics.line_time.LineStepper`, ``2 line_segments``
+        segments reported, ``line_segments`` for the error), the forward model at every node,
+        with ``beam="dynamic"`` the node moments drive the modes
+        (:class:`ipmc_asym.dynamics.line_time.LineBeamDynamics`); the chunks also hold :data:`LINE_COLUMNS`.  A stated error above
+        :data:`LINE_TOL` of the largest response so far is refused (``ValueError``: more segments).
+    line_segments : int   ``N`` of the coarser line
 
     Notes
     -----
@@ -85,6 +133,7 @@ def drive_chunks(wave, duration, points, *, strip: Strip | None = None, model="c
     period, the first-order hold of ``M_A``), else ``ValueError`` says how many points are needed.
     """
     check_choice("beam", beam, BEAM_CHOICES)
+    Rs = _sheet(sheet_resistance, beam)
     fun = _resolve(wave)
     s = Strip() if strip is None else strip
     m = NAFION_LI if material is None else material
@@ -102,9 +151,20 @@ def drive_chunks(wave, duration, points, *, strip: Strip | None = None, model="c
         need = int(math.ceil(40.0 * d / dyn.period)) + 1
         raise ValueError(f"points: the beam dynamics need >= 40 points per period of the first mode "
                          f"(T1 = {dyn.period:.4g} s): use --points >= {need} or beam quasi-static")
-    stepper = CircuitStepper(fun, s, perm, m)
+    line = LineStepper(fun, s, perm, m, Rs, line_segments) if Rs > 0.0 else None
+    ldyn = None
+    if line is not None and dyn is not None:
+        # the line's node moments drive the modes (both ladders: the coarse one for the error of w)
+        ldyn = (LineBeamDynamics(s, m, viscous_modulus, n_modes, line.x),
+                LineBeamDynamics(s, m, viscous_modulus, n_modes, line.x_coarse))
+    stepper = line if line is not None else CircuitStepper(fun, s, perm, m)
     R = float(core_resistance(s.thickness, m))
     Cg = stepper.Cg
+    lcols = LINE_COLUMNS if line is not None else ()
+    if line is not None:
+        # the forward model runs on every node of both ladders: keep its arrays at ~2e5 points a chunk
+        chunk = max(16, min(chunk, 200_000 // (3 * line.segments + 2)))
+    peak = {"sigma": 0.0, "w": 0.0}
     held = None  # last computed row, waiting for its successor (central difference of phi0 - u)
     prev = None  # (t, ub) of the row before it
     start = 0
@@ -113,23 +173,53 @@ def drive_chunks(wave, duration, points, *, strip: Strip | None = None, model="c
         idx = np.arange(start, stop + 1)
         t = idx * h
         t[-1] = d if stop == n - 1 else t[-1]
-        u, ub, sigma = stepper.advance(t)
-        # every time point through the forward model and its checks (the same as step's and estimate's)
-        fr = quasi_static_forward(u, s, perm, m)
-        M, th, w, Fb = (np.asarray(getattr(fr, k), dtype=float) for k in ("M_A", "theta", "w", "F_block"))
+        lc = {}
+        if line is None:
+            u, ub, sigma = stepper.advance(t)
+            # every time point through the forward model and its checks (the same as step's and estimate's)
+            fr = quasi_static_forward(u, s, perm, m)
+            M, th, w, Fb = (np.asarray(getattr(fr, k), dtype=float) for k in ("M_A", "theta", "w", "F_block"))
+            checks = {c: np.asarray(getattr(fr, c), bool).reshape(-1) for c in CHECKS}
+        else:
+            o = line.advance(t)
+            # every node at every time through the forward model; a time point passes a check where every node does
+            fr = quasi_static_forward(o["u"].ravel(), s, perm, m)
+            checks = {c: np.asarray(getattr(fr, c), bool).reshape(o["u"].shape).all(axis=1) for c in CHECKS}
+            Mn = np.asarray(fr.M_A, dtype=float).reshape(o["u"].shape)
+            M, th, w, Fb = _line_mechanics(Mn, line.x, s, m)
+            frc = quasi_static_forward(o["u_coarse"].ravel(), s, perm, m)
+            Mc = np.asarray(frc.M_A, dtype=float).reshape(o["u_coarse"].shape)
+            _, thc, wc, Fc = _line_mechanics(Mc, line.x_coarse, s, m)
+            w_qs = w
+            if ldyn is not None:
+                th, w, Fb = ldyn[0].advance(t, Mn, (th, w), Fb)
+                wc = ldyn[1].advance(t, Mc, (thc, wc), Fc)[1]
+            u = o["u"] @ line_weights(2 * line.segments, s.length)[1] / s.length
+            ub, sigma = o["ub_mean"], o["sigma_mean"]
+            lc = {"sigma_error": o["sigma_error"], "w_error": ERROR_FACTOR * np.abs(w - wc)}
+            for k, v in (("sigma", sigma), ("w", np.maximum(np.abs(w), np.abs(w_qs)))):
+                # the error bound against the largest response so far (a numerical check: refuse, not flag);
+                # for w the quasi-static deflection too (the strip's inertia delays the dynamic one)
+                scale = np.maximum.accumulate(np.maximum(np.abs(v), peak[k]))
+                over = lc[f"{k}_error"] > LINE_TOL * scale
+                if np.any(over):
+                    i = int(np.argmax(over))
+                    raise ValueError(f"line_segments: the electrode line's discretisation error on {k} exceeds "
+                                     f"{LINE_TOL:g} of the response at t = {t[i]:.4g} s with {2 * line.segments} "
+                                     f"segments; raise line_segments (now {line.segments}, at most {MAX_SEGMENTS})")
+                peak[k] = float(scale[-1])
         phi = fun(t)
-        checks = {c: np.asarray(getattr(fr, c), bool).reshape(-1) for c in CHECKS}
         warns = assumption_warnings(fr)
         over = np.abs(phi) > VALIDATED_VOLTAGE  # the applied voltage too: the layers' one lags behind it
         if np.any(over & checks["voltage"]):
             checks["voltage"] = checks["voltage"] & ~over
             warns = [x for x in warns if "VALIDATED_VOLTAGE" not in x] + [voltage_reason(np.max(np.abs(phi)))]
         valid = np.logical_and.reduce([checks[c] for c in CHECKS])
-        if dyn is not None:
+        if dyn is not None and line is None:
             th, w, Fb = dyn.advance(t, M, th, w, Fb)
         cols = {"t": t, "phi0": phi, "sigma": sigma, "layer_voltage": u, "M_A": M, "theta": th, "w": w,
                 "F_block": Fb, "_ub": ub, **{f"check_{c}": checks[c].astype(float) for c in CHECKS},
-                "valid": valid.astype(float)}
+                "valid": valid.astype(float), **lc}
         if held is not None:  # the first row of this chunk repeats the held one
             cols = {k: v[1:] for k, v in cols.items()}
             cols = {k: np.concatenate(([held[k]], cols[k])) for k in cols}
@@ -144,14 +234,14 @@ def drive_chunks(wave, duration, points, *, strip: Strip | None = None, model="c
             g = g[1:]
         emit = slice(None) if last else slice(0, -1)
         J = uu / R + Cg * g
-        out = {k: cols[k][emit] for k in DRIVE_COLUMNS + CHECK_COLUMNS if k != "current_density"}
+        out = {k: cols[k][emit] for k in DRIVE_COLUMNS + CHECK_COLUMNS + lcols if k != "current_density"}
         out["current_density"] = J[emit]
         if not last:
             held = {k: v[-1] for k, v in cols.items()}
             prev = (tt[-2], uu[-2])
         else:
             held = {}
-        yield {**{k: out[k] for k in DRIVE_COLUMNS + CHECK_COLUMNS}, "warnings": warns}
+        yield {**{k: out[k] for k in DRIVE_COLUMNS + CHECK_COLUMNS + lcols}, "warnings": warns}
         start = stop
         if last:
             break
@@ -160,4 +250,25 @@ def drive_chunks(wave, duration, points, *, strip: Strip | None = None, model="c
 def drive_response(wave, duration, points=1000, **kw):
     """All rows of :func:`drive_chunks` in memory (dict of arrays), for short runs and tests."""
     parts = list(drive_chunks(wave, duration, points, **kw))
-    return {k: np.concatenate([p[k] for p in parts]) for k in DRIVE_COLUMNS + CHECK_COLUMNS}
+    return {k: np.concatenate([p[k] for p in parts]) for k in DRIVE_COLUMNS + CHECK_COLUMNS + LINE_COLUMNS
+            if k in parts[0]}
+
+
+def _line_mechanics(M, x, strip: Strip, material: Material):
+    """``(M_A, theta, w, F_block)`` of the strip under the node moments ``M`` (n, nodes) of a ladder at ``x``.
+
+    The beam (:func:`ipmc_asym.beam.statics.solve_beam`) at the uniform moment of equal
+    small-displacement tip rotation, ``int M dx/L`` (theta; reported as M_A), and of equal tip
+    deflection, ``2 int (L - x) M dx/L^2`` (w and F_block: ``F = 3 int (L - x) M dx/L^3``,
+    ``derivations/line.py`` item 3 and ``beam.dynamics.moment_kernels``), trapezoidal sums on the
+    ladder's nodes.
+    """
+    L = strip.length
+    _, wt = line_weights(x.size - 1, L)
+    Mt = M @ wt / L
+    Mw = M @ (2.0 * (L - x) * wt / L**2)
+    EI = material.E * strip.I_p
+    with np.errstate(all="ignore"):
+        bt = solve_beam(Mt, L, EI, e=strip.e, strain_limit=material.strain_limit)
+        bw = solve_beam(Mw, L, EI, e=strip.e, strain_limit=material.strain_limit)
+    return Mt, np.asarray(bt.theta, dtype=float), np.asarray(bw.w, dtype=float), np.asarray(bw.F_block, dtype=float)

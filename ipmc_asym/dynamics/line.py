@@ -36,16 +36,19 @@ is :meth:`LineResult.modal_forcing` (any mode-shape curvature callable).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from ipmc_asym.dynamics.circuit import FrequencyResult, frequency_response
+from ipmc_asym.base.registry import check_choice
+from ipmc_asym.beam.dynamics import DEFAULT_MODES, distributed_transfer
+from ipmc_asym.dynamics.circuit import BEAM_CHOICES, FrequencyResult, dynamic_notes, frequency_response, strip_beam
 from ipmc_asym.model import groups
 from ipmc_asym.model.params import NAFION_LI, SHEET_RESISTANCE_SOURCE, Material, Strip, check_finite
 
 __all__ = ["LineResult", "line_response", "line_factors", "voltage_profile", "moment_modal_integral",
-           "MAX_PROFILE_POINTS"]
+           "ProfileQuadrature", "MAX_PROFILE_POINTS"]
 
 #: largest number of (frequency, x) values a voltage profile may hold
 MAX_PROFILE_POINTS = 10**7
@@ -136,29 +139,60 @@ def moment_modal_integral(curvature, g, length, *, uniform_panels: int = 4, erro
     -------
     ndarray complex, shape (len(g),) or (len(g), k)
     """
-    L = float(length)
-    g = np.atleast_1d(np.asarray(g, dtype=complex))
-    n = int(uniform_panels)
-    if n < 1 or n > 10**4:
-        raise ValueError(f"uniform_panels must be an integer in 1..10000; got {uniform_panels!r}")
-    ends = _panels(float(np.max(np.abs(g))) if g.size else 0.0, n)
+    quad = ProfileQuadrature(g, length, uniform_panels=uniform_panels, error=error)
+    return quad(curvature)
 
-    def rule(xg, wg):
-        a, b = ends[:-1, None], ends[1:, None]
-        xi = (0.5 * (b - a) * xg[None, :] + 0.5 * (a + b)).ravel()
-        wt = (0.5 * (b - a) * wg[None, :]).ravel()
-        c = np.asarray(curvature(xi * L), dtype=float)
+
+class ProfileQuadrature:
+    """The composite Gauss-Legendre rule of :func:`moment_modal_integral` with the voltage profile at
+    its nodes evaluated once, for several curvature callables at the same ``g`` (same arguments)."""
+
+    def __init__(self, g, length, *, uniform_panels: int = 4, error: bool = False):
+        L = float(length)
+        g = np.atleast_1d(np.asarray(g, dtype=complex))
+        n = int(uniform_panels)
+        if n < 1 or n > 10**4:
+            raise ValueError(f"uniform_panels must be an integer in 1..10000; got {uniform_panels!r}")
+        ends = _panels(float(np.max(np.abs(g))) if g.size else 0.0, n)
+        self.L = L
+        self.rules = []
+        pairs = [(_GL_X, _GL_W)] + ([np.polynomial.legendre.leggauss(_GL_N // 2)] if error else [])
+        for xg, wg in pairs:
+            a, b = ends[:-1, None], ends[1:, None]
+            xi = (0.5 * (b - a) * xg[None, :] + 0.5 * (a + b)).ravel()
+            wt = (0.5 * (b - a) * wg[None, :]).ravel()
+            if g.size and float(np.max(g.real)) <= 300.0:
+                # e^{-g (2 - xi)} = e^{-2g}/e^{-g xi} (no overflow for Re g <= 300), and on each panel
+                # e^{-g xi} = e^{-g c} e^{-g h t} (centre c, half width h, node t): the panels of one
+                # width share their e^{-g h t}, so a node costs a product, not an exponential
+                c, h = (0.5 * (a + b)).ravel(), (0.5 * (b - a)).ravel()
+                E = np.empty((g.size, c.size, xg.size), complex)
+                ec = np.exp(-g[:, None] * c[None, :])
+                for hw in np.unique(h):
+                    sel = h == hw
+                    E[:, sel, :] = ec[:, sel, None] * np.exp(-g[:, None] * (hw * xg))[:, None, :]
+                E = E.reshape(g.size, xi.size)
+                q = np.exp(-2.0 * g)
+                V = (E + q[:, None] / E) / (1.0 + q)[:, None]
+            else:
+                V = voltage_profile(g[:, None], xi[None, :])
+            # two real products (the curvatures are real): a quarter of the work of a complex one
+            self.rules.append((xi, L * wt, np.ascontiguousarray(V.real), np.ascontiguousarray(V.imag)))
+
+    def _rule(self, curvature, xi, wt, Vr, Vi):
+        c = np.asarray(curvature(xi * self.L), dtype=float)
         if c.shape[-1:] != xi.shape or c.ndim > 2:
             raise ValueError(f"curvature(x) must return an array of shape (n,) or (k, n) for n = {xi.size} positions")
         if not np.all(np.isfinite(c)):
             raise ValueError("curvature(x) must return finite values on [0, L]")
-        return L * (voltage_profile(g[:, None], xi[None, :]) @ (wt * c).T)
+        cw = np.ascontiguousarray((wt * c).T)
+        return Vr @ cw + 1j * (Vi @ cw)
 
-    val = rule(_GL_X, _GL_W)
-    if not error:
-        return val
-    xg, wg = np.polynomial.legendre.leggauss(_GL_N // 2)
-    return val, np.abs(val - rule(xg, wg))
+    def __call__(self, curvature):
+        val = self._rule(curvature, *self.rules[0])
+        if len(self.rules) == 1:
+            return val
+        return val, np.abs(val - self._rule(curvature, *self.rules[1]))
 
 
 @dataclass
@@ -181,7 +215,16 @@ class LineResult:
     x : ndarray or None         positions of the profile, m
     V_profile : ndarray complex or None   ``V(x)/V0``, shape (n, len(x))
     tau, method, model, notes   as :class:`ipmc_asym.dynamics.circuit.FrequencyResult`
-    uniform : FrequencyResult   the same strip with ideal electrodes
+    uniform : FrequencyResult   the same strip with ideal electrodes (quasi-static beam)
+    H_F : ndarray complex       blocking force per volt (blocked tip), N/V
+    error : ndarray or None     circuit at 0 V: relative error of Z and H_w against the same line with
+                                the linearised PNP's ``Z_area`` (computed at each frequency); None for
+                                pnp-linear and about a bias
+    error_max : float           largest ``error`` over the frequencies (NaN without ``error``)
+    f_d, resonances, beam, voltage   as :class:`ipmc_asym.dynamics.circuit.FrequencyResult`
+    beam_error : ndarray        dynamic beam: estimate of the relative error of H_w, H_theta, H_F from
+                                the modal integrals (a quadrature of half the order) and the modal
+                                truncation (the last kept mode's term); 0 for the quasi-static beam
     """
 
     f: np.ndarray
@@ -204,6 +247,14 @@ class LineResult:
     x: object = None
     V_profile: object = None
     extra: dict = field(default_factory=dict)
+    H_F: object = None
+    error: object = None
+    error_max: float = math.nan
+    f_d: float = math.nan
+    resonances: dict = field(default_factory=dict)
+    beam: str = "quasi-static"
+    voltage: float = 0.0
+    beam_error: object = None
 
     def modal_forcing(self, curvature, **kw):
         """``int_0^L M(x) phi''(x) dx`` per volt at the clamp, for each frequency (see
@@ -216,9 +267,48 @@ class LineResult:
         return (self.H_M * v.T).T
 
 
+def _uniform_panels(n_modes):
+    """Equal panels for the modal integrals: 24 Gauss points resolve ~8 half waves of ``phi_n''``,
+    mode n has ~n of them (and the kernels are cubic)."""
+    return max(4, -(-int(n_modes) // 6))
+
+
+def _line(u, strip: Strip, material: Material, Rs, beam, viscous_modulus, n_modes):
+    """(Z, H_w, H_theta, H_F, H_M, g, beam_error) of the line over the uniform quasi-static response ``u``."""
+    L = strip.length
+    g = groups.line_propagation(L, Rs, u.Z_area)
+    fz, fth, fw = line_factors(g)
+    EI = material.E * strip.I_p
+    # H_w^u = -L^2 H_M/(2 E I_p): the moment per volt of the uniform strip's own transfer
+    HM = -2.0 * EI * u.H_w / (L * L)
+    Z = u.Z * fz
+    if beam == "quasi-static":
+        Hw = u.H_w * fw
+        # blocked tip, small displacements: F = 3 int (L - x) M dx/L^3 = -3 E I_p w_free/L^3
+        return Z, Hw, 2.0 * u.H_w / L * fth, -3.0 * EI * Hw / L**3, HM, g, np.zeros(g.shape)
+    b = strip_beam(strip, material, viscous_modulus)
+    quad = ProfileQuadrature(g, L, uniform_panels=_uniform_panels(n_modes), error=True)
+
+    def integrate(c):
+        v, e = quad(c)
+        return HM[:, None] * v, np.abs(HM)[:, None] * e
+
+    from threadpoolctl import threadpool_limits  # deferred: only the modal integrals need it
+
+    # small products (frequencies x nodes x modes): BLAS threads would only compete for the cores
+    with threadpool_limits(1):
+        cf = distributed_transfer(u.f, b, "clamped-free", integrate, n_modes)
+        cp = distributed_transfer(u.f, b, "clamped-pinned", integrate, n_modes)
+    # the estimate of the quadrature (24 against 12 points a panel) plus the modal truncation
+    be = np.maximum.reduce([cf["error"]["w"], cf["error"]["theta"], cp["error"]["F"]])
+    be = be + max(cf["truncation"], cp["truncation"])
+    return Z, cf["w"], cf["theta"], cp["F"], HM, g, be
+
+
 def line_response(f, *, strip: Strip | None = None, model="constant", material: Material | None = None,
-                  sheet_resistance=None, method="pnp-linear", x=None) -> LineResult:
-    """Impedance and tip transfer functions of a strip with resistive electrodes, about 0 V.
+                  sheet_resistance=None, method="pnp-linear", x=None, beam="quasi-static", viscous_modulus=0.0,
+                  n_modes=DEFAULT_MODES, voltage=0.0) -> LineResult:
+    """Impedance and tip transfer functions of a strip with resistive electrodes (small signal).
 
     Parameters
     ----------
@@ -235,26 +325,45 @@ def line_response(f, *, strip: Strip | None = None, model="constant", material: 
         Through-thickness impedance, as :func:`ipmc_asym.dynamics.circuit.frequency_response`.
     x : array_like, optional
         Positions along the strip (m, in ``[0, L]``) where ``V(x)/V0`` is wanted.
+    beam : {"quasi-static", "dynamic"}
+        ``dynamic``: the distributed moment ``M(x, s) = H_M V(x, s)`` drives the strip's modes
+        (inertia, Kelvin-Voigt damping; :func:`ipmc_asym.beam.dynamics.distributed_transfer`):
+        free tip ``H_w``, ``H_theta``, blocked tip ``H_F`` with resonances.
+    viscous_modulus : float
+        ``eta_E`` (Pa s), default 0.
+    n_modes : int
+        Modes kept (dynamic beam).
+    voltage : float
+        DC bias (V), ``method="circuit"`` only: the shunt admittance per length is the small-signal
+        one about the biased static state (``R``, ``C_d(V)``, ``C_g``) and ``H_M`` the forward
+        model's moment slope there, as :func:`frequency_response` with ``voltage``.
 
     Returns
     -------
     LineResult
     """
+    check_choice("beam", beam, BEAM_CHOICES)
     s = Strip() if strip is None else strip
     m = NAFION_LI if material is None else material
     Rs = m.sheet_resistance if sheet_resistance is None else sheet_resistance
     Rs = check_finite("sheet_resistance", Rs, "a finite number >= 0 Ohm/sq")
     if Rs < 0.0:
         raise ValueError(f"sheet_resistance must be a finite number >= 0 Ohm/sq; got {sheet_resistance!r}")
-    u = frequency_response(f, strip=s, model=model, material=m, method=method)
+    u = frequency_response(f, strip=s, model=model, material=m, method=method, voltage=voltage)
     L = s.length
-    g = groups.line_propagation(L, Rs, u.Z_area)
-    fz, fth, fw = line_factors(g)
-    Z = u.Z * fz
-    Hw = u.H_w * fw
-    # H_w^u = -L^2 H_M/(2 E I_p): the moment per volt of the uniform strip's own transfer
-    HM = -2.0 * m.E * s.I_p * u.H_w / (L * L)
-    Hth = 2.0 * u.H_w / L * fth
+    Z, Hw, Hth, HF, HM, g, be = _line(u, s, m, Rs, "quasi-static" if Rs == 0.0 else beam, viscous_modulus, n_modes)
+    if Rs == 0.0 and beam == "dynamic":
+        # ideal electrodes: exactly the uniform strip's modal response (no quadrature)
+        d = frequency_response(f, strip=s, model=model, material=m, method=method, voltage=voltage, beam=beam,
+                               viscous_modulus=viscous_modulus, n_modes=n_modes)
+        Hw, Hth, HF = d.H_w, d.H_theta, d.H_F
+    err = None
+    if u.error is not None:
+        # the circuit's error of the line itself: against the same line on the linearised PNP's Z_area
+        ref = _line(frequency_response(f, strip=s, model=model, material=m), s, m, Rs, "quasi-static",
+                    viscous_modulus, n_modes)
+        err = np.maximum(np.abs(Z - ref[0]) / np.abs(ref[0]),
+                         np.abs(u.H_w * line_factors(g)[2] - ref[1]) / np.abs(ref[1]))
     prof = None
     xs = None
     if x is not None:
@@ -264,12 +373,21 @@ def line_response(f, *, strip: Strip | None = None, model="constant", material: 
         if xs.size * g.size > MAX_PROFILE_POINTS:
             raise ValueError(f"x: {xs.size} positions x {g.size} frequencies exceed {MAX_PROFILE_POINTS} profile values")
         prof = voltage_profile(g[:, None], xs[None, :] / L)
-    notes = list(u.notes) + [
+    notes = dynamic_notes(beam, viscous_modulus) + list(u.notes[len(dynamic_notes()):]) + [
         f"electrodes: sheet resistance R_s = {Rs:g} Ohm/sq each, in series along the length (r = 2 R_s/(2l)); "
         "the voltage decays along x as an RC line driven at the clamp; the moment follows the local voltage "
-        "(small displacements, quasi-static beam)",
+        + ("(small displacements, quasi-static beam)" if beam == "quasi-static" else
+           "and drives the modes through int M(x) phi_n''(x) dx (small displacements)"),
         SHEET_RESISTANCE_SOURCE,
     ]
+    if err is not None:
+        notes.append("circuit: 'error' is the relative error of the line's Z and H_w against the same line on the "
+                     "linearised PNP (computed at each frequency)")
+    if beam == "dynamic":
+        notes.append(f"dynamic beam: 'beam_error' bounds the modal quadrature and truncation (largest "
+                     f"{float(np.max(be)) if be.size else 0.0:.2g} relative)")
     return LineResult(f=u.f, Z=Z, Z_area=u.Z_area, H_w=Hw, w_amp=np.abs(Hw), w_phase=np.angle(Hw), H_theta=Hth,
                       H_M=HM, gamma_L=g, Z0=u.Z * g, sheet_resistance=Rs, length=L, tau=u.tau, method=u.method,
-                      model=u.model, notes=notes, uniform=u, x=xs, V_profile=prof)
+                      model=u.model, notes=notes, uniform=u, x=xs, V_profile=prof, H_F=HF, error=err,
+                      error_max=float(np.max(err)) if err is not None and err.size else math.nan, f_d=u.f_d,
+                      resonances=u.resonances, beam=beam, voltage=u.voltage, beam_error=be)

@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ipmc_asym.dynamics.circuit import frequency_response
+from ipmc_asym.dynamics.line import line_response
 from ipmc_asym.model.params import NAFION_LI, Material, Strip
 
 __all__ = ["RationalModel", "transfer_function", "vector_fit", "OUTPUTS", "MAX_ORDER"]
@@ -187,7 +188,10 @@ def transfer_function(f_min, f_max, *, strip: Strip | None = None, model="consta
         Log-spaced fit frequencies (the check grid has four times as many), 20-5000.
     **response_kw
         Passed to :func:`~ipmc_asym.dynamics.circuit.frequency_response` (``beam="dynamic"``,
-        ``viscous_modulus``, ``voltage``): the fit is of that response.  An undamped dynamic
+        ``viscous_modulus``, ``voltage``): the fit is of that response.  With ``sheet_resistance``
+        (Ohm/sq) the full model is the electrode line :func:`ipmc_asym.dynamics.line.line_response`
+        (``Z = Z_u g coth g`` is not rational: the order rises until the band meets ``tol``, and the
+        error on the check grid is stated as for the uniform strip).  An undamped dynamic
         beam has its resonances on the imaginary axis; give a viscous modulus for a fit across them.
 
     Returns
@@ -218,7 +222,11 @@ def transfer_function(f_min, f_max, *, strip: Strip | None = None, model="consta
     m = NAFION_LI if material is None else material
 
     def full(f):
-        r = frequency_response(f, strip=s_, model=model, material=m, method=method, **response_kw)
+        if response_kw.get("sheet_resistance") is not None:
+            r = line_response(f, strip=s_, model=model, material=m, method=method, **response_kw)
+        else:
+            kw = {k: v for k, v in response_kw.items() if k != "sheet_resistance"}
+            r = frequency_response(f, strip=s_, model=model, material=m, method=method, **kw)
         if output in ("charge", "current"):
             # fitted as the charge per volt Q = Y/s: the current I = s Q has a zero at s = 0 that
             # a relative fit of Y itself cannot pin

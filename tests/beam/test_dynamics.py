@@ -267,3 +267,43 @@ def test_first_resonance_vectorised_equals_the_modal_beam():
     EIp = NAFION_LI.E * second_moment(5e-3, 200e-6)
     rhoA = hydrated_density(NAFION_LI) * 5e-3 * 200e-6
     np.testing.assert_allclose(f, 1.8751040687**2 / (2 * np.pi * L**2) * np.sqrt(EIp / rhoA), rtol=1e-9)
+
+
+@pytest.mark.parametrize("support", ["clamped-free", "clamped-pinned"])
+def test_moment_kernels_of_a_uniform_moment_are_the_closed_form_statics(support):
+    # int kappa_1 dx and int kappa_2 dx over [0, L] against _static_small and _second_static, whose
+    # polynomials are built independently (the uniform moment's static deflection integrated)
+    from ipmc_asym.beam.dynamics import _second_static, _static_small, moment_kernels
+
+    b = Beam.from_strip(0.02, 5e-3, 200e-6, NAFION_LI, 2e3)
+    ker = moment_kernels(support, b)
+    w, th, F = _static_small(support, b)
+    w2, dw2, _, d3w2 = _second_static(support, b)
+    exact = ({"w": (w, w2), "theta": (th, dw2)} if support == "clamped-free"
+             else {"F": (F, -b.EI * d3w2), "theta": (th, dw2)})
+    for name, (k1, k2) in ker.items():
+        i1, i2 = k1.integ(1), k2.integ(1)
+        assert (i1(1) - i1(0)) * b.length == pytest.approx(exact[name][0], rel=1e-13)
+        assert (i2(1) - i2(0)) * b.length == pytest.approx(exact[name][1], rel=1e-13)
+    with pytest.raises(ValueError, match="distributed moment"):
+        moment_kernels("clamped-clamped", b)
+
+
+@pytest.mark.parametrize("support", ["clamped-free", "clamped-pinned"])
+def test_distributed_transfer_of_a_uniform_moment_is_the_modal_transfer(support):
+    from ipmc_asym.beam.dynamics import distributed_transfer
+
+    b = Beam.from_strip(0.02, 5e-3, 200e-6, NAFION_LI, 2e3)
+    f = np.array([0.0, 1.0, 22.0, 141.0, 400.0])
+    xg, wg = np.polynomial.legendre.leggauss(40)
+    edges = np.linspace(0.0, b.length, 41)
+    x = (0.5 * np.diff(edges)[:, None] * np.asarray(xg)[None, :] + 0.5 * (edges[1:] + edges[:-1])[:, None]).ravel()
+    wt = (0.5 * np.diff(edges)[:, None] * np.asarray(wg)[None, :]).ravel()
+
+    def integrate(c):  # M_a = 1 N m on [0, L]
+        return np.tile(c(x) @ wt, (f.size, 1)).astype(complex)
+
+    d = distributed_transfer(f, b, support, integrate)
+    t = transfer(f, b, support)
+    for k in ("w", "theta") if support == "clamped-free" else ("F", "theta"):
+        assert np.max(np.abs(d[k] / t[k] - 1)) < 1e-11, k

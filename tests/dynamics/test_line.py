@@ -9,6 +9,7 @@ import pytest
 import sympy as sp
 
 from derivations import line as DL
+from ipmc_asym.beam.dynamics import Beam, viscous_modulus_from_damping_ratio
 from ipmc_asym.cli import main
 from ipmc_asym.dynamics.circuit import frequency_response
 from ipmc_asym.dynamics.line import line_factors, line_response, moment_modal_integral, voltage_profile
@@ -17,7 +18,7 @@ from ipmc_asym.model.params import NAFION_LI, Strip
 F = np.geomspace(1e-3, 1e5, 25)
 
 
-def ladder(f, strip, Rs, N, method="pnp-linear", model="constant"):
+def ladder(f, strip, Rs, N, method="pnp-linear", model="constant", voltage=0.0):
     """Discretised line: N segments of series r h between nodes x_j = j h, shunt y h at the interior
     nodes and y h/2 at the two ends (second order in h), V(0) = 1.  Returns (Z_in, H_w, H_theta, V).
 
@@ -25,7 +26,7 @@ def ladder(f, strip, Rs, N, method="pnp-linear", model="constant"):
     area of the uniform strip is the input); the tip deflection and rotation are trapezoidal sums of
     the beam's -(L - x) M/(E I_p) and -M/(E I_p) with M = H_M V, H_M = -2 E I_p H_w^u/L^2.
     """
-    u = frequency_response(f, strip=strip, model=model, method=method)
+    u = frequency_response(f, strip=strip, model=model, method=method, voltage=voltage)
     L, w2 = strip.length, strip.width
     r = 2.0 * Rs / w2
     y = w2 / u.Z_area
@@ -86,6 +87,111 @@ def test_against_discretised_ladder(Rs, method):
     # the profile at the nodes of the 1000-segment ladder (second order: |g h|^2 / 24)
     vr = (4 * v2[::2] - v1) / 3
     assert np.max(np.abs(r.V_profile - vr.T)) <= 1e-6
+
+
+def _psi(f, beam, x, load):
+    """Exact harmonic response of the damped strip (no modes) to a unit tip force or couple:
+    ``(psi''(x), psi(L))``.  ``EI (1 + s tau_v) d4psi/dx4 = -s^2 rho A psi``, clamp at 0; at the tip
+    ``EI k psi'' = 0, EI k psi''' = -1`` (force) or ``EI k psi'' = 1, psi''' = 0`` (couple).  By the
+    symmetry of the beam's bilinear form the tip output of a distributed moment is
+    ``-int M psi'' dx``, and the blocked tip force ``-w_free(L)/psi(L)`` (tip force)."""
+    L = beam.length
+    s = 2j * np.pi * np.asarray(f, float)
+    EIk = beam.EI * (1 + s * beam.tau_v)
+    beta = (-(s * s) * beam.rhoA / EIk) ** 0.25
+    d2 = np.empty((f.size, x.size), complex)
+    tip = np.empty(f.size, complex)
+    for i, b in enumerate(beta):
+        ch, sh, c, sn = np.cosh(b * L), np.sinh(b * L), np.cos(b * L), np.sin(b * L)
+        # psi = A (cosh - cos) + B (sinh - sin) meets the clamp
+        M = np.array([[ch + c, sh + sn], [sh - sn, ch + c]]) * np.array([[b**2], [b**3]])
+        rhs = np.array([0.0, -1.0 / EIk[i]]) if load == "force" else np.array([1.0 / EIk[i], 0.0])
+        A, B = np.linalg.solve(M, rhs)
+        d2[i] = b**2 * (A * (np.cosh(b * x) + np.cos(b * x)) + B * (np.sinh(b * x) + np.sin(b * x)))
+        tip[i] = A * (ch - c) + B * (sh - sn)
+    return d2, tip
+
+
+def ladder_dynamic(f, strip, Rs, N, eta, **kw):
+    """The N-segment ladder's node voltages driving the exact (non-modal) damped beam: trapezoidal
+    sums of the moment against the tip force's and couple's curvature (even in h).  Returns
+    (Z_in, H_w, H_theta, H_F)."""
+    u = frequency_response(f, strip=strip, **kw)
+    z, _, _, V = ladder(f, strip, Rs, N, **kw)
+    beam = Beam.from_strip(strip.length, strip.width, strip.thickness, NAFION_LI, eta)
+    x = np.linspace(0.0, strip.length, N + 1)
+    wt = np.full(N + 1, strip.length / N)
+    wt[[0, -1]] *= 0.5
+    M = (-2.0 * beam.EI * u.H_w / strip.length**2)[:, None] * V.T
+    pf, tipf = _psi(f, beam, x, "force")
+    pc, _ = _psi(f, beam, x, "couple")
+    Hw = -np.sum(M * pf * wt, axis=1)
+    return z, Hw, -np.sum(M * pc * wt, axis=1), -Hw / tipf
+
+
+@pytest.mark.parametrize("Rs", [2.5, 25.0])
+def test_dynamic_beam_against_the_discretised_line_and_an_exact_beam(Rs):
+    s = Strip()
+    eta = viscous_modulus_from_damping_ratio(0.02, 22.5, NAFION_LI.E)  # 2 % of critical at the first mode
+    # below the third free-tip resonance (396 Hz), through the first two and the first blocked one
+    f = np.concatenate([np.geomspace(0.1, 350.0, 12), [22.0, 23.0, 98.0, 141.0]])
+    r = line_response(f, strip=s, sheet_resistance=Rs, beam="dynamic", viscous_modulus=eta)
+    a, b = ladder_dynamic(f, s, Rs, 1000, eta), ladder_dynamic(f, s, Rs, 2000, eta)
+    ref = [(4 * y - x) / 3 for x, y in zip(a, b)]  # Richardson 1000/2000 (both sums even in h)
+    for got, want in zip((r.Z, r.H_w, r.H_theta, r.H_F), ref):
+        assert np.max(rel(got, want)) <= 1e-6
+    # the stated error of the modal quadrature and truncation is small and not exceeded
+    assert np.max(r.beam_error) < 1e-6
+    # resonances: the free tip peaks near 22.5 Hz (more than the quasi-static line there)
+    q = line_response(f, strip=s, sheet_resistance=Rs)
+    assert abs(r.H_w[12]) > 5 * abs(q.H_w[12])
+    assert r.resonances["clamped-free"][0] == pytest.approx(22.546, rel=1e-3)
+
+
+@pytest.mark.parametrize("bias", [0.5, -0.3])
+def test_biased_line_against_the_discretised_line(bias):
+    # the shunt admittance about the biased static state (circuit: R, C_d(V), C_g) along the ladder
+    s = Strip()
+    r = line_response(F, strip=s, sheet_resistance=2.5, method="circuit", voltage=bias)
+    z1, w1, t1, _ = ladder(F, s, 2.5, 1000, "circuit", voltage=bias)
+    z2, w2, t2, _ = ladder(F, s, 2.5, 2000, "circuit", voltage=bias)
+    assert np.max(rel(r.Z, (4 * z2 - z1) / 3)) <= 1e-6
+    assert np.max(rel(r.H_w, (4 * w2 - w1) / 3)) <= 1e-6
+    assert r.voltage == bias and r.error is None
+    u = frequency_response(F, strip=s, method="circuit", voltage=bias)
+    assert np.array_equal(r.Z_area, u.Z_area)
+    # the bias changes the line (C_d(V) > C_d(0): slower); 0 Ohm/sq is the biased uniform strip
+    assert np.max(rel(r.Z, line_response(F, strip=s, sheet_resistance=2.5, method="circuit").Z)) > 1e-2
+    r0 = line_response(F, strip=s, sheet_resistance=0.0, method="circuit", voltage=bias)
+    assert np.array_equal(r0.Z, u.Z) and np.array_equal(r0.H_w, u.H_w)
+    with pytest.raises(ValueError, match="method 'circuit'"):
+        line_response(F, sheet_resistance=2.5, voltage=0.5)
+
+
+def test_circuit_line_error_is_the_deviation_from_the_pnp_line():
+    r = line_response(F, sheet_resistance=2.5, method="circuit")
+    p = line_response(F, sheet_resistance=2.5)
+    dev = np.maximum(rel(r.Z, p.Z), rel(r.H_w, p.H_w))
+    assert np.allclose(r.error, dev, rtol=1e-12, atol=0) and r.error_max == np.max(dev)
+    assert p.error is None and np.isnan(p.error_max)
+
+
+def test_zero_sheet_resistance_dynamic_is_the_uniform_modal_strip_exactly():
+    eta = 3e3
+    u = frequency_response(F, beam="dynamic", viscous_modulus=eta)
+    r = line_response(F, sheet_resistance=0.0, beam="dynamic", viscous_modulus=eta)
+    for a, b in ((r.Z, u.Z), (r.H_w, u.H_w), (r.H_theta, u.H_theta), (r.H_F, u.H_F)):
+        assert np.array_equal(a, b)
+    # a vanishing sheet resistance through the distributed moment's quadrature: the same within the
+    # stated beam_error (far above the resonances the modal sums cancel the statics: it grows there)
+    t = line_response(F, sheet_resistance=1e-14, beam="dynamic", viscous_modulus=eta)
+    low = F < 1e3
+    for a, b in ((t.H_w, u.H_w), (t.H_theta, u.H_theta), (t.H_F, u.H_F)):
+        assert np.all(rel(a, b) <= t.beam_error)
+        assert np.max(rel(a, b)[low]) < 1e-9
+    # the quasi-static line's blocked-tip force: 3 int (L - x) M dx/L^3, i.e. 1.5 H_M/L uniform
+    q = line_response(F, sheet_resistance=0.0)
+    assert np.allclose(q.H_F, frequency_response(F).H_F, rtol=1e-14, atol=0)
 
 
 def test_zero_sheet_resistance_is_the_uniform_strip_exactly():
@@ -214,3 +320,38 @@ def test_cli_sheet_resistance(capsys):
             main(["freq", "--from", "1Hz", "--to", "2Hz", "--sheet-resistance", bad])
         assert e.value.code == 2
         assert "--sheet-resistance" in capsys.readouterr().err
+
+
+def test_cli_sheet_resistance_with_the_dynamic_beam_a_bias_and_an_export(capsys, tmp_path):
+    f = np.geomspace(0.1, 1e3, 6)
+    base = ["freq", "--from", "0.1Hz", "--to", "1kHz", "--points", "6", "--sheet-resistance", "2.5ohm/sq", "--json"]
+    assert main(base + ["--viscous-modulus", "2e3"]) == 0  # --beam dynamic is freq's default
+    out = json.loads(capsys.readouterr().out)
+    r = line_response(f, sheet_resistance=2.5, beam="dynamic", viscous_modulus=2e3)
+    assert out["beam"] == "dynamic" and out["resonances"]["clamped-free"] == r.resonances["clamped-free"]
+    assert np.allclose(out["w_amp"], r.w_amp, rtol=1e-15) and np.allclose(out["F_amp"], np.abs(r.H_F), rtol=1e-15)
+    assert 0.0 <= out["beam_error_max"] < 1e-6
+    # with a DC bias (circuit): the small-signal line about the biased static state
+    assert main(base + ["--method", "circuit", "--voltage", "0.4V", "--beam", "quasi-static"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    r = line_response(f, sheet_resistance=2.5, method="circuit", voltage=0.4)
+    assert np.allclose(out["Z_re"], r.Z.real, rtol=1e-15) and out["voltage"] == 0.4 and "error" not in out
+    # the reduced-order model of the line, its stated error measured here against the full line
+    path = tmp_path / "tf.json"
+    assert main(base + ["--viscous-modulus", "2e3", "--export", str(path), "--export-tol", "1e-3"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    doc = json.loads(path.read_text())
+    m = doc["models"]["w"]
+    fc = np.geomspace(0.1, 1e3, 301)
+    fit = m["d"] + np.sum(np.array([complex(*p) for p in m["residues"]])
+                          / (2j * np.pi * fc[:, None] - np.array([complex(*p) for p in m["poles"]])), axis=1)
+    full = line_response(fc, sheet_resistance=2.5, beam="dynamic", viscous_modulus=2e3).H_w
+    assert np.max(rel(fit, full)) <= 1.5 * m["max_rel_error"] and m["max_rel_error"] <= 1e-3
+    assert "order" in out["export"]["w"]
+    # 0 Ohm/sq is the uniform strip's response, value for value, with the modal beam too
+    plain = ["freq", "--from", "0.1Hz", "--to", "1kHz", "--points", "6", "--viscous-modulus", "2e3", "--json"]
+    assert main(plain) == 0
+    a = json.loads(capsys.readouterr().out)
+    assert main(plain + ["--sheet-resistance", "0"]) == 0
+    b = json.loads(capsys.readouterr().out)
+    assert all(a[k] == b[k] for k in ("Z_re", "Z_im", "w_amp", "w_phase", "theta_amp", "F_amp", "F_phase"))
