@@ -26,7 +26,8 @@ def hashed_sources() -> list:
     here = Path(__file__).resolve().parents[1]
     return sorted([here / "base" / "settings.py", *(here / "kernels").glob("*.py"),
                    *(here / "integral").glob("*.py"), here / "dynamics" / "electrode.py",
-                   here / "dynamics" / "circuit.py", here / "io" / "textfmt.py", here / "beam" / "dynamics.py"])
+                   here / "dynamics" / "circuit.py", here / "dynamics" / "line_time.py", here / "io" / "textfmt.py",
+                   here / "beam" / "dynamics.py"])
 
 
 def _cache_dir() -> str:
