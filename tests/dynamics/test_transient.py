@@ -101,9 +101,9 @@ def test_tolerance_refused_beyond_the_cell_cap():
         step_response(1.0, TAU, fidelity="pnp", points=3, pnp_options={"tol": 1e-9, "max_cells": 3000})
 
 
-@pytest.mark.parametrize("model,V", [("constant", 1.0), ("affine", -0.5)])
+@pytest.mark.parametrize("model,V", [("constant", 1.0), ("affine", -0.5), ("linear", 1.0), ("linear", -0.3)])
 def test_analytic_jacobian_against_finite_differences(model, V):
-    from ipmc_asym.dynamics.transient import _Problem, make_fv_mesh
+    from ipmc_asym.dynamics.transient import _LinearProblem, _Problem, make_fv_mesh
     from ipmc_asym.model import groups
 
     perm = MODELS[model]
@@ -111,7 +111,7 @@ def test_analytic_jacobian_against_finite_differences(model, V):
     rho = perm.eps0 / perm.eps_moy
     psi0 = V / float(groups.thermal_voltage(NAFION_LI))
     X = make_fv_mesh(lam, abs(psi0), rho, cells_per_debye=1.0)
-    P = _Problem(X, lam, rho, lambda t: psi0, 0.0)
+    P = (_LinearProblem if rho == 0.0 else _Problem)(X, lam, rho, lambda t: psi0, 0.0)
     S = 1e-4 * np.cumsum(np.random.default_rng(1).normal(size=P.N - 1))
     lo, di, up, u, v = P.jacobian(S, 0.0)
     J = np.diag(di) + np.diag(lo, -1) + np.diag(up, 1) + np.outer(u, v)
@@ -204,9 +204,56 @@ def test_small_signal_against_a_small_sine_in_the_pnp_solver():
         assert abs(Z_pnp / Z_cir - 1) < 3e-2
 
 
-def test_linear_model_refused_by_the_pnp_solver():
-    with pytest.raises(ValueError, match="linear"):
-        solve_transient(np.array([0.0, TAU]), waveform("step", 1.0), S0, "linear", NAFION_LI)
+@pytest.mark.parametrize("V,thickness", [(1.0, 200e-6), (-1.0, 200e-6), (0.05, 200e-6), (-0.05, 200e-6),
+                                         (1.0, 20e-6), (-1.0, 1e-3)])
+def test_linear_model_long_time_limit_is_the_exact_static_charge(V, thickness):
+    """Linear model (eps -> 0 at the anode, E ~ e^{A2} there): the relaxed charge equals the exact static
+    charge within the run's own estimate, at the default tolerance, both signs, thin to thick strips."""
+    s = Strip(thickness=thickness)
+    tau = float(time_constant(thickness, "linear"))
+    r = solve_transient(np.array([0.0, tau, 30 * tau]), waveform("step", V), s, "linear", NAFION_LI)
+    assert r.success, r.message
+    ref = float(charge(thickness, V, "linear", "exact").sigma)
+    assert abs(r.sigma[-1] - ref) <= r.sigma_error[-1] <= 1e-6 * abs(ref)
+    # at t = 0+ only the bulk's displacement charge C_g phi0 (C_g = eps_core/(2e))
+    assert r.sigma[0] == pytest.approx(MODELS["linear"].eps_moy / thickness * V, rel=1e-12)
+    if thickness == S0.thickness:
+        Ms = quasi_static_mechanics(np.array([V]), s, MODELS["linear"], NAFION_LI)[0][0]
+        assert r.M_A_profiles[-1] == pytest.approx(Ms, rel=1e-5)
+
+
+def test_linear_model_far_beyond_the_representable_anode_field():
+    """20 V: the anode concentration e^{-A2} ~ e^{-778} underflows (E would overflow); the charge is the
+    saturation charge of the exact static solution, and the layer voltage V(sigma) is withheld there."""
+    tau = float(time_constant(S0.thickness, "linear"))
+    r = solve_transient(np.array([0.0, 0.1 * tau, 30 * tau]), waveform("step", -20.0), S0, "linear", NAFION_LI)
+    assert r.success, r.message
+    ref = float(charge(S0.thickness, -20.0, "linear", "exact").sigma)
+    assert abs(r.sigma[-1] - ref) <= r.sigma_error[-1] <= 1e-6 * abs(ref)
+    assert np.all(np.isfinite(r.sigma)) and np.isnan(r.layer_voltage[-1])
+
+
+def test_linear_model_second_order_mesh_convergence():
+    """Whole-mesh refinement by 2: the long-time charge converges at second order to the exact static
+    charge (an independent solution)."""
+    tau = float(time_constant(S0.thickness, "linear"))
+    ref = float(charge(S0.thickness, 0.05, "linear", "exact").sigma)
+    e = [abs(solve_transient(np.array([0.0, 30 * tau]), waveform("step", 0.05), S0, "linear", NAFION_LI, tol=None,
+                             refine=rf, moment=False).sigma[-1] / ref - 1) for rf in (1, 2, 4)]
+    assert 3.0 < e[0] / e[1] < 4.5 and 3.5 < e[1] / e[2] < 4.5
+
+
+@pytest.mark.parametrize("V", [1.0, -0.05])
+def test_linear_model_tolerance_run_agrees_with_a_twice_refined_run(V):
+    """A run at the default tolerance agrees with one started on a twice finer mesh within the sum of
+    their stated estimates at every output time (0.01 tau to 5 tau)."""
+    tau = float(time_constant(S0.thickness, "linear"))
+    t = tau * np.array([0.0, 0.01, 0.1, 1.0, 5.0])
+    a = solve_transient(t, waveform("step", V), S0, "linear", NAFION_LI, moment=False)
+    b = solve_transient(t, waveform("step", V), S0, "linear", NAFION_LI, moment=False, refine=2.0)
+    assert a.success and b.success
+    assert np.all(np.abs(a.sigma - b.sigma) <= a.sigma_error + b.sigma_error)
+    assert np.max(a.sigma_error) <= 1e-6 * np.max(np.abs(a.sigma))
 
 
 def test_charge_claims_rows_follow_their_criteria():
@@ -260,15 +307,19 @@ def test_step_tol_escalates_a_thin_affine_strip_at_2V():
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("model", ["constant", "affine"])
+@pytest.mark.parametrize("model", ["constant", "linear", "affine"])
 @pytest.mark.parametrize("V", [0.05, 1.0, 5.0])
 @pytest.mark.parametrize("thickness", [20e-6, 200e-6, 1e-3])
 def test_step_tol_grid(model, V, thickness):
     _ladder_case(model, V, thickness, 1e-2)
 
 
-def test_step_tol_refused_for_the_linear_model():
-    with pytest.raises(ValueError, match="linear"):
-        step_response(1.0, TAU, model="linear", points=3, tol=1e-2)
+def test_step_tol_bounds_the_circuit_for_the_linear_model():
+    """The circuit's stated error (against the PNP rung) holds for the linear model too."""
+    _ladder_case("linear", -1.0, 20e-6, 1e-2)
+    _ladder_case("linear", 0.05, S0.thickness, 1e-2)
+
+
+def test_step_tol_refused_out_of_range():
     with pytest.raises(ValueError, match="tol"):
         step_response(1.0, TAU, points=3, tol=0.7)
