@@ -305,14 +305,45 @@ class _Problem:
 
 def _int_x_over_linear(H, ln_c0, c1):
     """``int_0^H x/c(x) dx`` for ``c`` linear from ``exp(ln_c0)`` at 0 to ``c1`` at ``H`` (``c0`` in log
-    form: it may be below the smallest double)."""
-    c0 = math.exp(ln_c0)
+    form: it may be below the smallest double); vectorised over ``ln_c0``, ``c1``."""
+    ln_c0 = np.asarray(ln_c0, dtype=float)
+    c1 = np.asarray(c1, dtype=float)
+    c0 = np.exp(ln_c0)
     s = (c1 - c0) / H
-    z = s * H / c0 if c0 > 0.0 else math.inf
-    if abs(z) < 1e-3:
-        # (H^2/c0) (z - ln(1 + z))/z^2, series
-        return H * H / c0 * (0.5 - z / 3.0 + z * z / 4.0 - z**3 / 5.0)
-    return H / s - c0 / (s * s) * (math.log(c1) - ln_c0)
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        z = np.where(c0 > 0.0, s * H / c0, np.inf)
+        # (H^2/c0) (z - ln(1 + z))/z^2: its series for small z, else H/s - (c0/s^2) ln(c1/c0)
+        series = H * H / c0 * (0.5 - z / 3.0 + z * z / 4.0 - z**3 / 5.0)
+        closed = H / s - c0 / (s * s) * (np.log(c1) - ln_c0)
+    return np.where(np.abs(z) < 1e-3, series, closed)
+
+
+def _newton_delta(a_L, a_R, GL, GR, W, I0, p0, x):
+    """Root ``delta`` of ``F = d_0(delta) - (delta + psi0 - I0)/W`` (decreasing), scalars; see
+    :meth:`_LinearProblem.solve_d0` (the same iteration on arrays)."""
+    lo, hi = -math.inf, math.inf
+    for _ in range(200):
+        ex = math.exp(-abs(x))
+        if x > 0.0:
+            den = GL * ex + GR
+            d0 = (a_L * ex - a_R) / den
+        else:
+            den = GL + GR * ex
+            d0 = (a_L - a_R * ex) / den
+        dd = -(a_R * GL + a_L * GR) * ex / (den * den)
+        F = d0 - (x + p0 - I0) / W
+        if F > 0.0:
+            lo = x
+        else:
+            hi = x
+        xn = x - F / (dd - 1.0 / W)
+        if not lo < xn < hi:
+            step = 2.0 * (1.0 + abs(x))
+            xn = x + step if math.isinf(hi) else x - step if math.isinf(lo) else 0.5 * (lo + hi)
+        if abs(xn - x) <= 1e-14 * (1.0 + abs(x)):
+            return xn
+        x = xn
+    return x
 
 
 class _LinearProblem(_Problem):
@@ -326,11 +357,12 @@ class _LinearProblem(_Problem):
 
         psi0 = ln(c_R/c_L) + int_{-1}^{1} N/c dx
 
-    with the face concentrations ``c_L``, ``c_R`` carried as logarithms: each is the quadratic
-    through the two cell averages next to its face with the face slope ``dc/dx = d_0/lambda^2``
-    (``N = 0``), ``c_L = a_L - g_L d_0``, ``c_R = a_R + g_R d_0``; the unknown solved for is
-    ``delta = ln(c_L/c_R)`` (monotone scalar equation, Newton with a bracket), from which ``d_0``
-    follows without cancellation (:meth:`solve_d0`).  ``int N/c``: midpoint rule per cell.
+    with the face concentrations ``c_L``, ``c_R`` carried as logarithms: each is the polynomial of
+    degree ``FACE_CELLS`` through the means of the ``FACE_CELLS`` cells next to its face with the
+    face slope ``dc/dx = d_0/lambda^2`` (``N = 0``), ``c_L = a_L - G_L d_0``, ``c_R = a_R + G_R d_0``;
+    the unknown solved for is ``delta = ln(c_L/c_R)`` (a monotone scalar equation, Newton inside a
+    bracket), from which ``d_0`` follows without cancellation (:meth:`solve_d0`).  ``int N/c``:
+    midpoint rule per cell.  The methods take one state ``S`` (n,) or a stack (m, n).
     """
 
     def __init__(self, X, lam, rho, psi0_fun, A3):
@@ -339,84 +371,144 @@ class _LinearProblem(_Problem):
 
         def face_coefs(hs):
             # c(x) = c_face + g x + sum_p a_p x^p (x inward, p = 2..K) through the means of the K
-            # cells next to the face: c_face = w . means - gamma g
+            # cells next to the face: c_face = w . (means - g mean(x))
             edges = np.concatenate(([0.0], np.cumsum(hs)))
             K = len(hs)
             mom = np.array([[(edges[j + 1] ** (p + 1) - edges[j] ** (p + 1)) / ((p + 1) * hs[j]) for p in range(K + 1)]
                             for j in range(K)])  # mean of x^p over cell j
             A = np.column_stack((mom[:, 0], mom[:, 2:]))
-            w = np.linalg.solve(A.T, np.eye(K)[0])  # c_face = w . (means - g mean(x))
+            w = np.linalg.solve(A.T, np.eye(K)[0])
             return w, float(np.dot(w, mom[:, 1]))
 
-        self.aL = face_coefs(h[:FACE_CELLS])
-        self.aR = face_coefs(h[::-1][:FACE_CELLS])
-        self._delta = 0.0  # last root (Newton's start)
+        (self.wL, gl), (self.wR, gr) = face_coefs(h[:FACE_CELLS]), face_coefs(h[::-1][:FACE_CELLS])
+        # c_L = a_L - GL d_0, c_R = a_R + GR d_0 (face slope dc/dx = d_0/lambda^2, N = 0)
+        self.GL, self.GR = gl / self.lam2, gr / self.lam2
+        # the flux is linear: its tridiagonal derivative at fixed d_0 is constant
+        hl, hr, dl = h[:-1], h[1:], self.delta
+        self.T = (-1.0 / (dl[1:] * hl[1:]), 1.0 / (dl * hl) + 1.0 / (dl * hr) + 1.0 / self.lam2,
+                  -1.0 / (dl[:-1] * hr[:-1]))
+        # d a_L/dS, d a_R/dS: a_L = sum_j wL_j c_j, c_i = 1 + (S_{i+1} - S_i)/h_i (S index k = face k + 1)
+        n = self.N - 1
+        self.daL = np.zeros(n)
+        self.daR = np.zeros(n)
+        for j, (a, b) in enumerate(zip(self.wL, self.wR)):
+            self.daL[j] += a / h[j]
+            self.daR[n - j - 1] -= b / h[-1 - j]
+            if j:
+                self.daL[j - 1] -= a / h[j]
+                self.daR[n - j] += b / h[-1 - j]
+        self._delta = 0.0  # last root (Newton's start for one state)
+
+    def unpack(self, S):
+        S = np.asarray(S, dtype=float)
+        Sf = np.zeros(S.shape[:-1] + (self.N + 1,))
+        Sf[..., 1:-1] = S
+        c = 1.0 + np.diff(Sf, axis=-1) / self.h
+        return Sf, c
 
     def _parts(self, S):
         Sf, c = self.unpack(S)
-        lam2 = self.lam2
-        Nhat = -(c[1:] - c[:-1]) / self.delta + Sf[1:-1] / lam2  # flux at d_0 = 0
-        w = 0.5 * (self.h[:-1] / c[:-1] + self.h[1:] / c[1:])  # int N/c = sum_f N_f w_f
-        (wl, gl), (wr, gr) = self.aL, self.aR
-        K = wl.size
-        a_L = float(np.dot(wl, c[:K]))
-        a_R = float(np.dot(wr, c[::-1][:K]))
-        # c_L = a_L - GL d_0, c_R = a_R + GR d_0 (face slope dc/dx = d_0/lambda^2, N = 0)
-        GL, GR = gl / lam2, gr / lam2
-        return Sf, c, Nhat, w, a_L, a_R, GL, GR
+        Nhat = -(c[..., 1:] - c[..., :-1]) / self.delta + Sf[..., 1:-1] / self.lam2  # flux at d_0 = 0
+        with np.errstate(divide="ignore"):
+            w = 0.5 * (self.h[:-1] / c[..., :-1] + self.h[1:] / c[..., 1:])  # int N/c = sum_f N_f w_f
+        K = self.wL.size
+        a_L = c[..., :K] @ self.wL
+        a_R = c[..., ::-1][..., :K] @ self.wR
+        return Sf, c, Nhat, w, a_L, a_R
+
+    def _d0_of(self, x, a_L, a_R):
+        """``d_0`` and ``dd_0/ddelta`` at ``delta = x`` (``c_L = c_R e^delta``; scaled by ``e^{-|x|}``)."""
+        GL, GR = self.GL, self.GR
+        ex = np.exp(-np.abs(x))
+        pos = x > 0.0
+        num = np.where(pos, a_L * ex - a_R, a_L - a_R * ex)
+        den = np.where(pos, GL * ex + GR, GL + GR * ex)
+        return num / den, -(a_R * GL + a_L * GR) * ex / (den * den)
 
     def solve_d0(self, S, t):
-        """``(d_0, ln c_L, ln c_R)`` from the voltage constraint (see the class notes)."""
-        Sf, c, Nhat, w, a_L, a_R, GL, GR = self._parts(S)
-        if not np.all(c > 0.0) or not a_L * GR + a_R * GL > 0.0:
-            return math.nan, math.nan, math.nan
-        W = float(np.sum(w)) / self.lam2
-        I0 = float(np.dot(Nhat, w))
-        p0 = self.psi0(t)
-
-        def d0_of(dl):
-            # c_L = c_R e^{dl}: d_0 = (a_L - a_R e^{dl})/(GL + GR e^{dl}) (scaled by e^{-dl} for dl > 0)
-            if dl <= 0.0:
-                x = math.exp(dl)
-                return (a_L - a_R * x) / (GL + GR * x), -(a_R * GL + a_L * GR) * x / (GL + GR * x) ** 2
-            x = math.exp(-dl)
-            return (a_L * x - a_R) / (GL * x + GR), -(a_R * GL + a_L * GR) * x / (GL * x + GR) ** 2
-
-        # F(dl) = d_0(dl) - (dl + psi0 - I0)/W is decreasing: Newton inside a bracket
-        lo, hi = -math.inf, math.inf
-        x = self._delta if math.isfinite(self._delta) else 0.0
-        for _ in range(200):
-            d0, dd = d0_of(x)
-            F = d0 - (x + p0 - I0) / W
-            if F > 0.0:
-                lo = x
-            else:
-                hi = x
-            xn = x - F / (dd - 1.0 / W)
-            if not lo < xn < hi:
-                if math.isinf(lo) or math.isinf(hi):
-                    step = 2.0 * (1.0 + abs(x))
-                    xn = x + step if math.isinf(hi) else x - step
-                else:
-                    xn = 0.5 * (lo + hi)
-            if abs(xn - x) <= 1e-14 * (1.0 + abs(x)):
-                x = xn
-                break
-            x = xn
-        self._delta = x
-        d0 = d0_of(x)[0]
-        if x <= 0.0:
-            lnR = math.log(a_R + GR * d0)
-            lnL = lnR + x
+        """``(d_0, ln c_L, ln c_R)`` from the voltage constraint (see the class notes); NaN where the
+        state has a non-positive cell concentration."""
+        S = np.asarray(S, dtype=float)
+        one = S.ndim == 1
+        S2 = np.atleast_2d(S)
+        Sf, c, Nhat, w, a_L, a_R = self._parts(S2)
+        p0 = np.broadcast_to(np.asarray([self.psi0(x) for x in np.atleast_1d(t)], dtype=float), a_L.shape)
+        ok = np.all(c > 0.0, axis=-1) & (a_L * self.GR + a_R * self.GL > 0.0)
+        W = np.sum(np.where(ok[:, None], w, 1.0), axis=-1) / self.lam2
+        I0 = np.sum(np.where(ok[:, None], Nhat * w, 0.0), axis=-1)
+        # F(delta) = d_0(delta) - (delta + psi0 - I0)/W is decreasing: Newton inside a bracket
+        if one:
+            # one state (the integrator's right-hand side): the same iteration in scalars (numpy's
+            # per-call overhead on 1-element arrays is ~10x the arithmetic)
+            x = np.array([_newton_delta(float(a_L[0]), float(a_R[0]), self.GL, self.GR, float(W[0]), float(I0[0]),
+                                        float(p0[0]), self._delta if math.isfinite(self._delta) else 0.0)
+                          if ok[0] else 0.0])
         else:
-            lnL = math.log(a_L - GL * d0)
-            lnR = lnL - x
+            x = np.zeros(a_L.shape)
+            lo = np.full(x.shape, -np.inf)
+            hi = np.full(x.shape, np.inf)
+        with np.errstate(all="ignore"):
+            for _ in range(0 if one else 200):
+                d0, dd = self._d0_of(x, a_L, a_R)
+                F = d0 - (x + p0 - I0) / W
+                lo = np.where(F > 0.0, x, lo)
+                hi = np.where(F > 0.0, hi, x)
+                xn = x - F / (dd - 1.0 / W)
+                step = 2.0 * (1.0 + np.abs(x))
+                alt = np.where(np.isinf(hi), x + step, np.where(np.isinf(lo), x - step, 0.5 * (lo + hi)))
+                xn = np.where((lo < xn) & (xn < hi), xn, alt)
+                done = ~ok | (np.abs(xn - x) <= 1e-14 * (1.0 + np.abs(x)))
+                x = np.where(ok, xn, 0.0)
+                if np.all(done):
+                    break
+            d0 = self._d0_of(x, a_L, a_R)[0]
+            lnR = np.where(x <= 0.0, np.log(a_R + self.GR * d0), 0.0)
+            lnL = np.where(x <= 0.0, lnR + x, np.log(a_L - self.GL * d0))
+            lnR = np.where(x <= 0.0, lnR, lnL - x)
+        d0, lnL, lnR = (np.where(ok, a, np.nan) for a in (d0, lnL, lnR))
+        if one:
+            self._delta = float(x[0])
+            return float(d0[0]), float(lnL[0]), float(lnR[0])
         return d0, lnL, lnR
 
+    def flux(self, c, d):
+        """Flux at the interior faces 1..N-1 (``d``: the induction at the faces 0..N)."""
+        return -(c[..., 1:] - c[..., :-1]) / self.delta + d[..., 1:-1] / self.lam2
+
+    def _border(self, S2, t):
+        """For states (m, n): ``(d_0, ln c_L, ln c_R, v = grad_S d_0, dd_0/dpsi0)`` (the tridiagonal part
+        ``T`` and ``u = dN/dd_0 = 1/lambda^2`` are constant)."""
+        Sf, c, Nhat, w, a_L, a_R = self._parts(S2)
+        d0, lnL, lnR = self.solve_d0(S2, t)
+        lam2 = self.lam2
+        lower, diag, upper = self.T
+        Nf = Nhat + d0[:, None] / lam2
+        # G = ln c_L - ln c_R - sum N_f w_f + psi0 = 0, scaled by m = min(c_L, c_R)
+        lm = np.minimum(lnL, lnR)
+        sL, sR, cm = np.exp(lm - lnL), np.exp(lm - lnR), np.exp(lm)
+        Gd = -self.GL * sL - self.GR * sR - cm * np.sum(w, axis=-1) / lam2
+        # sum_f w_f dN_f/dS_k (T^T w) and sum_f N_f dw_f/dS_k
+        Tw = diag * w
+        Tw[:, 1:] += upper * w[:, :-1]
+        Tw[:, :-1] += lower * w[:, 1:]
+        Nfull = np.zeros((Nf.shape[0], self.N + 1))
+        Nfull[:, 1:-1] = Nf
+        ec = -0.5 * self.h * (Nfull[:, :-1] + Nfull[:, 1:]) / (c * c)  # d(sum N w)/dc_i
+        dW = ec[:, :-1] / self.h[:-1] - ec[:, 1:] / self.h[1:]
+        GS = self.daL * sL[:, None] - self.daR * sR[:, None] - cm[:, None] * (Tw + dW)
+        v = -GS / Gd[:, None]
+        return d0, lnL, lnR, v, -cm / Gd  # G_psi0 = 1 (scaled: cm)
+
+    def jacobian(self, S, t):
+        """As :meth:`_Problem.jacobian`: ``J = -(T + u v^T)``, ``(lower, diag, upper, u, v)`` for ``-N``."""
+        v = self._border(S[None, :], t)[3][0]
+        lower, diag, upper = self.T
+        return -lower, -diag, -upper, np.full(self.N - 1, -1.0 / self.lam2), v
+
     def fields(self, S, t):
-        """(c, d at faces, r_f, dpsi at faces, psi at centres) as :meth:`_Problem.fields`; ``dpsi``
-        of the two boundary half cells from the log face concentrations (``ln(c_i/c_face)`` plus the
-        flux term), so it stays finite where ``E`` is not representable."""
+        """(c, d at faces, r_f, dpsi at faces, psi at centres) as :meth:`_Problem.fields`; ``psi`` from
+        ``mu = ln c + psi`` (``mu = psi0 + ln c_L`` at the face ``z = -e``, ``dmu/dx = -N/c``), so it
+        stays finite where ``E`` is not representable."""
         Sf, c = self.unpack(S)
         d0, lnL, lnR = self.solve_d0(S, t)
         d = d0 + Sf
@@ -424,9 +516,7 @@ class _LinearProblem(_Problem):
         r = np.empty(self.N + 1)
         r[0], r[-1] = half[0], half[-1]
         r[1:-1] = half[:-1] + half[1:]
-        Nf = self.flux(c, d)
-        Nfull = np.concatenate(([0.0], Nf, [0.0]))
-        # mu = ln c + psi, dmu/dx = -N/c: mu at the centres by the midpoint rule per half cell
+        Nfull = np.concatenate(([0.0], self.flux(c, d), [0.0]))
         q = 0.25 * self.h * (0.5 * (Nfull[:-1] + Nfull[1:]) + Nfull[:-1]) / c  # face f -> centre f
         qr = 0.25 * self.h * (0.5 * (Nfull[:-1] + Nfull[1:]) + Nfull[1:]) / c  # centre f -> face f+1
         mu = (self.psi0(t) + lnL) - np.cumsum(q) - np.concatenate(([0.0], np.cumsum(qr[:-1])))
@@ -437,74 +527,33 @@ class _LinearProblem(_Problem):
         dpsi[-1] = -psi[-1]
         return c, d, r, dpsi, psi
 
-    def flux(self, c, d):
-        """Flux at the interior faces 1..N-1 (``d``: the induction at the faces 0..N)."""
-        return -(c[1:] - c[:-1]) / self.delta + d[1:-1] / self.lam2
-
-    def _border(self, S, t):
-        """``(d_0, T lower/diag/upper at fixed d_0, u = dN/dd_0, v = grad_S d_0, dd_0/dpsi0)``."""
-        Sf, c, Nhat, w, a_L, a_R, GL, GR = self._parts(S)
-        d0, lnL, lnR = self.solve_d0(S, t)
-        lam2 = self.lam2
-        hl, hr, dl = self.h[:-1], self.h[1:], self.delta
-        diag = 1.0 / (dl * hl) + 1.0 / (dl * hr) + 1.0 / lam2
-        lower = -1.0 / (dl[1:] * hl[1:])
-        upper = -1.0 / (dl[:-1] * hr[:-1])
-        u = np.full(self.N - 1, 1.0 / lam2)
-        Nf = Nhat + d0 / lam2
-        # G = ln c_L - ln c_R - sum N_f w_f + psi0 = 0, scaled by m = min(c_L, c_R)
-        lm = min(lnL, lnR)
-        sL, sR, cm = math.exp(lm - lnL), math.exp(lm - lnR), math.exp(lm)
-        Gd = -GL * sL - GR * sR - cm * float(np.sum(w)) / lam2
-        # d a/dS: a_L = sum_j w_j c_j, c_i = 1 + (S_{i+1} - S_i)/h_i (S index k = face k + 1)
-        n = self.N - 1
-        daL = np.zeros(n)
-        daR = np.zeros(n)
-        h = self.h
-        for j, (a, b) in enumerate(zip(self.aL[0], self.aR[0])):
-            daL[j] += a / h[j]
-            daR[n - j - 1] -= b / h[-1 - j]
-            if j:
-                daL[j - 1] -= a / h[j]
-                daR[n - j] += b / h[-1 - j]
-        # sum_f w_f dN_f/dS_k (T^T w) and sum_f N_f dw_f/dS_k
-        Tw = diag * w
-        Tw[1:] += upper * w[:-1]
-        Tw[:-1] += lower * w[1:]
-        Nfull = np.concatenate(([0.0], Nf, [0.0]))
-        ec = -0.5 * h * (Nfull[:-1] + Nfull[1:]) / (c * c)  # d(sum N w)/dc_i
-        dW = ec[:-1] / hl - ec[1:] / hr
-        GS = daL * sL - daR * sR - cm * (Tw + dW)
-        v = -GS / Gd
-        dpsi0 = -cm / Gd  # G_psi0 = 1 (scaled: cm)
-        return d0, lower, diag, upper, u, v, dpsi0
-
-    def outputs(self, S, t, dpsi0):
-        """``(d_0, dd_0/dt, profile moment, free energy, c)``; ``dd_0/dt = v . dS/dt + (dd_0/dpsi0) dpsi0/dt``."""
-        Sf, c = self.unpack(S)
-        d0, _, _, _, _, v, dpsi = self._border(S, t)
-        d = d0 + Sf
-        _, lnL, lnR = self.solve_d0(S, t)
-        J = float(np.dot(v, -self.flux(c, d))) + dpsi * dpsi0
-        if t == 0.0 and not np.any(S):
-            # the uncharged state at t = 0+: no layer has formed (width sqrt(t)), the face
-            # concentrations are the cells' (c = 1), and the charge is the bulk's displacement
-            # charge lambda^2 psi0/2 (the face extrapolation with the slope d_0/lambda^2 would
-            # put an O(h) layer there)
-            d0 = 0.5 * self.lam2 * self.psi0(t)
-            d = d0 + Sf
-            lnL = lnR = 0.0
+    def outputs_all(self, S2, t, dpsi0):
+        """``(d_0, dd_0/dt, profile moment, free energy, c)`` at the states ``S2`` (m, n), times ``t`` (m,)
+        (``dpsi0 = dpsi0/dt``); ``dd_0/dt = v . dS/dt + (dd_0/dpsi0) dpsi0/dt``."""
+        Sf, c = self.unpack(S2)
+        d0, lnL, lnR, v, dpsi = self._border(S2, t)
+        d = d0[:, None] + Sf
+        J = np.sum(v * -self.flux(c, d), axis=-1) + dpsi * dpsi0
+        # the uncharged state at t = 0+: no layer has formed (width sqrt(t)), the face concentrations
+        # are the cells' (c = 1), and the charge is the bulk's displacement charge lambda^2 psi0/2 (the
+        # face extrapolation with the slope d_0/lambda^2 would put an O(h) layer there)
+        at0 = (np.asarray(t) == 0.0) & ~np.any(S2, axis=-1)
+        if np.any(at0):
+            d0 = np.where(at0, 0.5 * self.lam2 * np.array([self.psi0(x) for x in t]), d0)
+            d = d0[:, None] + Sf
+            lnL = np.where(at0, 0.0, lnL)
+            lnR = np.where(at0, 0.0, lnR)
         M = self._moment_linear(c, d, lnL, lnR)
         cpos = np.maximum(c, 1e-300)
         half = 0.5 * self.h / c
-        r = np.empty(self.N + 1)
-        r[0], r[-1] = half[0], half[-1]
-        r[1:-1] = half[:-1] + half[1:]
-        Fe = float(np.dot(r, d * d) / (2 * self.lam2) + np.dot(self.h, cpos * np.log(cpos) - cpos + 1.0))
+        r = np.zeros((c.shape[0], self.N + 1))
+        r[:, :-1] += half
+        r[:, 1:] += half
+        Fe = np.sum(r * d * d, axis=-1) / (2 * self.lam2) + (cpos * np.log(cpos) - cpos + 1.0) @ self.h
         return d0, J, M, Fe, c
 
     def _moment_linear(self, c, d, lnL, lnR):
-        """Moment from the profiles, ``int (c + A3) E (1 - z^2)/2 dz`` with ``c E = d/lambda^2``.
+        """Moment from the profiles, ``int (c + A3) E (1 - z^2)/2 dz`` with ``c E = d/lambda^2`` (rows).
 
         ``E = d/(lambda^2 c)`` grows like ``1/x`` towards a depleted face while ``E (1 - z^2)`` stays
         smooth: the ``A3`` term takes ``c`` at the quarter points of each cell (linear through the
@@ -515,30 +564,26 @@ class _LinearProblem(_Problem):
         h, xc, lam2, A3 = self.h, self.xc, self.lam2, self.A3
         zl = xc - 0.25 * h
         zr = xc + 0.25 * h
-        dl = d[:-1] * 0.75 + d[1:] * 0.25
-        dr = d[:-1] * 0.25 + d[1:] * 0.75
+        dl = d[:, :-1] * 0.75 + d[:, 1:] * 0.25
+        dr = d[:, :-1] * 0.25 + d[:, 1:] * 0.75
         wl = (1 - zl * zl) / 2
         wr = (1 - zr * zr) / 2
-        M = float(np.sum(0.5 * h * (dl * wl + dr * wr))) / lam2  # c E = d/lambda^2
-        slope = np.empty(self.N)
-        slope[1:-1] = (c[2:] - c[:-2]) / (xc[2:] - xc[:-2])
-        slope[0] = (c[1] - c[0]) / (xc[1] - xc[0])
-        slope[-1] = (c[-1] - c[-2]) / (xc[-1] - xc[-2])
+        M = (dl * wl + dr * wr) @ (0.5 * h) / lam2  # c E = d/lambda^2
+        slope = np.empty(c.shape)
+        slope[:, 1:-1] = (c[:, 2:] - c[:, :-2]) / (xc[2:] - xc[:-2])
+        slope[:, 0] = (c[:, 1] - c[:, 0]) / (xc[1] - xc[0])
+        slope[:, -1] = (c[:, -1] - c[:, -2]) / (xc[-1] - xc[-2])
         cl = c - 0.25 * h * slope
         cr = c + 0.25 * h * slope
         cl = np.where(cl > 0.0, cl, c)
         cr = np.where(cr > 0.0, cr, c)
         EA = 0.5 * h * (dl * wl / cl + dr * wr / cr) / lam2
-        EA[0] -= 0.5 * h[0] * dl[0] * wl[0] / cl[0] / lam2
-        EA[-1] -= 0.5 * h[-1] * dr[-1] * wr[-1] / cr[-1] / lam2
-        for i, lnf, dc in ((0, lnL, dl[0]), (-1, lnR, dr[-1])):
+        EA[:, 0] -= 0.5 * h[0] * dl[:, 0] * wl[0] / cl[:, 0] / lam2
+        EA[:, -1] -= 0.5 * h[-1] * dr[:, -1] * wr[-1] / cr[:, -1] / lam2
+        for i, lnf, dc in ((0, lnL, dl[:, 0]), (-1, lnR, dr[:, -1])):
             H = 0.5 * h[i]
-            EA[i] += (dc / lam2) * (1.0 - 0.5 * H) * _int_x_over_linear(H, lnf, c[i])
-        return M + A3 * float(np.sum(EA))
-
-    def jacobian(self, S, t):
-        _, lower, diag, upper, u, v, _ = self._border(S, t)
-        return -lower, -diag, -upper, -u, v
+            EA[:, i] += (dc / lam2) * (1.0 - 0.5 * H) * _int_x_over_linear(H, lnf, c[:, i])
+        return M + A3 * np.sum(EA, axis=-1)
 
     def rhs(self, t, y, with_diss):
         S = y[: self.N - 1]
@@ -840,15 +885,22 @@ def _solve_once(t, phi0_fun, strip, model, material, *, cells_per_debye, ratio, 
     Mprof = np.empty(nt)
     Fe = np.empty(nt)
     cs = np.empty((nt, P.N)) if profiles else np.empty((0, P.N))
+    dpsi0 = np.zeros(nt)
     for k in range(nt):
-        S = sol.y[: P.N - 1, k]
         th = sol.t[k]
         dt = 1e-7 * max(th, 1e-3)
-        dpsi0 = (psi0(th + dt) - psi0(max(th - dt, 0.0))) / (th + dt - max(th - dt, 0.0)) if th > 0 else 0.0
-        d0[k], J[k], Mprof[k], Fe[k], c = P.outputs(S, th, dpsi0)
-        qtot[k] = float(np.dot(c - 1.0, P.h))
+        dpsi0[k] = (psi0(th + dt) - psi0(max(th - dt, 0.0))) / (th + dt - max(th - dt, 0.0)) if th > 0 else 0.0
+    if isinstance(P, _LinearProblem):
+        d0, J, Mprof, Fe, call = P.outputs_all(sol.y[: P.N - 1].T, sol.t, dpsi0)
+        qtot = (call - 1.0) @ P.h
         if profiles:
-            cs[k] = c
+            cs = call
+    else:
+        for k in range(nt):
+            d0[k], J[k], Mprof[k], Fe[k], c = P.outputs(sol.y[: P.N - 1, k], sol.t[k], dpsi0[k])
+            qtot[k] = float(np.dot(c - 1.0, P.h))
+            if profiles:
+                cs[k] = c
     sigma = sig_scale * d0
     Jsi = sig_scale * J / tscale
 
