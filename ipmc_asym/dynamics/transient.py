@@ -34,9 +34,16 @@ Mesh error: ``tol`` (default 1e-6 relative on sigma) refines the whole mesh by 2
 Richardson estimate between successive levels meets it (:func:`solve_transient`); the
 long-time limit then equals the static charge (``electrode.charge``) within ``tol``.
 
-Not supported: the linear model (``eps -> 0`` at the anode: ``E ~ e^{A2}`` within ~1e-19 e of
-the face, which no mesh resolves; the static BVP integrates it in ``s = A0 C + A1 ln C``),
-custom ``eps(C)`` callables.  Water transport (Darcy) is outside the model.
+The linear model (``eps0 = 0``: ``eps -> 0`` at a depleted anode, where ``E ~ e^{A2}`` within
+~1e-19 e of the face -- not representable, nor resolvable by any mesh) is solved in other
+variables (:class:`_LinearProblem`): there ``epshat = c``, Gauss's law gives ``c dpsi/dx =
+-d/lambda^2`` and the flux ``N = -dc/dx + d/lambda^2`` is linear in ``(c, d)``; the voltage
+constraint goes through the electrochemical potential, ``psi0 = ln(c_R/c_L) + int N/c dx``,
+with the face concentrations in log form (they may lie below the smallest double).  The same
+state, mesh ladder, Richardson estimate and bordered Jacobian (its tridiagonal part constant);
+the long-time limit equals the exact static charge (``charge(..., fidelity="exact")``) within
+``tol``.  Not supported: custom ``eps(C)`` callables.  Water transport (Darcy) is outside the
+model.
 """
 
 from __future__ import annotations
