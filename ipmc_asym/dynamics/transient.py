@@ -698,7 +698,7 @@ def solve_transient(t, phi0_fun, strip: Strip, model="constant", material: Mater
         Output times (s), increasing, ``t[0] >= 0``.
     phi0_fun : callable
         ``phi0(t)`` in volts, vectorised (see :func:`ipmc_asym.dynamics.circuit.waveform`).
-    strip : Strip ; model : "constant" / "affine" or Permittivity ; material : Material
+    strip : Strip ; model : "constant" / "linear" / "affine" or Permittivity ; material : Material
     cells_per_debye, ratio, h_core : float
         Mesh (:func:`make_fv_mesh`); the layer zone is sized for ``max |phi0|`` on ``t``.
     refine : float
@@ -840,7 +840,7 @@ def _solve_once(t, phi0_fun, strip, model, material, *, cells_per_debye, ratio, 
     perm: Permittivity = get_model(model)
     m = material
     if perm.is_custom:
-        raise ValueError("the transient solver needs an affine permittivity (constant or affine)")
+        raise ValueError("the transient solver needs an affine permittivity (constant, linear, affine or a Permittivity)")
     if method not in ("BDF", "Radau"):
         raise ValueError(f"method must be BDF or Radau; got {method!r}")
     check_positive("cells_per_debye", cells_per_debye)
