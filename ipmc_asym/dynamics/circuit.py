@@ -599,9 +599,6 @@ def _circuit_error(sigma_c, t, fun, strip, perm, material, opts):
     (``refine`` 1/4; its own Richardson estimate refines it when that is not enough); it is
     also the pnp rung when the circuit fails.  Returns ``(pnp result, bound)``.
     """
-    if perm.eps0 == 0.0:
-        raise ValueError("tol: the linear model has no PNP rung (eps -> 0 at the anode), so the circuit's "
-                         "error cannot be bounded; drop tol or use another model")
     o = dict(opts)
     o["tol"] = 0.1 * o["tol"]
     o.setdefault("refine", 0.25)

@@ -50,7 +50,7 @@ def plot_step(path, voltage=1.0, strip: Strip | None = None, material=NAFION_LI)
     plt = pyplot()
     tau = float(time_constant(s.thickness, "constant", material))
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(10, 4))
-    for m, c in (("constant", MODEL_COLOURS["constant"]), ("affine", MODEL_COLOURS["affine"])):
+    for m, c in MODEL_COLOURS.items():
         tm = float(time_constant(s.thickness, m, material))
         rc = step_response(voltage, 6 * tm, strip=s, model=m, material=material, points=600)
         rp = step_response(voltage, 6 * tm, strip=s, model=m, material=material, fidelity="pnp", points=31)

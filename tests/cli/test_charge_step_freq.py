@@ -55,7 +55,6 @@ def test_freq_json(capsys):
     (["charge", "--thickness", "0"], "thickness"),
     (["charge", "--fidelity", "exact-ish"], "fidelity"),
     (["step", "--duration", "-1s"], "duration"),
-    (["step", "--fidelity", "pnp", "--model", "linear", "--points", "3"], "linear"),
     (["step", "--out", "/nonexistent-dir/x.csv"], "--out"),
     (["freq", "--from", "10Hz", "--to", "1Hz"], "--to"),
     (["freq", "--from", "0", "--to", "1Hz"], "--from"),

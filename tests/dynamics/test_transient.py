@@ -101,9 +101,9 @@ def test_tolerance_refused_beyond_the_cell_cap():
         step_response(1.0, TAU, fidelity="pnp", points=3, pnp_options={"tol": 1e-9, "max_cells": 3000})
 
 
-@pytest.mark.parametrize("model,V", [("constant", 1.0), ("affine", -0.5)])
+@pytest.mark.parametrize("model,V", [("constant", 1.0), ("affine", -0.5), ("linear", 1.0), ("linear", -0.3)])
 def test_analytic_jacobian_against_finite_differences(model, V):
-    from ipmc_asym.dynamics.transient import _Problem, make_fv_mesh
+    from ipmc_asym.dynamics.transient import _LinearProblem, _Problem, make_fv_mesh
     from ipmc_asym.model import groups
 
     perm = MODELS[model]
@@ -111,7 +111,7 @@ def test_analytic_jacobian_against_finite_differences(model, V):
     rho = perm.eps0 / perm.eps_moy
     psi0 = V / float(groups.thermal_voltage(NAFION_LI))
     X = make_fv_mesh(lam, abs(psi0), rho, cells_per_debye=1.0)
-    P = _Problem(X, lam, rho, lambda t: psi0, 0.0)
+    P = (_LinearProblem if rho == 0.0 else _Problem)(X, lam, rho, lambda t: psi0, 0.0)
     S = 1e-4 * np.cumsum(np.random.default_rng(1).normal(size=P.N - 1))
     lo, di, up, u, v = P.jacobian(S, 0.0)
     J = np.diag(di) + np.diag(lo, -1) + np.diag(up, 1) + np.outer(u, v)
@@ -121,6 +121,9 @@ def test_analytic_jacobian_against_finite_differences(model, V):
         dS[k] = 1e-7
         Jn[:, k] = (P.rhs(0.0, S + dS, False) - P.rhs(0.0, S - dS, False)) / 2e-7
     assert np.max(np.abs(J - Jn)) <= 1e-6 * np.max(np.abs(Jn))
+    if rho == 0.0:  # the outputs' batch solve of the constraint is the integrator's scalar one
+        d0 = P.outputs_all(np.vstack((S, 2 * S)), np.array([0.5, 0.5]), np.zeros(2))[0]
+        assert d0 == pytest.approx([P.solve_d0(S, 0.5)[0], P.solve_d0(2 * S, 0.5)[0]], rel=1e-12)
 
 
 def test_time_step_self_convergence():
@@ -184,29 +187,86 @@ def test_small_signal_dc_limit_is_the_static_slope():
 
 
 @pytest.mark.slow
-def test_small_signal_against_a_small_sine_in_the_pnp_solver():
-    """Drive the transient solver with 1 mV sines; fit the periodic current; compare Z."""
+@pytest.mark.parametrize("model", ["constant", "linear"])
+def test_small_signal_against_a_small_sine_in_the_pnp_solver(model):
+    """Drive the transient solver with 1 mV sines; fit the periodic current; compare Z (the linear model
+    linearises about eps_core like the constant one: an independent check of its formulation)."""
     amp = 1e-3
+    tau = float(time_constant(S0.thickness, model))
     for fac in (0.3, 3.0):
-        f = fac / (2 * math.pi * TAU)
+        f = fac / (2 * math.pi * tau)
         per = 1 / f
         t = np.linspace(0, 8 * per, 8 * 32 + 1)
-        r = solve_transient(t, waveform("sine", amp, frequency=f), S0, "constant", NAFION_LI, moment=False,
+        r = solve_transient(t, waveform("sine", amp, frequency=f), S0, model, NAFION_LI, moment=False,
                             rtol=1e-9, atol=1e-16, tol=None)
         sel = t >= 6 * per
         A = np.column_stack([np.sin(2 * math.pi * f * t[sel]), np.cos(2 * math.pi * f * t[sel])])
         a, b = np.linalg.lstsq(A, r.current_density[sel], rcond=None)[0]
         Jc = a + 1j * b  # current = Im[Jc e^{i w t}] with voltage amp sin = Im[amp e^{i w t}]
         Z_pnp = amp / Jc / (S0.width * S0.length)
-        Z_lin = frequency_response([f], method="pnp-linear").Z[0]
-        Z_cir = frequency_response([f], method="circuit").Z[0]
+        Z_lin = frequency_response([f], model=model, method="pnp-linear").Z[0]
+        Z_cir = frequency_response([f], model=model, method="circuit").Z[0]
         assert abs(Z_pnp / Z_lin - 1) < 1e-2  # mesh error of the default mesh (~5e-3)
         assert abs(Z_pnp / Z_cir - 1) < 3e-2
 
 
-def test_linear_model_refused_by_the_pnp_solver():
-    with pytest.raises(ValueError, match="linear"):
-        solve_transient(np.array([0.0, TAU]), waveform("step", 1.0), S0, "linear", NAFION_LI)
+@pytest.mark.parametrize("V,thickness", [(1.0, 200e-6), (-1.0, 200e-6), (0.05, 200e-6), (-0.05, 200e-6),
+                                         (1.0, 20e-6), (-1.0, 1e-3)])
+def test_linear_model_long_time_limit_is_the_exact_static_charge(V, thickness):
+    """Linear model (eps -> 0 at the anode, E ~ e^{A2} there): the relaxed charge equals the exact static
+    charge within the run's own estimate, at the default tolerance, both signs, thin to thick strips."""
+    s = Strip(thickness=thickness)
+    tau = float(time_constant(thickness, "linear"))
+    r = solve_transient(np.array([0.0, tau, 30 * tau]), waveform("step", V), s, "linear", NAFION_LI)
+    assert r.success, r.message
+    ref = float(charge(thickness, V, "linear", "exact").sigma)
+    assert abs(r.sigma[-1] - ref) <= r.sigma_error[-1] <= 1e-6 * abs(ref)
+    # at t = 0+ only the bulk's displacement charge C_g phi0 (C_g = eps_core/(2e))
+    assert r.sigma[0] == pytest.approx(MODELS["linear"].eps_moy / thickness * V, rel=1e-12)
+    if thickness == S0.thickness:
+        Ms = quasi_static_mechanics(np.array([V]), s, MODELS["linear"], NAFION_LI)[0][0]
+        assert r.M_A_profiles[-1] == pytest.approx(Ms, rel=1e-5)
+
+
+def test_linear_model_far_beyond_the_representable_anode_field():
+    """20 V: the anode concentration e^{-A2} ~ e^{-778} underflows (E would overflow); the charge is the
+    saturation charge of the exact static solution, and the layer voltage V(sigma) is withheld there."""
+    tau = float(time_constant(S0.thickness, "linear"))
+    r = solve_transient(np.array([0.0, 0.1 * tau, 30 * tau]), waveform("step", -20.0), S0, "linear", NAFION_LI)
+    assert r.success, r.message
+    ref = float(charge(S0.thickness, -20.0, "linear", "exact").sigma)
+    assert abs(r.sigma[-1] - ref) <= r.sigma_error[-1] <= 1e-6 * abs(ref)
+    assert np.all(np.isfinite(r.sigma)) and np.isnan(r.layer_voltage[-1])
+
+
+def test_linear_model_second_order_mesh_convergence():
+    """Whole-mesh refinement by 2: the long-time charge converges at second order to the exact static
+    charge (an independent solution)."""
+    tau = float(time_constant(S0.thickness, "linear"))
+    ref = float(charge(S0.thickness, 0.05, "linear", "exact").sigma)
+    e = [abs(solve_transient(np.array([0.0, 30 * tau]), waveform("step", 0.05), S0, "linear", NAFION_LI, tol=None,
+                             refine=rf, moment=False).sigma[-1] / ref - 1) for rf in (1, 2, 4)]
+    assert 3.0 < e[0] / e[1] < 4.5 and 3.5 < e[1] / e[2] < 4.5
+
+
+@pytest.mark.parametrize("V,thickness", [(1.0, 200e-6), (-0.05, 200e-6), (-1.0, 20e-6),
+                                         pytest.param(5.0, 20e-6, marks=pytest.mark.slow),
+                                         pytest.param(5.0, 1e-3, marks=pytest.mark.slow)])
+def test_linear_model_tolerance_run_agrees_with_a_twice_refined_run(V, thickness):
+    """A run at the default tolerance agrees with one whose mesh ladder starts twice finer than the
+    levels of the first one's extrapolation, within the sum of their stated estimates at every output
+    time (0.01 tau to 5 tau: the initial layer of the step included)."""
+    s = Strip(thickness=thickness)
+    tau = float(time_constant(thickness, "linear"))
+    t = tau * np.array([0.0, 0.01, 0.03, 0.1, 0.3, 1.0, 5.0])
+    a = solve_transient(t, waveform("step", V), s, "linear", NAFION_LI, moment=False)
+    assert a.success, a.message
+    rf = 2.0 * a.extra["refinement"][-3]["refine"]
+    b = solve_transient(t, waveform("step", V), s, "linear", NAFION_LI, moment=False, refine=rf)
+    assert b.success, b.message
+    assert np.any(a.sigma != b.sigma)
+    assert np.all(np.abs(a.sigma - b.sigma) <= a.sigma_error + b.sigma_error)
+    assert np.max(a.sigma_error) <= 1e-6 * np.max(np.abs(a.sigma))
 
 
 def test_charge_claims_rows_follow_their_criteria():
@@ -260,15 +320,19 @@ def test_step_tol_escalates_a_thin_affine_strip_at_2V():
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("model", ["constant", "affine"])
+@pytest.mark.parametrize("model", ["constant", "linear", "affine"])
 @pytest.mark.parametrize("V", [0.05, 1.0, 5.0])
 @pytest.mark.parametrize("thickness", [20e-6, 200e-6, 1e-3])
 def test_step_tol_grid(model, V, thickness):
     _ladder_case(model, V, thickness, 1e-2)
 
 
-def test_step_tol_refused_for_the_linear_model():
-    with pytest.raises(ValueError, match="linear"):
-        step_response(1.0, TAU, model="linear", points=3, tol=1e-2)
+def test_step_tol_bounds_the_circuit_for_the_linear_model():
+    """The circuit's stated error (against the PNP rung) holds for the linear model too."""
+    _ladder_case("linear", -1.0, 20e-6, 1e-2)
+    _ladder_case("linear", 0.05, S0.thickness, 1e-2)
+
+
+def test_step_tol_refused_out_of_range():
     with pytest.raises(ValueError, match="tol"):
         step_response(1.0, TAU, points=3, tol=0.7)
