@@ -64,7 +64,7 @@ from ipmc_asym.model.params import Material, check_positive, second_moment
 __all__ = ["SUPPORTS", "DEFAULT_MODES", "VISCOUS_MODULUS_SOURCE", "Beam", "Modes", "hydrated_density",
            "characteristic", "eigenvalues", "first_resonance", "mode_shape", "modes", "natural_frequencies", "transfer",
            "ModalIntegrator", "viscous_modulus_from_damping_ratio", "moment_kernels", "distributed_transfer",
-           "DISTRIBUTED_OUTPUTS"]
+           "DISTRIBUTED_OUTPUTS", "SUPPORT_OUTPUTS", "CLAMPED_OUTPUTS", "static_outputs"]
 
 SUPPORTS = ("clamped-free", "clamped-pinned", "clamped-clamped")
 
@@ -334,6 +334,145 @@ def _second_static(support, beam: Beam):
     return float(w2(1)), float(w2.deriv(1)(1)) / L, float(w2.deriv(2)(0)) / L**2, float(w2.deriv(3)(1)) / L**3
 
 
+#: outputs of a clamped-clamped strip: reaction moments and forces of the two clamps, midspan deflection
+CLAMPED_OUTPUTS = ("M_root", "M_tip", "F_root", "F_tip", "w_mid")
+
+#: outputs of :func:`transfer` and :class:`ModalIntegrator` for each support (any electrode)
+SUPPORT_OUTPUTS = {"clamped-free": ("w", "theta"), "clamped-pinned": ("F", "theta"), "clamped-clamped": CLAMPED_OUTPUTS}
+
+# output -> (derivative order k, position xi = x/L, force or kinematic, sign c): a kinematic output is
+# d^k w/dx^k at x; a force c EI (1 + tau_v d/dt) d^k w/dx^k plus the active moment there (moments, k = 2).
+# With m = EI (w'' + tau_v dw''/dt) + M_a: M_root = m(0), M_tip = m(L) (the clamps' reaction moments, the
+# paper's sign), F_root = m'(0), F_tip = F = -m'(L) (the clamps' transverse forces on the strip, +z: the
+# blocking force's convention; statically F_root = -F_tip)
+_OUTPUT_SPEC = {"w": (0, 1.0, False, 1.0), "theta": (1, 1.0, False, 1.0), "w_mid": (0, 0.5, False, 1.0),
+                "F": (3, 1.0, True, -1.0), "F_tip": (3, 1.0, True, -1.0), "F_root": (3, 0.0, True, 1.0),
+                "M_root": (2, 0.0, True, 1.0), "M_tip": (2, 1.0, True, 1.0)}
+
+
+def _dpow(k, d, x):
+    """``d^d/dx^d x^k`` at ``x``."""
+    return 0.0 if d > k else math.factorial(k) / math.factorial(k - d) * x ** (k - d)
+
+
+@functools.lru_cache(maxsize=64)
+def _piecewise_statics(support, beam: Beam):
+    """Static deflection ``w1`` and second static ``w2`` per unit active moment, any electrode.
+
+    ``w1``: ``EI w1'' = m - M_a`` with ``m`` linear (no load), ``M_a = 1`` on the electrode; the
+    support's conditions on ``w`` and ``m`` (``m = 0`` at a free or pinned end, ``m' = 0`` at a
+    free end).  ``w2``: ``(EI/rho A) d^4 w2/dx^4 = w1`` with the support's homogeneous conditions
+    (the operator's inverse applied twice, as :func:`_second_static`).  Polynomials (degree 3 and
+    7) on the pieces cut by the electrode's ends, joined with ``w, w', m, m'`` continuous.
+
+    Returns ``(breaks, w1, w2, Ma)``: breaks in ``xi = x/L``, tuples of
+    :class:`numpy.polynomial.Polynomial` in ``xi`` (SI values), the active moment on each piece.
+    """
+    L, EI = beam.length, beam.EI
+    a, b = (0.0, 1.0) if beam.electrode is None else (beam.electrode[0] / L, beam.electrode[1] / L)
+    brk = sorted({0.0, float(a), float(b), 1.0})
+    ns = len(brk) - 1
+    Ma = [1.0 if (brk[j] >= a and brk[j + 1] <= b) else 0.0 for j in range(ns)]
+    end = {"clamped-free": (2, 3), "clamped-pinned": (0, 2), "clamped-clamped": (0, 1)}[support]
+
+    def solve(q, s):
+        # w_j = part_j + sum_k c_jk xi^k; continuity of w, w', w'' + s M_a (the moment), w''' at the breaks
+        part = [qj.integ(4) for qj in q]
+        A = np.zeros((4 * ns, 4 * ns))
+        r = np.zeros(4 * ns)
+
+        def cond(row, j, d, x, coef):
+            A[row, 4 * j:4 * j + 4] += [coef * _dpow(k, d, x) for k in range(4)]
+            return -coef * part[j].deriv(d)(x)
+
+        row = 0
+        for d in (0, 1):  # the clamp at x = 0
+            r[row] = cond(row, 0, d, 0.0, 1.0)
+            row += 1
+        for j in range(1, ns):
+            for d in range(4):
+                r[row] = cond(row, j - 1, d, brk[j], 1.0) + cond(row, j, d, brk[j], -1.0)
+                if d == 2:
+                    r[row] += s * (Ma[j] - Ma[j - 1])
+                row += 1
+        for d in end:
+            r[row] = cond(row, ns - 1, d, 1.0, 1.0) - (s * Ma[-1] if d == 2 else 0.0)
+            row += 1
+        c = np.linalg.solve(A, r)
+        return tuple(part[j] + P(c[4 * j:4 * j + 4]) for j in range(ns))
+
+    w1 = solve([P([0.0])] * ns, L * L / EI)
+    w2 = solve([w * (beam.rhoA * L**4 / EI) for w in w1], 0.0)
+    return tuple(brk), w1, w2, tuple(Ma)
+
+
+def _piece(brk, xi):
+    """Index of the piece holding ``xi`` (the first one at a break: 0 at the clamp, the last at the tip)."""
+    for j in range(len(brk) - 1):
+        if brk[j] <= xi <= brk[j + 1]:
+            return j
+    raise ValueError(f"xi = {xi!r} outside [0, 1]")
+
+
+def static_outputs(support, beam: Beam, names=None):
+    """Small-displacement static outputs and second statics per unit active moment, any electrode.
+
+    Parameters
+    ----------
+    support : str ; beam : Beam (its ``electrode``, default the whole strip)
+    names : iterable of str, optional   default :data:`SUPPORT_OUTPUTS` of the support
+
+    Returns
+    -------
+    dict  name -> ``(O1, O2)``: ``O1`` the static value (m, rad, N or N m per N m of active moment),
+          ``O2`` the second static ``d^k w2/dx^k`` at the output's point (the sum over all modes of
+          ``g_n phi_n^(k)/omega_n^4``, see :func:`transfer`)
+    """
+    _check_support(support)
+    brk, w1, w2, Ma = _piecewise_statics(support, beam)
+    L, EI = beam.length, beam.EI
+    out = {}
+    for n in (SUPPORT_OUTPUTS[support] if names is None else names):
+        k, xi, force, c = _OUTPUT_SPEC[n]
+        j = _piece(brk, xi)
+        o1 = float(w1[j].deriv(k)(xi)) / L**k
+        o2 = float(w2[j].deriv(k)(xi)) / L**k
+        if force:
+            o1 = c * EI * o1 + (Ma[j] if k == 2 else 0.0)
+        out[n] = (o1, o2)
+    return out
+
+
+def _general_transfer(f, beam: Beam, support, n_modes):
+    """:func:`transfer` for any electrode and the outputs of :data:`SUPPORT_OUTPUTS` (the same expansion)."""
+    md = modes(support, beam, n_modes)
+    L, EI = beam.length, beam.EI
+    s = 2j * math.pi * f[..., None]
+    kv = 1.0 + s * beam.tau_v
+    Dn = md.omega**2 * kv + s * s
+    g = -md.P / (beam.rhoA * L)
+    rem = g * s**4 / (md.omega**4 * kv * kv * Dn)
+    k0, s0 = kv[..., 0], s[..., 0]
+    st = static_outputs(support, beam)
+    out = {"static": {n: v[0] for n, v in st.items()}}
+    trunc = 0.0
+    for n, (o1, o2) in st.items():
+        k, xi, force, c = _OUTPUT_SPEC[n]
+        ph = mode_shape(support, md.b, xi, k) / L**k
+        if force:  # c EI (1 + s tau_v) w^(k) (+ M_a): the static unfiltered, the second static once
+            t = c * EI * kv * rem * ph
+            out[n] = o1 - c * EI * s0 * s0 * o2 / k0 + t.sum(axis=-1)
+        else:
+            t = rem * ph
+            out[n] = o1 / k0 - s0 * s0 * o2 / k0**2 + t.sum(axis=-1)
+        if f.size:
+            trunc = max(trunc, float(np.max(np.abs(t[..., -1]) / np.maximum(np.abs(out[n]), 1e-300))))
+    out["dynamic_factor"] = {k: out[k] / v for k, v in out["static"].items() if v != 0.0}
+    out["truncation"] = trunc
+    out["modes"] = md
+    return out
+
+
 def transfer(f, beam: Beam, support="clamped-free", n_modes=DEFAULT_MODES):
     """Tip responses per unit active moment at frequencies ``f`` (Hz), small displacements.
 
@@ -356,8 +495,8 @@ def transfer(f, beam: Beam, support="clamped-free", n_modes=DEFAULT_MODES):
     f = np.asarray(f, dtype=float)
     if not np.all(np.isfinite(f)) or np.any(f < 0):
         raise ValueError("frequencies must be finite and >= 0 Hz")
-    if beam.electrode is not None:
-        raise ValueError("frequency transfer with a partial electrode: the static part is only written for a full electrode")
+    if beam.electrode is not None or support == "clamped-clamped":
+        return _general_transfer(f, beam, support, n_modes)
     md = modes(support, beam, n_modes)
     s = 2j * math.pi * f[..., None]
     kv = 1.0 + s * beam.tau_v
@@ -623,7 +762,8 @@ class ModalIntegrator:
     ``advance(t, M, statics)`` takes output times ``t`` (s, increasing; the first equal to the
     last time of the previous chunk, or 0 at the start, at rest), the moment ``M_A(t)`` (N m) and
     the quasi-static outputs at those times (dict name -> array: ``w``, ``theta``, ``F``,
-    ``M_root``, from the static model), and returns the dynamic outputs: the quasi-static values
+    ``M_root``, from the static model; for a clamped-clamped strip also ``M_tip``, ``F_root``,
+    ``F_tip``, ``w_mid``, e.g. :func:`static_outputs` times the moment), and returns the dynamic outputs: the quasi-static values
     through the creep filter (forces unfiltered) plus the modal sums of ``q_n - q_n^qs``.
     """
 
@@ -644,6 +784,14 @@ class ModalIntegrator:
         _, _, d2w20, d3w2L = _second_static(support, beam) if beam.electrode is None else (0.0, 0.0, 0.0, 0.0)
         self.tail_F = d3w2L - float(np.sum(g * md.d3phi_L / md.omega**4))
         self.tail_M = d2w20 - float(np.sum(g * md.d2phi_0 / md.omega**4))
+        # any electrode, every output of the support: the mode values at its point and the force tail
+        self.spec = {}
+        st = static_outputs(support, beam, tuple(_OUTPUT_SPEC))
+        for n, (k, xi, force, c) in _OUTPUT_SPEC.items():
+            ph = mode_shape(support, md.b, xi, k) / beam.length**k
+            self.spec[n] = (ph, force, c, st[n][1] - float(np.sum(g * ph / md.omega**4)))
+        if beam.electrode is not None:
+            self.tail_F, self.tail_M = self.spec["F"][3], self.spec["M_root"][3]
 
     def advance(self, t, M, statics):
         t = np.ascontiguousarray(t, dtype=float)
@@ -690,6 +838,13 @@ class ModalIntegrator:
             elif k == "M_root":
                 dd = oq + b.tau_v * odq if b.tau_v > 0.0 else oq
                 out[k] = S[:, j] + b.EI * (dd @ md.d2phi_0) - b.EI * self.tail_M * ydd
+            elif k in self.spec:
+                ph, force, c, tail = self.spec[k]
+                if force:  # c EI (1 + tau_v d/dt) w^(k) plus the unfiltered static (with the active moment)
+                    dd = oq + b.tau_v * odq if b.tau_v > 0.0 else oq
+                    out[k] = S[:, j] + c * b.EI * (dd @ ph) - c * b.EI * tail * ydd
+                else:
+                    out[k] = oys[:, j] + oq @ ph
             else:
-                raise ValueError(f"unknown output {k!r}; allowed: w, theta, F, M_root")
+                raise ValueError(f"unknown output {k!r}; allowed: {', '.join(_OUTPUT_SPEC)}")
         return out

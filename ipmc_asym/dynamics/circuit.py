@@ -43,11 +43,14 @@ import numpy as np
 from ipmc_asym.base.registry import check_choice
 from ipmc_asym.base.settings import VALIDATED_VOLTAGE
 from ipmc_asym.beam.dynamics import (
+    CLAMPED_OUTPUTS,
     DEFAULT_MODES,
+    SUPPORTS,
     VISCOUS_MODULUS_SOURCE,
     Beam,
     ModalIntegrator,
     natural_frequencies,
+    static_outputs,
     transfer,
 )
 from ipmc_asym.dynamics.electrode import (
@@ -78,7 +81,8 @@ from ipmc_asym.model.permittivity import Permittivity, get_model
 
 __all__ = ["DYNAMIC_NOTES", "StepResult", "FrequencyResult", "core_resistance", "time_constant",
            "waveform", "step_response", "frequency_response", "circuit_response", "quasi_static_mechanics",
-           "circuit_impedance_error", "circuit_band", "quasi_static_forward"]
+           "circuit_impedance_error", "circuit_band", "quasi_static_forward", "check_support", "check_electrode",
+           "support_notes"]
 
 #: stated in every dynamic output
 WATER_NOTE = ("water transport (the paper's Darcy law) and the back-relaxation it causes are outside this model: "
@@ -105,9 +109,50 @@ def dynamic_notes(beam="quasi-static", viscous_modulus=0.0):
     return notes
 
 
-def strip_beam(strip: Strip, material: Material, viscous_modulus=0.0) -> Beam:
-    """The strip's beam (``E I_p``, mass per length of the hydrated membrane, ``tau_v = eta_E/E``)."""
-    return Beam.from_strip(strip.length, strip.width, strip.thickness, material, viscous_modulus)
+def strip_beam(strip: Strip, material: Material, viscous_modulus=0.0, electrode=None) -> Beam:
+    """The strip's beam (``E I_p``, mass per length of the hydrated membrane, ``tau_v = eta_E/E``;
+    ``electrode`` the covered part ``(x1, x2)`` of the length, m, default the whole strip)."""
+    return Beam.from_strip(strip.length, strip.width, strip.thickness, material, viscous_modulus, electrode)
+
+
+def check_support(support):
+    """``None`` (the default pair: free tip w, theta and blocked tip F_block) or one of ``SUPPORTS``."""
+    if support is not None and support not in SUPPORTS:
+        raise ValueError(f"support must be one of {', '.join(SUPPORTS)}; got {support!r}")
+    return support
+
+
+def check_electrode(electrode, length):
+    """``(x1, x2)`` (m) with ``0 <= x1 < x2 <= length``, or ``None`` for the whole strip (also for ``(0, L)``)."""
+    if electrode is None:
+        return None
+    try:
+        x1, x2 = (float(v) for v in electrode)
+    except (TypeError, ValueError):
+        raise ValueError(f"electrode must be a pair (x1, x2) of lengths in m; got {electrode!r}") from None
+    if not (math.isfinite(x1) and math.isfinite(x2) and 0.0 <= x1 < x2 <= length):
+        raise ValueError(f"electrode must be (x1, x2) with 0 <= x1 < x2 <= L = {length:g} m; got {electrode!r}")
+    return None if (x1 == 0.0 and x2 == length) else (x1, x2)
+
+
+def support_notes(support, electrode):
+    """The notes of a clamped-clamped strip or a partial electrode (what they report, what they assume)."""
+    notes = []
+    if electrode is not None:
+        notes.append(f"partial electrode on [{electrode[0]:g}, {electrode[1]:g}] m: the active moment M_A acts there only; "
+                     "the beam outputs are small-displacement (linear in M_A; the forward model's large-displacement "
+                     "beam holds for a full electrode)")
+    if support == "clamped-clamped":
+        notes.append("clamped-clamped strip (small displacements): M_root, M_tip = bending moments at the clamps x = 0, L "
+                     "(the clamps' reaction moments, the paper's sign); F_root, F_tip = transverse forces of the clamps on "
+                     "the strip (+z; F_tip with the sign of F_block; statically F_root = -F_tip); w_mid = deflection at "
+                     "x = L/2; with a full electrode nothing moves and M_root = M_tip = M_A")
+    return notes
+
+
+def _linear_statics(beam: Beam, M, support, names=None):
+    """Small-displacement quasi-static outputs (dict) for the moment ``M`` (N m) on the beam's electrode."""
+    return {n: v[0] * M for n, v in static_outputs(support, beam, names).items()}
 
 
 #: modes kept in the time domain (with the static correction the tip deflection's tail from mode 21 on is
@@ -116,18 +161,26 @@ TIME_MODES = 20
 
 
 class BeamDynamics:
-    """Free tip (``w``, ``theta``) and blocked tip (``F_block``) driven by ``M_A(t)``, chunk by chunk."""
+    """Free tip (``w``, ``theta``) and blocked tip (``F_block``) driven by ``M_A(t)``, chunk by chunk;
+    with ``clamped=True`` also the clamped-clamped strip (:meth:`advance_clamped`); ``electrode``
+    ``(x1, x2)`` (m): the moment acts there only (the statics passed in are then small-displacement)."""
 
-    def __init__(self, strip: Strip, material: Material, viscous_modulus=0.0, n_modes=TIME_MODES):
-        self.beam = strip_beam(strip, material, viscous_modulus)
+    def __init__(self, strip: Strip, material: Material, viscous_modulus=0.0, n_modes=TIME_MODES, electrode=None,
+                 clamped=False):
+        self.beam = strip_beam(strip, material, viscous_modulus, electrode)
         self.free = ModalIntegrator(self.beam, "clamped-free", n_modes)
         self.blocked = ModalIntegrator(self.beam, "clamped-pinned", n_modes)
+        self.clamped = ModalIntegrator(self.beam, "clamped-clamped", n_modes) if clamped else None
         self.period = 1.0 / float(natural_frequencies("clamped-free", self.beam, 1)[0])
 
     def advance(self, t, M, theta, w, F_block):
         a = self.free.advance(t, M, {"w": w, "theta": theta})
         b = self.blocked.advance(t, M, {"F": F_block})
         return a["theta"], a["w"], b["F"]
+
+    def advance_clamped(self, t, M, statics):
+        """Clamped-clamped outputs (dict, :data:`CLAMPED_OUTPUTS`) from their quasi-static values ``statics``."""
+        return self.clamped.advance(t, M, statics)
 
 
 def _beam_grid(t, period, cap=5_000_000):
@@ -629,7 +682,12 @@ class FrequencyResult:
     H_theta : ndarray complex tip rotation per volt (free tip), rad/V
     H_F : ndarray complex     blocking force per volt (blocked tip), N/V
     resonances : dict         first three natural frequencies (Hz) of the free and the blocked strip
+                              (and of the clamped-clamped one with ``support="clamped-clamped"``)
     beam : str ; voltage : float  (DC bias, V)
+    support : str or None     the requested support (None: the default pair, free and blocked tip)
+    electrode : tuple or None covered part (x1, x2) of the length, m (None: the whole strip)
+    H_clamped : dict          clamped-clamped only: output (:data:`CLAMPED_OUTPUTS`) -> complex array per
+                              volt: ``M_root``, ``M_tip`` (N m/V), ``F_root``, ``F_tip`` (N/V), ``w_mid`` (m/V)
     """
 
     f: np.ndarray
@@ -651,11 +709,14 @@ class FrequencyResult:
     resonances: dict = field(default_factory=dict)
     beam: str = "quasi-static"
     voltage: float = 0.0
+    support: str | None = None
+    electrode: tuple | None = None
+    H_clamped: dict = field(default_factory=dict)
 
 
 def frequency_response(f, *, strip: Strip | None = None, model="constant", material: Material | None = None,
                        method="pnp-linear", beam="quasi-static", viscous_modulus=0.0, n_modes=DEFAULT_MODES,
-                       voltage=0.0) -> FrequencyResult:
+                       voltage=0.0, support=None, electrode=None) -> FrequencyResult:
     """Impedance and tip-deflection/voltage transfer function about zero volts.
 
     Parameters
@@ -681,6 +742,15 @@ def frequency_response(f, *, strip: Strip | None = None, model="constant", mater
         DC bias (V): small signal about the biased static state (``method="circuit"`` only:
         ``R`` in series with the layers' differential capacitance ``C_d(V)``, ``C_g`` across the
         core; the moment slope ``dM_A/dV`` of the forward model).
+    support : {None, "clamped-free", "clamped-pinned", "clamped-clamped"}
+        ``None`` (default), ``clamped-free`` or ``clamped-pinned``: the free tip (``H_w``,
+        ``H_theta``) and the blocked tip (``H_F``), as always reported together;
+        ``clamped-clamped`` adds ``H_clamped`` (reaction moments and forces of both clamps,
+        midspan deflection; :data:`ipmc_asym.beam.dynamics.CLAMPED_OUTPUTS`) and its resonances.
+    electrode : (x1, x2), optional
+        Covered part of the length (m, ``0 <= x1 < x2 <= L``; default the whole strip): the
+        moment acts there only (modal force ``phi_n'(x2) - phi_n'(x1)``); all beam outputs are
+        then small-displacement (:func:`ipmc_asym.beam.dynamics.static_outputs`).
 
     Returns
     -------
@@ -697,6 +767,8 @@ def frequency_response(f, *, strip: Strip | None = None, model="constant", mater
     if not np.all(np.isfinite(f)) or np.any(f <= 0):
         raise ValueError("frequencies must be finite and > 0 Hz")
     bias = check_finite("voltage (DC bias)", voltage, "a finite number of volts")
+    support = check_support(support)
+    el = check_electrode(electrode, s.length)
     if bias != 0.0 and method != "circuit":
         raise ValueError("voltage: a DC bias needs method 'circuit' (pnp-linear is the linearisation about 0 V)")
     e = s.e
@@ -736,19 +808,31 @@ def frequency_response(f, *, strip: Strip | None = None, model="constant", mater
     # the layers' moment follows their charge: u = V(sigma) = sigma/C_d = J/(i omega C_d)
     Hw = h0 / (1j * omega * C0 * Za)
     HM = Hw / w_per_M  # moment per volt, N m/V
-    b = strip_beam(s, m, viscous_modulus)
+    b = strip_beam(s, m, viscous_modulus, el)
     if beam == "dynamic":
         cf = transfer(f, b, "clamped-free", n_modes)
         cp = transfer(f, b, "clamped-pinned", n_modes)
         Hw = HM * cf["w"]
         Htheta = HM * cf["theta"]
         HF = HM * cp["F"]
-    else:
+    elif el is None:
         Htheta = HM * (-s.length / b.EI)
         HF = HM * (1.5 / s.length)
-    resonances = {sup: natural_frequencies(sup, b, 3).tolist() for sup in ("clamped-free", "clamped-pinned")}
+    else:  # the moment on [x1, x2] only: the small-displacement statics of that load
+        Hw = _linear_statics(b, HM, "clamped-free", ("w",))["w"]
+        Htheta = _linear_statics(b, HM, "clamped-free", ("theta",))["theta"]
+        HF = _linear_statics(b, HM, "clamped-pinned", ("F",))["F"]
+    Hcc = {}
+    if support == "clamped-clamped":
+        if beam == "dynamic":
+            cc = transfer(f, b, "clamped-clamped", n_modes)
+            Hcc = {n: HM * cc[n] for n in CLAMPED_OUTPUTS}
+        else:
+            Hcc = _linear_statics(b, HM, "clamped-clamped")
+    sups = ("clamped-free", "clamped-pinned") + (("clamped-clamped",) if support == "clamped-clamped" else ())
+    resonances = {sup: natural_frequencies(sup, b, 3).tolist() for sup in sups}
     area = s.width * s.length
-    notes = dynamic_notes(beam, viscous_modulus)
+    notes = dynamic_notes(beam, viscous_modulus) + support_notes(support, el)
     if bias != 0.0:
         notes.append(f"small signal about the static state at {bias:g} V (circuit: R, C_d({bias:g} V), C_g; "
                      "dM_A/dV of the forward model); its error against a linearised PNP about the bias is not computed")
@@ -764,4 +848,5 @@ def frequency_response(f, *, strip: Strip | None = None, model="constant", mater
     return FrequencyResult(f=f, Z=Za / area, Z_area=Za, H_w=Hw, w_amp=np.abs(Hw), w_phase=np.angle(Hw), tau=tau,
                            method=method, model=perm.name, notes=notes, H_w_profiles=Hprof, error=err, f_d=f_d,
                            error_max=0.5 * lam if err is not None else math.nan, H_theta=Htheta, H_F=HF,
-                           resonances=resonances, beam=beam, voltage=bias)
+                           resonances=resonances, beam=beam, voltage=bias, support=support, electrode=el,
+                           H_clamped=Hcc)

@@ -18,15 +18,20 @@ import numpy as np
 
 from ipmc_asym.base.registry import check_choice
 from ipmc_asym.base.settings import VALIDATED_VOLTAGE
-from ipmc_asym.beam.dynamics import natural_frequencies
+from ipmc_asym.beam.dynamics import CLAMPED_OUTPUTS, natural_frequencies
 from ipmc_asym.beam.statics import solve_beam
 from ipmc_asym.dynamics.circuit import (
     BEAM_CHOICES,
     TIME_MODES,
     BeamDynamics,
     CircuitStepper,
+    _linear_statics,
+    check_electrode,
+    check_support,
     dynamic_notes,
     quasi_static_forward,
+    strip_beam,
+    support_notes,
     waveform,
 )
 from ipmc_asym.dynamics.electrode import core_resistance, time_constant
@@ -43,12 +48,15 @@ from ipmc_asym.forward.model import CHECKS, assumption_warnings, voltage_reason
 from ipmc_asym.model.params import NAFION_LI, SHEET_RESISTANCE_SOURCE, Material, Strip, check_finite, check_positive
 from ipmc_asym.model.permittivity import get_model
 
-__all__ = ["DRIVE_COLUMNS", "CHECK_COLUMNS", "LINE_COLUMNS", "MAX_DRIVE_POINTS", "drive_info", "drive_chunks",
+__all__ = ["DRIVE_COLUMNS", "CHECK_COLUMNS", "LINE_COLUMNS", "CLAMPED_COLUMNS", "MAX_DRIVE_POINTS", "drive_info", "drive_chunks",
            "drive_response", "LINE_NOTE"]
 
 DRIVE_COLUMNS = ("t", "phi0", "sigma", "current_density", "layer_voltage", "M_A", "theta", "w", "F_block")
 #: the forward model's checks at each time point (1 passed, 0 failed), as in step and estimate
 CHECK_COLUMNS = tuple(f"check_{c}" for c in CHECKS) + ("valid",)
+
+#: with support="clamped-clamped": the clamps' reaction moments (N m) and forces (N), the midspan deflection (m)
+CLAMPED_COLUMNS = CLAMPED_OUTPUTS
 
 #: with a sheet resistance: the stated discretisation error of sigma (C/m^2) and w (m) of the line
 LINE_COLUMNS = ("sigma_error", "w_error")
@@ -85,11 +93,23 @@ def _sheet(sheet_resistance, beam):
     return Rs
 
 
+def _support(support, electrode, strip, Rs):
+    """The checked support and electrode; a clamped-clamped strip or a partial electrode refuses the line."""
+    support = check_support(support)
+    el = check_electrode(electrode, strip.length)
+    if Rs > 0.0 and (support == "clamped-clamped" or el is not None):
+        what = "support clamped-clamped" if support == "clamped-clamped" else "a partial electrode"
+        raise ValueError(f"sheet_resistance: {what} is not supported with the electrode line (its moment is "
+                         "distributed over the full strip, clamped-free and clamped-pinned)")
+    return support, el
+
+
 def drive_info(strip: Strip, model, material: Material, beam="dynamic", viscous_modulus=0.0, sheet_resistance=0.0,
-               line_segments=DEFAULT_SEGMENTS):
+               line_segments=DEFAULT_SEGMENTS, support=None, electrode=None):
     """Header of a run: time constant, R, resonances, notes (what is modelled and what is not)."""
     perm = get_model(model)
     Rs = _sheet(sheet_resistance, beam)
+    support, el = _support(support, electrode, strip, Rs)
     info = {"tau": float(time_constant(strip.thickness, perm, material)),
             "R": float(core_resistance(strip.thickness, material)), "model": perm.name, "beam": beam,
             "viscous_modulus": float(viscous_modulus), "notes": dynamic_notes(beam, viscous_modulus)}
@@ -98,15 +118,20 @@ def drive_info(strip: Strip, model, material: Material, beam="dynamic", viscous_
         info["line_segments"] = 2 * int(line_segments)
         info["notes"] += [LINE_NOTE.format(Rs=Rs, n2=2 * int(line_segments), n=int(line_segments)),
                           SHEET_RESISTANCE_SOURCE]
+    if support is not None or el is not None:
+        info["support"] = support
+        info["electrode"] = None if el is None else list(el)
+        info["notes"] += support_notes(support, el)
     if beam == "dynamic":
         b = BeamDynamics(strip, material, viscous_modulus, 1).beam
-        info["resonances"] = {s: natural_frequencies(s, b, 3).tolist() for s in ("clamped-free", "clamped-pinned")}
+        sups = ("clamped-free", "clamped-pinned") + (("clamped-clamped",) if support == "clamped-clamped" else ())
+        info["resonances"] = {s: natural_frequencies(s, b, 3).tolist() for s in sups}
     return info
 
 
 def drive_chunks(wave, duration, points, *, strip: Strip | None = None, model="constant",
                  material: Material | None = None, beam="dynamic", viscous_modulus=0.0, n_modes=TIME_MODES,
-                 chunk=20_000, sheet_resistance=0.0, line_segments=DEFAULT_SEGMENTS):
+                 chunk=20_000, sheet_resistance=0.0, line_segments=DEFAULT_SEGMENTS, support=None, electrode=None):
     """Yield dicts of column arrays (:data:`DRIVE_COLUMNS`) over ``points`` equally spaced times in [0, duration].
 
     Parameters
@@ -126,6 +151,14 @@ def drive_chunks(wave, duration, points, *, strip: Strip | None = None, model="c
         (:class:`ipmc_asym.dynamics.line_time.LineBeamDynamics`); the chunks also hold :data:`LINE_COLUMNS`.  A stated error above
         :data:`LINE_TOL` of the largest response so far is refused (``ValueError``: more segments).
     line_segments : int   ``N`` of the coarser line
+    support : {None, "clamped-free", "clamped-pinned", "clamped-clamped"}
+        ``None`` (default) and the first two: the columns :data:`DRIVE_COLUMNS` (free tip ``theta``,
+        ``w``; blocked tip ``F_block``); ``clamped-clamped`` adds :data:`CLAMPED_COLUMNS` (the clamps'
+        reaction moments and forces, the midspan deflection; small displacements).
+    electrode : (x1, x2), optional
+        Covered part of the length (m); the moment acts there only and the beam outputs are the
+        small-displacement statics of that load (the forward model's beam is for a full electrode).
+        Neither with ``sheet_resistance > 0`` (``ValueError``).
 
     Notes
     -----
@@ -145,7 +178,11 @@ def drive_chunks(wave, duration, points, *, strip: Strip | None = None, model="c
     if not 2 <= n <= MAX_DRIVE_POINTS:
         raise ValueError(f"points must be an integer in [2, {MAX_DRIVE_POINTS}]; got {points!r}")
     chunk = max(int(chunk), 16)
-    dyn = BeamDynamics(s, m, viscous_modulus, n_modes) if beam == "dynamic" else None
+    support, el = _support(support, electrode, s, Rs)
+    clamped = support == "clamped-clamped"
+    ccols = CLAMPED_COLUMNS if clamped else ()
+    dyn = BeamDynamics(s, m, viscous_modulus, n_modes, el, clamped) if beam == "dynamic" else None
+    lb = strip_beam(s, m, viscous_modulus, el)
     h = d / (n - 1)
     if dyn is not None and h > dyn.period / 40.0:
         need = int(math.ceil(40.0 * d / dyn.period)) + 1
@@ -180,6 +217,11 @@ def drive_chunks(wave, duration, points, *, strip: Strip | None = None, model="c
             fr = quasi_static_forward(u, s, perm, m)
             M, th, w, Fb = (np.asarray(getattr(fr, k), dtype=float) for k in ("M_A", "theta", "w", "F_block"))
             checks = {c: np.asarray(getattr(fr, c), bool).reshape(-1) for c in CHECKS}
+            if el is not None:  # the moment on [x1, x2] only: its small-displacement statics
+                w = _linear_statics(lb, M, "clamped-free", ("w",))["w"]
+                th = _linear_statics(lb, M, "clamped-free", ("theta",))["theta"]
+                Fb = _linear_statics(lb, M, "clamped-pinned", ("F",))["F"]
+            cc = _linear_statics(lb, M, "clamped-clamped") if clamped else {}
         else:
             o = line.advance(t)
             # every node at every time through the forward model; a time point passes a check where every node does
@@ -217,9 +259,11 @@ def drive_chunks(wave, duration, points, *, strip: Strip | None = None, model="c
         valid = np.logical_and.reduce([checks[c] for c in CHECKS])
         if dyn is not None and line is None:
             th, w, Fb = dyn.advance(t, M, th, w, Fb)
+            if clamped:
+                cc = dyn.advance_clamped(t, M, cc)
         cols = {"t": t, "phi0": phi, "sigma": sigma, "layer_voltage": u, "M_A": M, "theta": th, "w": w,
                 "F_block": Fb, "_ub": ub, **{f"check_{c}": checks[c].astype(float) for c in CHECKS},
-                "valid": valid.astype(float), **lc}
+                "valid": valid.astype(float), **lc, **(cc if line is None else {})}
         if held is not None:  # the first row of this chunk repeats the held one
             cols = {k: v[1:] for k, v in cols.items()}
             cols = {k: np.concatenate(([held[k]], cols[k])) for k in cols}
@@ -234,14 +278,14 @@ def drive_chunks(wave, duration, points, *, strip: Strip | None = None, model="c
             g = g[1:]
         emit = slice(None) if last else slice(0, -1)
         J = uu / R + Cg * g
-        out = {k: cols[k][emit] for k in DRIVE_COLUMNS + CHECK_COLUMNS + lcols if k != "current_density"}
+        out = {k: cols[k][emit] for k in DRIVE_COLUMNS + CHECK_COLUMNS + lcols + ccols if k != "current_density"}
         out["current_density"] = J[emit]
         if not last:
             held = {k: v[-1] for k, v in cols.items()}
             prev = (tt[-2], uu[-2])
         else:
             held = {}
-        yield {**{k: out[k] for k in DRIVE_COLUMNS + CHECK_COLUMNS + lcols}, "warnings": warns}
+        yield {**{k: out[k] for k in DRIVE_COLUMNS + CHECK_COLUMNS + lcols + ccols}, "warnings": warns}
         start = stop
         if last:
             break
@@ -250,8 +294,8 @@ def drive_chunks(wave, duration, points, *, strip: Strip | None = None, model="c
 def drive_response(wave, duration, points=1000, **kw):
     """All rows of :func:`drive_chunks` in memory (dict of arrays), for short runs and tests."""
     parts = list(drive_chunks(wave, duration, points, **kw))
-    return {k: np.concatenate([p[k] for p in parts]) for k in DRIVE_COLUMNS + CHECK_COLUMNS + LINE_COLUMNS
-            if k in parts[0]}
+    return {k: np.concatenate([p[k] for p in parts])
+            for k in DRIVE_COLUMNS + CHECK_COLUMNS + LINE_COLUMNS + CLAMPED_COLUMNS if k in parts[0]}
 
 
 def _line_mechanics(M, x, strip: Strip, material: Material):
