@@ -96,3 +96,23 @@ def I_layer_quadrature(g):
     M1a = quad(lambda yp: w(yp) * quad(yw, yp, 0.0, **QKW)[0], ya, 0.0, points=pts, **QKW)[0]
     Jy = M0 - M1 - M0a + M1a
     return int_rho_z / A2 + A3 / A2 * Jy, B1
+
+
+def partial_electrode_statics(L, EI, x1, x2):
+    """Small-displacement statics per unit active moment on ``[x1, x2]`` (closed form, by hand).
+
+    ``EI w'' = m - M_a`` with ``m = A + B x`` (no load).  Free tip (``m = 0``): ``theta = -(x2 - x1)/EI``,
+    ``w = -int_{x1}^{x2} (L - x) dx/EI``.  Pinned tip (``m(L) = 0``, ``w(L) = 0``):
+    ``F = -m' = 3 int_{x1}^{x2} (L - x) dx/L^3``.  Clamped tip (``w(L) = w'(L) = 0``):
+    ``A L + B L^2/2 = x2 - x1``, ``A L^2/2 + B L^3/6 = int_{x1}^{x2} (L - x) dx``; reaction moments
+    ``m(0), m(L)``, forces ``m'(0)``, ``-m'(L)``, and ``w(L/2) = [A h^2/2 + B h^3/6 - int_{[x1, x2] and [0, h]}
+    (h - x) dx]/EI`` with ``h = L/2``.
+    """
+    lever = ((L - x1) ** 2 - (L - x2) ** 2) / 2.0  # int_{x1}^{x2} (L - x) dx
+    A = (6.0 * lever - 2.0 * (x2 - x1) * L) / L**2
+    B = (6.0 * (x2 - x1) * L - 12.0 * lever) / L**3
+    h = L / 2.0
+    c, d = min(x1, h), min(x2, h)
+    w_mid = (A * h * h / 2.0 + B * h**3 / 6.0 - ((h - c) ** 2 - (h - d) ** 2) / 2.0) / EI
+    return {"w": -lever / EI, "theta": -(x2 - x1) / EI, "F": 3.0 * lever / L**3,
+            "M_root": A, "M_tip": A + B * L, "F_root": B, "F_tip": -B, "w_mid": w_mid}

@@ -8,7 +8,8 @@ import sys
 import numpy as np
 
 from ipmc_asym.base.registry import model_names
-from ipmc_asym.base.units import fmt_length, parse_quantity, parse_sheet_resistance, parse_time
+from ipmc_asym.base.units import fmt_length, parse_length, parse_quantity, parse_sheet_resistance, parse_time
+from ipmc_asym.beam.dynamics import SUPPORTS
 from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import (
     add_strip_options,
@@ -23,6 +24,7 @@ from ipmc_asym.cli.common import (
 from ipmc_asym.dynamics.circuit import BEAM_CHOICES
 from ipmc_asym.dynamics.drive import (
     CHECK_COLUMNS,
+    CLAMPED_COLUMNS,
     DRIVE_COLUMNS,
     LINE_COLUMNS,
     MAX_DRIVE_POINTS,
@@ -89,6 +91,56 @@ def add_line_options(p):
                         f"{DEFAULT_SEGMENTS}, at most {MAX_SEGMENTS}")
 
 
+def _electrode_conv(text):
+    parts = str(text).split(":")
+    if len(parts) != 2:
+        raise ValueError(f"--electrode must be X1:X2, the covered part of the length (e.g. 2mm:18mm); got {text!r}")
+    return tuple(parse_length("--electrode", v.strip()) for v in parts)
+
+
+def add_support_options(p):
+    """``--support`` and ``--electrode`` (freq, drive)."""
+    p.add_argument("--support", default=None, choices=SUPPORTS,
+                   help="strip support: clamped-free and clamped-pinned give the default outputs (free tip w, theta; "
+                        "blocked tip F_block); clamped-clamped adds the clamps' reaction moments and forces M_root, "
+                        "M_tip, F_root, F_tip and the midspan deflection w_mid (small displacements)")
+    p.add_argument("--electrode", type=arg_type(_electrode_conv, "--electrode"), default=None,
+                   help="X1:X2 covered part of the length (e.g. 2mm:18mm, 0 <= X1 < X2 <= L; default the whole strip): "
+                        "the active moment acts there only, the beam outputs are small-displacement")
+
+
+def support_from_args(args, strip):
+    """``(support, electrode)`` checked against the strip and the other options (one-line ValueError)."""
+    el = args.electrode
+    if el is not None:
+        x1, x2 = el
+        if not 0.0 <= x1 < x2 <= strip.length:
+            raise ValueError(f"--electrode X1:X2 must satisfy 0 <= X1 < X2 <= L = {fmt_length(strip.length)}; "
+                             f"got {fmt_length(x1)}:{fmt_length(x2)}")
+    if el is not None or args.support == "clamped-clamped":
+        what = "--support clamped-clamped" if args.support == "clamped-clamped" else "--electrode"
+        if getattr(args, "sheet_resistance", None):
+            raise ValueError(f"{what} is not supported with --sheet-resistance (the electrode line's moment is "
+                             "distributed over the full strip, free or blocked tip)")
+    return args.support, el
+
+
+def print_clamped(t_name, t, rows):
+    """Text table of the clamped-clamped outputs (``rows``: dict name -> values at ``t``)."""
+    print(f"clamped-clamped: {t_name:>9s} {'M_root [N m]':>13s} {'M_tip [N m]':>13s} {'F_root [mN]':>12s} "
+          f"{'F_tip [mN]':>12s} {'w_mid [mm]':>11s}")
+    for i in range(len(t)):
+        r = {k: float(v[i]) + 0.0 for k, v in rows.items()}
+        print(f"                 {float(t[i]):9.4g} {r['M_root']:13.5g} {r['M_tip']:13.5g} {r['F_root'] * 1e3:12.5g} "
+              f"{r['F_tip'] * 1e3:12.5g} {r['w_mid'] * 1e3:11.5g}")
+
+
+CLAMPED_UNITS = {"M_root": "N m (reaction moment of the clamp x = 0)", "M_tip": "N m (reaction moment of the clamp x = L)",
+                 "F_root": "N (force of the clamp x = 0 on the strip, +z)",
+                 "F_tip": "N (force of the clamp x = L on the strip, +z; the sign of F_block)",
+                 "w_mid": "m (deflection at x = L/2)"}
+
+
 def add_beam_options(p, default):
     p.add_argument("--beam", default=default, choices=BEAM_CHOICES,
                    help=f"strip mechanics: dynamic (inertia, Kelvin-Voigt damping, resonances) or quasi-static "
@@ -111,6 +163,7 @@ def register(sub):
                    help="cation diffusion coefficient D (1e-10m2/s, 1e-6cm2/s; a bare number is m^2/s)")
     add_beam_options(p, "dynamic")
     add_line_options(p)
+    add_support_options(p)
     p.add_argument("--out", default=None, help="CSV file, written as computed (columns " + ", ".join(DRIVE_COLUMNS)
                    + ", then the forward model's check_* and valid per time point, 1 or 0)")
     p.add_argument("--json", action="store_true", help=f"print one JSON object (at most {MAX_JSON_POINTS:g} points)")
@@ -149,19 +202,22 @@ def run(args):
     if args.diffusion is not None:
         material = material.with_(D=args.diffusion)
     strip = strip_from_args(args)
+    support, electrode = support_from_args(args, strip)
+    clamped = support == "clamped-clamped"
     info = drive_info(strip, args.model, material, args.beam, args.viscous_modulus, args.sheet_resistance,
-                      args.line_segments)
-    columns = COLUMNS + (LINE_COLUMNS if args.sheet_resistance > 0.0 else ())
+                      args.line_segments, support=support, electrode=electrode)
+    columns = COLUMNS + (LINE_COLUMNS if args.sheet_resistance > 0.0 else ()) + (CLAMPED_COLUMNS if clamped else ())
     head = dict(info, waveform=args.waveform.spec, duration=args.duration, points=args.points,
                 thickness_total=strip.thickness, half_thickness_e=strip.e, diffusion_coefficient=material.D,
                 units={"t": "s", "phi0": "V", "sigma": "C/m^2 (face z = -e)", "current_density": "A/m^2",
                        "layer_voltage": "V", "M_A": "N m", "theta": "rad (free tip)", "w": "m (free tip)",
                        "F_block": "N (blocked tip)", "sigma_error": "C/m^2 (electrode line, stated)",
-                       "w_error": "m (electrode line, stated)"})
+                       "w_error": "m (electrode line, stated)", **(CLAMPED_UNITS if clamped else {})})
     first_run_notice()
     gen = drive_chunks(args.waveform, args.duration, args.points, strip=strip, model=args.model, material=material,
                        beam=args.beam, viscous_modulus=args.viscous_modulus, sheet_resistance=args.sheet_resistance,
-                       line_segments=args.line_segments)
+                       line_segments=args.line_segments, support=support, electrode=electrode)
+    shown_cols = DRIVE_COLUMNS + (CLAMPED_COLUMNS if clamped else ())
     show = set(np.unique(np.linspace(0, args.points - 1, min(args.points, 11)).astype(int)).tolist())
     shown, kept = [], []
     seen, counts = {}, {}
@@ -176,7 +232,7 @@ def run(args):
                 _note_warnings(ch, seen, counts)
                 fh.write(_csv_rows(ch, columns))
                 n = ch["t"].size
-                shown += [{c: float(ch[c][i - i0]) for c in DRIVE_COLUMNS} for i in range(i0, i0 + n) if i in show]
+                shown += [{c: float(ch[c][i - i0]) for c in shown_cols} for i in range(i0, i0 + n) if i in show]
                 i0 += n
         sys.stderr.write(f"drive: {args.points} rows -> {args.out}\n")
     else:
@@ -185,7 +241,7 @@ def run(args):
             n = ch["t"].size
             if args.json:
                 kept.append(ch)
-            shown += [{c: float(ch[c][i - i0]) for c in DRIVE_COLUMNS} for i in range(i0, i0 + n) if i in show]
+            shown += [{c: float(ch[c][i - i0]) for c in shown_cols} for i in range(i0, i0 + n) if i in show]
             i0 += n
     # the forward model's failed assumptions: one line each (kept numbers, flagged rows)
     warn_lines = list(seen.values())
@@ -203,13 +259,17 @@ def run(args):
           f"beam {args.beam}: tau = {info['tau']:.4g} s")
     if "resonances" in info:
         print(f"first resonances: free tip {', '.join(f'{v:.4g}' for v in info['resonances']['clamped-free'])} Hz; "
-              f"blocked tip {', '.join(f'{v:.4g}' for v in info['resonances']['clamped-pinned'])} Hz")
+              f"blocked tip {', '.join(f'{v:.4g}' for v in info['resonances']['clamped-pinned'])} Hz"
+              + (f"; clamped-clamped {', '.join(f'{v:.4g}' for v in info['resonances']['clamped-clamped'])} Hz"
+                 if clamped else ""))
     print(f"{'t [s]':>11s} {'phi0 [V]':>9s} {'sigma [C/m^2]':>14s} {'J [A/m^2]':>11s} {'M_A [N m]':>11s} "
           f"{'theta':>9s} {'w [mm]':>9s} {'F_block [mN]':>12s}")
     for r in shown:
         r = {k: v + 0.0 for k, v in r.items()}  # no "-0" in the table
         print(f"{r['t']:11.4g} {r['phi0']:9.4g} {r['sigma']:14.6g} {r['current_density']:11.4g} {r['M_A']:11.4g} "
               f"{r['theta']:9.4g} {r['w'] * 1e3:9.4g} {r['F_block'] * 1e3:12.4g}")
+    if clamped:
+        print_clamped("t [s]", [r["t"] for r in shown], {c: [r[c] for r in shown] for c in CLAMPED_COLUMNS})
     for n in info["notes"]:
         print(f"note: {n}")
     return 0

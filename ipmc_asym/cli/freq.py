@@ -6,6 +6,7 @@ import numpy as np
 
 from ipmc_asym.base.registry import model_names
 from ipmc_asym.base.units import fmt_length, parse_quantity, parse_sheet_resistance
+from ipmc_asym.beam.dynamics import CLAMPED_OUTPUTS
 from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import (
     add_size_option,
@@ -18,7 +19,7 @@ from ipmc_asym.cli.common import (
     strip_from_args,
     voltage_type,
 )
-from ipmc_asym.cli.drive import add_beam_options
+from ipmc_asym.cli.drive import CLAMPED_UNITS, add_beam_options, add_support_options, print_clamped, support_from_args
 from ipmc_asym.dynamics.circuit import FREQ_METHODS, frequency_response
 from ipmc_asym.dynamics.line import line_response
 from ipmc_asym.dynamics.reduction import transfer_function
@@ -67,6 +68,7 @@ def register(sub):
     p.add_argument("--sheet-resistance", dest="sheet_resistance", type=_sheet, default=None,
                    help="sheet resistance of each electrode (2.5ohm/sq; a bare number is Ohm/sq; default 0 = ideal): "
                         "Z and w of the RC line along the strip, driven at the clamp")
+    add_support_options(p)
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--export", metavar="F.json", default=None,
                    help="write reduced-order models of V -> w and V -> charge over [--from, --to] (poles, residues, "
@@ -96,6 +98,11 @@ def run(args):
     if args.diffusion is not None:
         material = material.with_(D=args.diffusion)
     strip = strip_from_args(args)
+    support, electrode = support_from_args(args, strip)
+    clamped = support == "clamped-clamped"
+    if args.export is not None and (clamped or electrode is not None):
+        raise ValueError("--export models the full-electrode strip (free tip): not with --support clamped-clamped or "
+                         "--electrode")
     f = np.geomspace(args.f1, args.f2, args.points)
     if args.voltage != 0.0 and args.method != "circuit":
         raise ValueError("--voltage (a DC bias) needs --method circuit: pnp-linear is the linearisation about 0 V")
@@ -106,12 +113,16 @@ def run(args):
                           viscous_modulus=args.viscous_modulus, voltage=args.voltage)
     else:
         r = frequency_response(f, strip=strip, model=args.model, material=material, method=args.method,
-                               beam=args.beam, viscous_modulus=args.viscous_modulus, voltage=args.voltage)
+                               beam=args.beam, viscous_modulus=args.viscous_modulus, voltage=args.voltage,
+                               **({} if support is None and electrode is None else
+                                  {"support": support, "electrode": electrode}))
     cols = {"f": r.f, "Z_re": r.Z.real, "Z_im": r.Z.imag, "w_amp": r.w_amp, "w_phase": r.w_phase,
             "theta_amp": np.abs(r.H_theta), "theta_phase": np.angle(r.H_theta),
             "F_amp": np.abs(r.H_F), "F_phase": np.angle(r.H_F)}
     if r.error is not None:
         cols["error"] = r.error
+    for n in CLAMPED_OUTPUTS if clamped else ():
+        cols[f"{n}_amp"], cols[f"{n}_phase"] = np.abs(r.H_clamped[n]), np.angle(r.H_clamped[n])
     head = {"tau": r.tau, "model": r.model, "method": r.method, "thickness_total": strip.thickness,
             "f_d": r.f_d, "voltage": args.voltage, "beam": args.beam,
             "viscous_modulus": args.viscous_modulus,
@@ -123,6 +134,10 @@ def run(args):
                       "theta_amp": "rad/V (free tip)", "theta_phase": "rad", "F_amp": "N/V (blocked tip)",
                       "F_phase": "rad", "error": "relative, of Z and w against pnp-linear"},
             "notes": r.notes + [f"about phi0 = {args.voltage:g} V; w from the layers' charge, small displacements"]}
+    if support is not None or electrode is not None:
+        head["support"] = support
+        head["electrode"] = None if electrode is None else list(electrode)
+        head["units"].update({f"{n}_amp": CLAMPED_UNITS[n].replace(" (", "/V (", 1) for n in CLAMPED_OUTPUTS if clamped})
     if args.sheet_resistance is not None:
         head["sheet_resistance"] = args.sheet_resistance
         head["units"]["sheet_resistance"] = "Ohm/sq (each electrode)"
@@ -153,7 +168,9 @@ def run(args):
           f"thickness 2e = {fmt_length(strip.thickness)}{line}: tau = {r.tau:.4g} s, D = {material.D:.3g} m^2/s")
     if head["resonances"]:
         print(f"resonances: free tip {', '.join(f'{v:.4g}' for v in head['resonances']['clamped-free'])} Hz; "
-              f"blocked tip {', '.join(f'{v:.4g}' for v in head['resonances']['clamped-pinned'])} Hz")
+              f"blocked tip {', '.join(f'{v:.4g}' for v in head['resonances']['clamped-pinned'])} Hz"
+              + (f"; clamped-clamped {', '.join(f'{v:.4g}' for v in head['resonances']['clamped-clamped'])} Hz"
+                 if clamped else ""))
     ecol = "error" in cols
     print(f"{'f [Hz]':>11s} {'Z_re [Ohm]':>12s} {'Z_im [Ohm]':>12s} {'|w|/V [mm/V]':>13s} {'phase [rad]':>11s}"
           + (f" {'error':>9s}" if ecol else ""))
@@ -161,6 +178,8 @@ def run(args):
         print(f"{fmt_num(f[i], '11.4g')} {fmt_num(cols['Z_re'][i], '12.5g')} {fmt_num(cols['Z_im'][i], '12.5g')} "
               f"{fmt_num(cols['w_amp'][i] * 1e3, '13.5g')} {fmt_num(cols['w_phase'][i], '11.4g')}"
               + (f" {fmt_num(cols['error'][i], '9.2g')}" if ecol else ""))
+    if clamped:  # amplitudes per volt
+        print_clamped("f [Hz]", f, {n: cols[f"{n}_amp"] for n in CLAMPED_OUTPUTS})
     for n in head["notes"]:
         print(f"note: {n}")
     if args.export is not None:

@@ -61,3 +61,76 @@ def test_circuit_error_is_its_stated_error_and_below_lambda_over_2(thickness, mo
 def test_circuit_band():
     f = np.array([1.0, 2.0, 3.0, 4.0, 5.0])
     assert circuit_band(f, np.array([0.0, 1.0, 0.0, 0.0, 1.0]), 0.5) == [[1.0, 1.0], [3.0, 4.0]]
+
+
+# --- support and electrode of frequency_response -------------------------------------------------------------------
+
+def test_frequency_response_defaults_and_the_full_electrode_clamped_clamped_strip():
+    """``electrode=(0, L)`` and ``support`` clamped-free/pinned are the defaults exactly; with a full electrode
+    the clamped-clamped strip does not move and both clamps take the moment per volt (any frequency)."""
+    strip = Strip()
+    f = np.array([0.5, 20.0, 150.0, 2e3])
+    base = frequency_response(f, strip=strip, beam="dynamic")
+    for kw in ({"electrode": (0.0, strip.length)}, {"support": "clamped-free"}, {"support": "clamped-clamped"}):
+        r = frequency_response(f, strip=strip, beam="dynamic", **kw)
+        for k in ("Z", "H_w", "H_theta", "H_F"):
+            assert np.array_equal(getattr(r, k), getattr(base, k)), (kw, k)
+    cc = r.H_clamped
+    # the moment per volt, independently: the quasi-static free tip's deflection over -L^2/(2 E I_p)
+    qs = frequency_response(f, strip=strip, beam="quasi-static")
+    HM = qs.H_w / (-strip.length**2 / (2 * NAFION_LI.E * strip.I_p))
+    assert np.allclose(cc["M_root"], HM, rtol=1e-13, atol=0) and np.allclose(cc["M_tip"], HM, rtol=1e-13, atol=0)
+    assert np.all(cc["F_root"] == 0) and np.all(cc["F_tip"] == 0) and np.all(cc["w_mid"] == 0)
+    # the clamped-clamped resonances: cos(b) cosh(b) = 1, b1 = 4.730040745 (textbook root)
+    b = frequency_response(f[:1], strip=strip, support="clamped-clamped").resonances["clamped-clamped"][0]
+    A = strip.width * strip.thickness
+    rho = (1 - NAFION_LI.phi4) * NAFION_LI.rho3 + NAFION_LI.phi4 * NAFION_LI.rho2
+    f1 = 4.730040745**2 / (2 * math.pi * strip.length**2) * math.sqrt(NAFION_LI.E * strip.I_p / (rho * A))
+    assert b == pytest.approx(f1, rel=1e-9)
+
+
+@pytest.mark.parametrize("electrode", [(0.002, 0.012), (0.0, 0.006), (0.015, 0.02)])
+def test_frequency_response_partial_electrode_quasi_static_limit_is_the_closed_form_statics(electrode):
+    """f -> 0 (dynamic beam at 0.1 mHz, first mode ~20 Hz) and the quasi-static beam at every frequency: each
+    output per volt is the hand-derived small-displacement statics (tests/references.py) times the moment
+    per volt of the full-electrode strip."""
+    from references import partial_electrode_statics
+
+    strip = Strip()
+    st = partial_electrode_statics(strip.length, NAFION_LI.E * strip.I_p, *electrode)
+    f = np.array([1e-4, 1.0, 30.0])  # the dynamic correction at 0.1 mHz: (f/f1)^2 ~ 2e-11
+    qs = frequency_response(f, strip=strip, beam="quasi-static")
+    HM = qs.H_w / (-strip.length**2 / (2 * NAFION_LI.E * strip.I_p))
+    for beam in ("quasi-static", "dynamic"):
+        r = frequency_response(f, strip=strip, beam=beam, support="clamped-clamped", electrode=electrode)
+        got = {"w": r.H_w, "theta": r.H_theta, "F": r.H_F, **r.H_clamped}
+        n = f.size if beam == "quasi-static" else 1
+        for k, v in st.items():
+            scale = np.abs(HM[:n]) * max(abs(v), abs(st["M_root"]) / strip.length if k.startswith("F") else 0.0,
+                                         abs(st["M_root"]) if k.startswith("M") else 0.0, 1e-300)
+            assert np.all(np.abs(got[k][:n] - HM[:n] * v) <= 1e-9 * scale), (beam, k)
+        assert r.electrode == tuple(electrode) and "partial electrode" in " ".join(r.notes)
+
+
+def test_frequency_response_partial_electrode_resonance():
+    """A damped clamped-clamped strip, electrode on its first fifth: the midspan deflection per volt peaks at
+    the first clamped-clamped resonance, ~1/(2 zeta) above its static value."""
+    from ipmc_asym.beam.dynamics import viscous_modulus_from_damping_ratio
+
+    strip = Strip()
+    f1 = frequency_response([1.0], strip=strip, support="clamped-clamped").resonances["clamped-clamped"][0]
+    eta = viscous_modulus_from_damping_ratio(0.05, f1, NAFION_LI.E)
+    f = np.linspace(0.9, 1.1, 401) * f1
+    kw = dict(strip=strip, support="clamped-clamped", electrode=(0.0, 0.004), viscous_modulus=eta)
+    r = frequency_response(f, beam="dynamic", **kw)
+    q = frequency_response(f, beam="quasi-static", **kw)
+    gain = np.abs(r.H_clamped["w_mid"] / q.H_clamped["w_mid"])
+    assert f[np.argmax(gain)] == pytest.approx(f1, rel=5e-3)
+    assert 7.0 < gain.max() < 13.0  # one mode dominates: Q = 1/(2 zeta) = 10 times its modal share
+
+
+@pytest.mark.parametrize("kw, word", [({"support": "pinned"}, "support"), ({"electrode": (0.01, 0.005)}, "electrode"),
+                                      ({"electrode": (0.0, 0.03)}, "electrode"), ({"electrode": 0.01}, "electrode")])
+def test_frequency_response_support_refusals(kw, word):
+    with pytest.raises(ValueError, match=word):
+        frequency_response([1.0], **kw)
