@@ -127,3 +127,65 @@ def test_sheet_resistance_refusals_one_line(args, word, capsys):
     assert code == 2
     err = capsys.readouterr().err.strip()
     assert word in err and len(err.splitlines()) == 1
+
+
+def test_freq_and_drive_support_and_electrode(tmp_path, capsys):
+    """--support clamped-clamped and --electrode add columns/keys (the default ones kept, in order); the
+    quasi-static clamped-clamped reactions are the hand-derived statics (tests/references.py)."""
+    from references import partial_electrode_statics
+
+    from ipmc_asym.dynamics.drive import drive_response
+    from ipmc_asym.model.params import NAFION_LI, Strip
+
+    base = ["freq", "--from", "1Hz", "--to", "100Hz", "--points", "3", "--beam", "quasi-static", "--json"]
+    assert main(base) == 0
+    a = json.loads(capsys.readouterr().out)
+    assert main(base + ["--support", "clamped-clamped", "--electrode", "2mm:12mm"]) == 0
+    b = json.loads(capsys.readouterr().out)
+    assert set(a) < set(b) and b["electrode"] == pytest.approx([0.002, 0.012]) and "clamped-clamped" in b["resonances"]
+    assert b["Z_re"] == a["Z_re"]
+    s = Strip()
+    st = partial_electrode_statics(s.length, NAFION_LI.E * s.I_p, 0.002, 0.012)
+    full = partial_electrode_statics(s.length, NAFION_LI.E * s.I_p, 0.0, s.length)
+    HM = np.array(a["w_amp"]) / abs(full["w"])  # the moment per volt of the full strip
+    for k in ("M_root", "M_tip", "F_root", "F_tip", "w_mid", "w", "theta", "F"):
+        col = {"w": "w_amp", "theta": "theta_amp", "F": "F_amp"}.get(k, f"{k}_amp")
+        assert np.allclose(b[col], HM * abs(st[k]), rtol=1e-10, atol=0), k
+    # drive: the CSV's header keeps the default columns and appends the new ones; rows = the library's
+    f = tmp_path / "d.csv"
+    assert main(["drive", "--waveform", "step:0.5V", "--duration", "50ms", "--points", "201", "--support",
+                 "clamped-clamped", "--electrode", "2mm:12mm", "--out", str(f)]) == 0
+    capsys.readouterr()
+    rows = list(csv.reader(f.read_text().splitlines()))
+    default = ["drive", "--waveform", "step:0.5V", "--duration", "50ms", "--points", "201", "--json"]
+    assert main(default) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert rows[0][-5:] == ["M_root", "M_tip", "F_root", "F_tip", "w_mid"] and all(c in rows[0] for c in d if
+                                                                                     c in ("t", "w", "valid"))
+    r = drive_response("step:0.5V", 0.05, 201, support="clamped-clamped", electrode=(0.002, 0.012))
+    for c in ("w", "M_root", "F_tip", "w_mid"):
+        assert np.allclose([float(x[rows[0].index(c)]) for x in rows[1:]], r[c], rtol=1e-15, atol=0), c
+    side = json.loads((tmp_path / "d.csv.json").read_text())
+    assert side["support"] == "clamped-clamped" and "M_root" in side["units"]
+
+
+@pytest.mark.parametrize("args, word", [
+    (["freq", "--from", "1Hz", "--to", "2Hz", "--electrode", "12mm:2mm"], "--electrode"),
+    (["freq", "--from", "1Hz", "--to", "2Hz", "--electrode", "2mm:3cm"], "--electrode"),
+    (["freq", "--from", "1Hz", "--to", "2Hz", "--electrode", "2mm"], "--electrode"),
+    (["freq", "--from", "1Hz", "--to", "2Hz", "--support", "pinned"], "--support"),
+    (["freq", "--from", "1Hz", "--to", "2Hz", "--support", "clamped-clamped", "--sheet-resistance", "2"],
+     "--sheet-resistance"),
+    (["freq", "--from", "1Hz", "--to", "2Hz", "--electrode", "0:1cm", "--export", "x.json"], "--export"),
+    (["drive", "--waveform", "step:1V", "--duration", "1s", "--electrode", "0:1cm", "--sheet-resistance", "2.5"],
+     "--sheet-resistance"),
+    (["drive", "--waveform", "step:1V", "--duration", "1s", "--electrode", "-1mm:1cm"], "--electrode"),
+])
+def test_support_and_electrode_refusals_one_line(args, word, capsys):
+    try:
+        code = main(args)
+    except SystemExit as e:
+        code = e.code
+    assert code == 2
+    err = capsys.readouterr().err.strip()
+    assert word in err and len(err.splitlines()) == 1

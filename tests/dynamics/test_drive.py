@@ -84,3 +84,53 @@ def test_frequency_response_dynamic_over_quasi_static_is_the_beam_transfer():
     assert any("Darcy" in n for n in d.notes) and any("inertia" in n for n in d.notes)
     # the resonance of the free strip shows in |H_w|
     assert d.w_amp[2] > 5 * q.w_amp[2] and d.w_amp[3] > 5 * q.w_amp[3]
+
+
+# --- support and electrode of drive_response ------------------------------------------------------------------------
+
+CC_KEYS = ("M_root", "M_tip", "F_root", "F_tip", "w_mid")
+
+
+@pytest.mark.parametrize("beam", ["dynamic", "quasi-static"])
+def test_drive_clamped_clamped_full_electrode_gives_the_moment_to_the_clamps(beam):
+    """Columns are only added: the default ones are unchanged; with a full electrode the clamped-clamped
+    strip does not move and both reaction moments are M_A(t) (the beam docstring's limit), at every time."""
+    base = drive_response(SPEC, 0.1, 1001, beam=beam)
+    r = drive_response(SPEC, 0.1, 1001, beam=beam, support="clamped-clamped")
+    assert all(np.array_equal(base[k], r[k]) for k in base)
+    assert np.array_equal(r["M_root"], r["M_A"]) and np.array_equal(r["M_tip"], r["M_A"])
+    assert all(np.all(r[k] == 0.0) for k in ("F_root", "F_tip", "w_mid"))
+    assert not set(CC_KEYS) & set(drive_response(SPEC, 0.1, 1001, beam=beam, support="clamped-free"))
+
+
+def test_drive_partial_electrode_static_limit_is_the_closed_form_statics():
+    """Quasi-static beam: every row is the hand-derived small-displacement statics (tests/references.py) times
+    M_A(t); dynamic, damped, after the transient: the same at the end (the clamped-clamped reactions, the
+    free tip's w and theta, the blocked tip's force)."""
+    from references import partial_electrode_statics
+
+    strip = Strip()
+    x1, x2 = 0.002, 0.012
+    st = partial_electrode_statics(strip.length, NAFION_LI.E * strip.I_p, x1, x2)
+    cols = {"w": "w", "theta": "theta", "F": "F_block", **{k: k for k in CC_KEYS}}
+    q = drive_response("step:0.5V", 0.3, 601, beam="quasi-static", support="clamped-clamped", electrode=(x1, x2))
+    for k, c in cols.items():
+        assert np.allclose(q[c], st[k] * q["M_A"], rtol=1e-12, atol=1e-15 * abs(st[k] * q["M_A"][-1])), k
+    f1 = natural_frequencies("clamped-free", strip_beam(strip, NAFION_LI), 1)[0]
+    eta = viscous_modulus_from_damping_ratio(0.2, f1, NAFION_LI.E)
+    r = drive_response("step:0.5V", 1.0, 4001, beam="dynamic", viscous_modulus=eta, support="clamped-clamped",
+                       electrode=(x1, x2))
+    assert np.array_equal(r["M_A"], drive_response("step:0.5V", 1.0, 4001, beam="quasi-static")["M_A"])
+    for k, c in cols.items():
+        assert r[c][-1] == pytest.approx(st[k] * r["M_A"][-1], rel=1e-7), k
+
+
+@pytest.mark.parametrize("kw, word", [
+    ({"support": "clamped-clamped", "sheet_resistance": 2.5}, "sheet_resistance"),
+    ({"electrode": (0.0, 0.01), "sheet_resistance": 2.5}, "sheet_resistance"),
+    ({"electrode": (0.01, 0.03)}, "electrode"),
+    ({"support": "free"}, "support"),
+])
+def test_drive_support_refusals(kw, word):
+    with pytest.raises(ValueError, match=word):
+        drive_response("step:0.5V", 0.1, 1001, **kw)
