@@ -487,7 +487,9 @@ def transfer(f, beam: Beam, support="clamped-free", n_modes=DEFAULT_MODES):
     dict of complex ndarrays and floats
         clamped-free: ``w`` (m/(N m)), ``theta`` (rad/(N m)); clamped-pinned: ``F`` (N/(N m),
         the blocking force), ``theta``; clamped-clamped: ``M_root`` (the reaction moment at the
-        clamp x = 0 per unit moment).  ``static``: the same at f = 0 (exact small-displacement
+        clamp x = 0 per unit moment) and ``M_tip``, ``F_root``, ``F_tip``, ``w_mid``
+        (:data:`SUPPORT_OUTPUTS`).  A partial electrode (``beam.electrode``) takes the statics of
+        :func:`static_outputs` in the same expansion.  ``static``: the same at f = 0 (exact small-displacement
         statics); ``dynamic_factor``: each divided by its static value (where that is not 0);
         ``truncation``: relative size of the last kept mode's term (the tail is smaller).
     """

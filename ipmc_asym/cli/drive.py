@@ -125,10 +125,11 @@ def support_from_args(args, strip):
     return args.support, el
 
 
-def print_clamped(t_name, t, rows):
-    """Text table of the clamped-clamped outputs (``rows``: dict name -> values at ``t``)."""
-    print(f"clamped-clamped: {t_name:>9s} {'M_root [N m]':>13s} {'M_tip [N m]':>13s} {'F_root [mN]':>12s} "
-          f"{'F_tip [mN]':>12s} {'w_mid [mm]':>11s}")
+def print_clamped(t_name, t, rows, per=""):
+    """Text table of the clamped-clamped outputs (``rows``: dict name -> values at ``t``; ``per``: "/V" for amplitudes)."""
+    print(f"clamped-clamped: {t_name:>9s} {f'|M_root| [N m{per}]' if per else 'M_root [N m]':>13s} "
+          f"{f'|M_tip| [N m{per}]' if per else 'M_tip [N m]':>13s} {f'|F_root| [mN{per}]' if per else 'F_root [mN]':>12s} "
+          f"{f'|F_tip| [mN{per}]' if per else 'F_tip [mN]':>12s} {f'|w_mid| [mm{per}]' if per else 'w_mid [mm]':>11s}")
     for i in range(len(t)):
         r = {k: float(v[i]) + 0.0 for k, v in rows.items()}
         print(f"                 {float(t[i]):9.4g} {r['M_root']:13.5g} {r['M_tip']:13.5g} {r['F_root'] * 1e3:12.5g} "

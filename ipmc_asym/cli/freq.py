@@ -138,6 +138,7 @@ def run(args):
         head["support"] = support
         head["electrode"] = None if electrode is None else list(electrode)
         head["units"].update({f"{n}_amp": CLAMPED_UNITS[n].replace(" (", "/V (", 1) for n in CLAMPED_OUTPUTS if clamped})
+        head["units"].update({f"{n}_phase": "rad" for n in CLAMPED_OUTPUTS if clamped})
     if args.sheet_resistance is not None:
         head["sheet_resistance"] = args.sheet_resistance
         head["units"]["sheet_resistance"] = "Ohm/sq (each electrode)"
@@ -179,7 +180,7 @@ def run(args):
               f"{fmt_num(cols['w_amp'][i] * 1e3, '13.5g')} {fmt_num(cols['w_phase'][i], '11.4g')}"
               + (f" {fmt_num(cols['error'][i], '9.2g')}" if ecol else ""))
     if clamped:  # amplitudes per volt
-        print_clamped("f [Hz]", f, {n: cols[f"{n}_amp"] for n in CLAMPED_OUTPUTS})
+        print_clamped("f [Hz]", f, {n: cols[f"{n}_amp"] for n in CLAMPED_OUTPUTS}, per="/V")
     for n in head["notes"]:
         print(f"note: {n}")
     if args.export is not None:

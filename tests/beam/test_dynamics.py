@@ -445,21 +445,24 @@ def test_clamped_clamped_full_electrode_gives_the_moment_to_the_clamps():
     assert abs(ref["M_root"] - 1.0) < 1e-9 and abs(ref["w_mid"]) < 1e-12 * BEAM.length**2 / BEAM.EI
 
 
-def test_time_response_of_a_clamped_clamped_partial_electrode_reaches_the_exact_harmonic_state():
+@pytest.mark.parametrize("support,electrode", [("clamped-clamped", PARTIAL), ("clamped-pinned", (0.005, 0.02)),
+                                               ("clamped-free", PARTIAL)])
+def test_time_response_of_a_partial_electrode_reaches_the_exact_harmonic_state(support, electrode):
     """A sine moment switched on at rest, damped: after the transient the modal integrator's outputs
-    (every clamped-clamped output) are the exact continuous beam's harmonic response."""
-    from ipmc_asym.beam.dynamics import CLAMPED_OUTPUTS, static_outputs
+    (every output of the support) are the exact continuous beam's harmonic response."""
+    from ipmc_asym.beam.dynamics import SUPPORT_OUTPUTS, static_outputs
 
-    f1 = natural_frequencies("clamped-clamped", BEAM, 1)[0]
+    f1 = natural_frequencies(support, BEAM, 1)[0]
     eta = viscous_modulus_from_damping_ratio(0.1, f1, NAFION_LI.E)
-    beam = Beam.from_strip(0.02, 5e-3, 200e-6, NAFION_LI, viscous_modulus=eta, electrode=PARTIAL)
+    beam = Beam.from_strip(0.02, 5e-3, 200e-6, NAFION_LI, viscous_modulus=eta, electrode=electrode)
     fd = 0.6 * f1
     t = np.linspace(0.0, 60.0 / fd, 60 * 200 + 1)
     M = np.sin(2 * math.pi * fd * t)
-    st = static_outputs("clamped-clamped", beam)
-    out = ModalIntegrator(beam, "clamped-clamped").advance(t, M, {n: st[n][0] * M for n in CLAMPED_OUTPUTS})
-    ref = _exact_beam(fd, beam, "clamped-clamped")
+    st = static_outputs(support, beam)
+    names = SUPPORT_OUTPUTS[support]
+    out = ModalIntegrator(beam, support).advance(t, M, {n: st[n][0] * M for n in names})
+    ref = _exact_beam(fd, beam, support)
     last = t > 58.0 / fd
-    for n in CLAMPED_OUTPUTS:
+    for n in names:
         want = np.imag(ref[n] * np.exp(2j * math.pi * fd * t[last]))
         assert np.max(np.abs(out[n][last] - want)) < 2e-3 * abs(ref[n]), n
