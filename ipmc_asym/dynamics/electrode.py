@@ -128,7 +128,7 @@ def _dhat(Y, rho, model_id):
     return G.dhat(Y, rho)
 
 
-@jit
+@jit(inline="always")  # a node of the driver's inner loop: no call per node
 def _chat_generic(u, sgn, rho, wt):
     """``wt chat(sgn u)`` (generic rho): the integrand of :func:`_layer_integral`."""
     return wt * GC.layer_capacitance(sgn * u, rho)

@@ -77,7 +77,7 @@ def _ehat(y, rho):
     return rho + (1.0 - rho) * math.exp(y)
 
 
-@jit
+@jit(inline="always")  # a node of the driver's inner loop: no call per node
 def _w_integrand(u, sg, rho, wt):
     """``wt (ehat/|s| - 1/u) = wt (ehat u/|s| - 1)/u`` at ``y = sg u``, ``|s| = Dhat(y) = u sqrt(Qhat)``."""
     y = sg * u

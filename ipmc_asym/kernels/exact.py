@@ -298,13 +298,13 @@ def make_exact_driver(core_point, outer_point):
     return core_fill, outer_fill, solve
 
 
-@jit
+@jit(inline="always")  # a node of the driver's inner loop: no call per node
 def _exact_core_point(y, t2, rho):
     f, g = exact_core(y, t2, rho)
     return f, g, y
 
 
-@jit
+@jit(inline="always")  # a node of the driver's inner loop: no call per node
 def _exact_outer_point(y, rho):
     e, s2 = exact_outer_parts(y, rho)
     return e, s2, y

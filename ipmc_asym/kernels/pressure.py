@@ -171,7 +171,7 @@ def face_values(A2, rho, b0, g0):
     return Yc, Ya, r1 <= 1e-12 and r2 <= 1e-12
 
 
-@jit
+@jit(inline="always")  # a node of the driver's inner loop: no call per node
 def _core_point(y, t2, par):
     """``(F, dF/dell, P)`` at a core node: ``(ehat_b, Q)`` in place of the paper's ``(ehat, Qhat)``."""
     rho, b0, A3, g0 = par
@@ -181,7 +181,7 @@ def _core_point(y, t2, par):
     return f, f * (1.0 - t2) / t1, _p_of_y(y, A3, b0, g0)
 
 
-@jit
+@jit(inline="always")  # a node of the driver's inner loop: no call per node
 def _outer_point(y, par):
     """``(ehat_b, S, P)`` at an outer node."""
     rho, b0, A3, g0 = par
