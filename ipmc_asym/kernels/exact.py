@@ -216,10 +216,13 @@ def make_exact_driver(core_point, outer_point):
         OG = np.empty(nout)
         # core nodes: depend on kappa unless every node has v > 20 (then y = ysw e^{-d}, t2 = 1)
         ncore = 80 * split * n
-        CF = np.empty((2, ncore))
-        CG = np.empty((2, ncore))
-        CY = np.empty((2, ncore))
-        CH = np.empty((2, ncore))
+        # the length alone refills the cores at every pass: one set of buffers serves both sides
+        # (half the working set of the Newton loop)
+        nbuf = 2 if with_moments else 1
+        CF = np.empty((nbuf, ncore))
+        CG = np.empty((nbuf, ncore))
+        CY = np.empty((nbuf, ncore))
+        CH = np.empty((nbuf, ncore))
         npc = np.zeros(2, dtype=np.int64)
         frozen = np.zeros(2, dtype=np.bool_)
         acc = np.empty(4)
@@ -241,14 +244,15 @@ def make_exact_driver(core_point, outer_point):
                 m, dm = _core_layout(ysw, V1)
                 v_bottom = V1 - dm
                 asym = v_bottom > 20.0
+                c = s if with_moments else 0
                 if not (asym and frozen[s]):
-                    npc[s] = core_fill(ysw, sgns[s], V1, m, par, X, split, CF[s], CG[s], CY[s], CH[s], asym)
+                    npc[s] = core_fill(ysw, sgns[s], V1, m, par, X, split, CF[c], CG[c], CY[c], CH[c], asym)
                     frozen[s] = asym and with_moments
                 acc[0] = lam * v_bottom
                 acc[1] = lam * math.tanh(V1)  # int sech^2 dv over the core; the rest is G - sech^2
                 acc[2] = 0.0
                 acc[3] = 0.0
-                _accumulate(lam, CF[s], CG[s], CY[s], CH[s], npc[s], acc[0], Wt, S, moments, acc)
+                _accumulate(lam, CF[c], CG[c], CY[c], CH[c], npc[s], acc[0], Wt, S, moments, acc)
                 zeta1 = acc[0]
                 # outer panels: F, G from the cached (ehat, s2)
                 for q in range(npo[s] * n):
