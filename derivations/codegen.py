@@ -28,6 +28,10 @@ SPECIAL = ("exprel", "e2rel", "li2", "li3")
 
 
 class _Printer(PythonCodePrinter):
+    #: wrap every unrolled integer power in parentheses (``x*(t*t)``); False: only where
+    #: the grammar needs it, the lone factor of a denominator (``x/(t*t)``)
+    group_powers = False
+
     def __init__(self):
         super().__init__({"fully_qualified_modules": True, "standard": "python3"})
 
@@ -46,6 +50,13 @@ class _Printer(PythonCodePrinter):
     def _print_Integer(self, expr):
         return f"{int(expr)}.0"
 
+    @staticmethod
+    def _unrolled(expr) -> bool:
+        """True where :meth:`_print_Pow` prints ``expr`` as a product ``b*b*...`` (a string of
+        the precedence of a product, not of a power)."""
+        base, exp = expr.as_base_exp()
+        return bool(expr.is_Pow and exp.is_Integer and 1 < int(exp) <= 4 and not base.is_Number)
+
     def _print_Pow(self, expr, rational=False):
         base, exp = expr.as_base_exp()
         if base.is_Number and exp.is_Rational:  # e.g. sqrt(402): a literal, not a call
@@ -58,25 +69,37 @@ class _Printer(PythonCodePrinter):
             b = self._print(base)
             inner = f"({b})*math.sqrt({b})"
             return f"({inner})" if exp > 0 else f"(1.0/({inner}))"
-        if exp.is_Integer and 1 < int(exp) <= 4:
+        if self._unrolled(expr):
             b = self.parenthesize(base, sp.printing.precedence.PRECEDENCE["Pow"])
-            return "*".join([b] * int(exp))
+            out = "*".join([b] * int(exp))
+            return f"({out})" if self.group_powers else out
         if exp.is_Integer and -4 <= int(exp) < 0:
             b = self.parenthesize(base, sp.printing.precedence.PRECEDENCE["Pow"])
             return "(1.0/(" + "*".join([b] * (-int(exp))) + "))"
         return super()._print_Pow(expr, rational)
 
+    def _print_Mul(self, expr):
+        # SymPy's Mul printer writes a lone denominator factor as ``num/den`` without
+        # parentheses, by the precedence of a power; an unrolled power is a product there
+        # (``x/t*t`` would be ``(x/t)*t``): group it.  Numerators are left as SymPy orders them.
+        out = super()._print_Mul(expr)
+        if self.group_powers:
+            return out
+        den = [f for f in sp.Mul.make_args(expr)
+               if f.is_commutative and f.is_Pow and f.exp.is_Rational and f.exp.is_negative]
+        if len(den) == 1 and den[0].exp != -1:
+            d = sp.Pow(den[0].base, -den[0].exp, evaluate=False)
+            if self._unrolled(d):
+                tail = "/" + self.parenthesize(d, sp.printing.precedence.precedence(expr))
+                if out.endswith(tail):
+                    return out[:-len(tail)] + "/(" + tail[1:] + ")"
+        return out
+
 
 class _GroupedPrinter(_Printer):
-    """:class:`_Printer` with integer powers parenthesised: ``x/(t*t*t*t)``, not ``x/t*t*t*t``
-    (the plain printer's unrolled power reads wrongly after a division)."""
+    """:class:`_Printer` with every unrolled integer power parenthesised: ``x*(t*t)``, ``x/(t*t*t*t)``."""
 
-    def _print_Pow(self, expr, rational=False):
-        out = super()._print_Pow(expr, rational)
-        base, exp = expr.as_base_exp()
-        if exp.is_Integer and 1 < int(exp) <= 4 and not base.is_Number:
-            return f"({out})"
-        return out
+    group_powers = True
 
 
 def render_kernel(k: Kernel, printer=None) -> str:
@@ -295,11 +318,19 @@ def write() -> list:
     return out
 
 
-def check() -> int:
-    """Regenerate every target in memory; 0 if all are identical to the files, else diff and 1."""
+def check(only=None) -> int:
+    """Regenerate every target (or those named in ``only``, file names such as
+    ``"_generated_exact.py"``) in memory; 0 if all are identical to the files, else diff and 1."""
     _pin_warning()
     status = 0
+    if only is not None:
+        unknown = set(only) - {t.name for t in TARGETS}
+        if unknown:
+            raise ValueError(f"no generated module named {', '.join(sorted(unknown))}; "
+                             f"one of {', '.join(t.name for t in TARGETS)}")
     for target, build in TARGETS.items():
+        if only is not None and target.name not in only:
+            continue
         fresh = build()
         rel = target.relative_to(ROOT)
         try:

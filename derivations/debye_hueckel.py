@@ -38,6 +38,12 @@ over ``u^2 (1 - Q)^j`` (no overflow at any ``u``); below ``U_SERIES`` (thin stri
 from __future__ import annotations
 
 import functools
+import hashlib
+import os
+import pickle
+import sys
+import tempfile
+from pathlib import Path
 
 import mpmath as mp
 import sympy as sp
@@ -259,10 +265,48 @@ def b1_series(order: int = 4):
     return sp.expand(B.subs(sol))
 
 
+def _cache_path() -> Path:
+    """Where :func:`order_four` keeps its result: keyed by the sources it is derived from (this
+    module and ``model.py``) and the SymPy, mpmath and Python versions, so any change of them
+    derives it again."""
+    h = hashlib.sha256()
+    for p in (Path(__file__), Path(M.__file__)):
+        h.update(p.read_bytes())
+    h.update(f"{sp.__version__} {mp.__version__} {sys.version_info[:2]}".encode())
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return Path(base) / "ipmc_asym" / "derivations" / f"dh_order4-{h.hexdigest()[:16]}.pickle"
+
+
+@functools.lru_cache(maxsize=None)
+def order_four():
+    """``I4(u, E, rho, A3)``, unsimplified: ``perturbation(5)[4]`` (~40 s of SymPy), cached on
+    disk by :func:`_cache_path` (a missing or unreadable cache file is derived again)."""
+    path = _cache_path()
+    try:
+        with open(path, "rb") as fh:
+            return pickle.load(fh)
+    except (OSError, pickle.UnpicklingError, EOFError, AttributeError, ImportError):
+        pass
+    I4 = perturbation(5)[4]
+    tmp = None
+    try:  # atomic: a concurrent or interrupted run never leaves a partial file
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp")
+        with os.fdopen(fd, "wb") as fh:
+            pickle.dump(I4, fh)
+        os.replace(tmp, path)
+    except OSError:  # a read-only cache: derived again next time
+        if tmp is not None and os.path.exists(tmp):
+            os.unlink(tmp)
+    return I4
+
+
 @functools.lru_cache(maxsize=None)
 def remainder_constants():
     """``(K4A, K4B)``: ``|I4| <= (K4A + K4B |A3|) n(u)`` over u in [0.02, 1e4], rho in [0, 1]."""
-    f = sp.lambdify((u, E, rho, A3), perturbation(5)[4], "mpmath")
+    # common subexpressions evaluated once: the unsimplified I4 (~5e4 operations) evaluates ~30x
+    # faster at the same 60 digits; both maxima agree with the plain evaluation to 40 digits
+    f = sp.lambdify((u, E, rho, A3), order_four(), "mpmath", cse=True)
     worst_a = worst_b = mp.mpf(0)
     with mp.workdps(60):
         for ui in mp.linspace(mp.log(mp.mpf("0.02")), mp.log(mp.mpf(10000)), 22):

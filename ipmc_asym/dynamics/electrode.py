@@ -43,6 +43,7 @@ from ipmc_asym.kernels import _generated as G
 from ipmc_asym.kernels import _generated_charge as GC
 from ipmc_asym.kernels.charge_exact import TINY_A2, charge_exact_point, closed_charge_errors, layer_potentials
 from ipmc_asym.kernels.jit import jit, jit_parallel, prange
+from ipmc_asym.kernels.quadrature import doubling_panels
 from ipmc_asym.kernels.special import gauss_legendre
 from ipmc_asym.model import groups
 from ipmc_asym.model.params import NAFION_LI, Material, Strip, check_positive
@@ -127,28 +128,22 @@ def _dhat(Y, rho, model_id):
     return G.dhat(Y, rho)
 
 
+@jit(inline="always")  # a node of the driver's inner loop: no call per node
+def _chat_generic(u, sgn, rho, wt):
+    """``wt chat(sgn u)`` (generic rho): the integrand of :func:`_layer_integral`."""
+    return wt * GC.layer_capacitance(sgn * u, rho)
+
+
+_chat_panels = doubling_panels(_chat_generic)
+
+
 @jit
 def _layer_integral(Yc, rho, X, Wt):
     """``int_0^Yc chat(y) dy`` (generic rho) on panels with breakpoints 0, 1/2, 1, 2, 4, ..."""
     if Yc == 0.0:
         return 0.0
     sgn = 1.0 if Yc > 0.0 else -1.0
-    T = abs(Yc)
-    total = 0.0
-    a = 0.0
-    b = min(0.5, T)
-    while True:
-        hm = 0.5 * (b - a)
-        xm = 0.5 * (a + b)
-        s = 0.0
-        for j in range(X.shape[0]):
-            s += Wt[j] * GC.layer_capacitance(sgn * (xm + hm * X[j]), rho)
-        total += hm * s
-        if b >= T:
-            break
-        a = b
-        b = min(2.0 * b, T)
-    return total
+    return _chat_panels(abs(Yc), sgn, rho, X, Wt)
 
 
 @jit

@@ -19,7 +19,7 @@ from ipmc_asym.integral.api import ANY_THICKNESS, check_fidelity, check_min_thic
 from ipmc_asym.model.params import NAFION_LI, Material
 from ipmc_asym.model.permittivity import get_model
 
-__all__ = ["moment_escalating", "Escalated", "check_tol", "rung_checks", "ladder_inputs"]
+__all__ = ["moment_escalating", "Escalated", "Climb", "check_tol", "rung_checks", "ladder_inputs"]
 
 
 def check_tol(tol, what="tol"):
@@ -74,6 +74,39 @@ class Escalated:
     message: str
 
 
+class Climb:
+    """What a climb of the ladder records per point, rung by rung (``n`` flat points): the
+    bookkeeping of :func:`moment_escalating` and of the per-point ``C_moy`` ladder of
+    :mod:`ipmc_asym.forward.model`, which differ in how a rung is evaluated only."""
+
+    def __init__(self, n: int):
+        self.I = np.full(n, np.nan)
+        self.error = np.full(n, np.inf)
+        self.B1 = np.full(n, np.nan)
+        self.core = np.full(n, np.nan)
+        self.used = np.full(n, "", dtype=f"U{max(len(f) for f in fidelity_names())}")
+        self.elec = np.zeros(n, bool)
+        self.layer = np.zeros(n, bool)
+
+    def take(self, f: str, idx, ok, I, error, core, e_ok, l_ok, B1=None):
+        """Rung ``f`` evaluated at the points ``idx``: its checks recorded there, its values kept
+        where ``ok``; returns the points kept."""
+        sel = idx[ok]
+        self.I[sel], self.error[sel], self.core[sel], self.used[sel] = I[ok], error[ok], core[ok], f
+        if B1 is not None:
+            self.B1[sel] = B1[ok]
+        self.elec[idx], self.layer[idx] = e_ok, l_ok
+        return sel
+
+    def result(self, valid, message: str, shape=None) -> "Escalated":
+        """The climb as an :class:`Escalated` (arrays reshaped to ``shape`` if given)."""
+        rs = (lambda a: a) if shape is None else (lambda a: a.reshape(shape))
+        return Escalated(I=rs(self.I), error=rs(self.error), B1=rs(self.B1), core=rs(self.core),
+                         fidelity_used=rs(self.used), electrochemistry=rs(self.elec | valid),
+                         layer_separation=rs(self.layer | valid), valid=rs(valid), success=rs(valid),
+                         message=message)
+
+
 def ladder_inputs(thickness, voltage, fidelity, tol):
     """The checked inputs of a ladder climb: ``(tol, limit, thickness, voltage, shape)`` with the
     inputs broadcast and flattened, ``limit = min(tol, VALIDITY_LIMIT)``, the fidelity and the
@@ -116,13 +149,7 @@ def moment_escalating(thickness, voltage, model="constant", fidelity="quadrature
     tol, limit, th, v, shape = ladder_inputs(thickness, voltage, fidelity, tol)
     perm = get_model(model)
     n = th.size
-    I = np.full(n, np.nan)
-    err = np.full(n, np.inf)
-    B1 = np.full(n, np.nan)
-    core = np.full(n, np.nan)
-    used = np.full(n, "", dtype=f"U{max(len(f) for f in fidelity_names())}")
-    elec = np.zeros(n, bool)
-    layer = np.zeros(n, bool)
+    climb = Climb(n)
     todo = np.ones(n, bool)
     why = []
     names = fidelity_names()
@@ -143,9 +170,7 @@ def moment_escalating(thickness, voltage, model="constant", fidelity="quadrature
         e_ok, l_ok = rung_checks(r.I, r.error, r.core, f, limit)
         # r.valid adds the rung's own ceiling (registry) to the checks here
         ok = e_ok & l_ok & np.asarray(r.success) & np.asarray(r.valid)
-        sel = idx[ok]
-        I[sel], err[sel], B1[sel], core[sel], used[sel] = r.I[ok], r.error[ok], r.B1[ok], r.core[ok], f
-        elec[idx], layer[idx] = e_ok, l_ok
+        sel = climb.take(f, idx, ok, r.I, r.error, r.core, e_ok, l_ok, B1=r.B1)
         todo[sel] = False
         bad = ~ok
         if np.any(bad):
@@ -161,7 +186,4 @@ def moment_escalating(thickness, voltage, model="constant", fidelity="quadrature
         k = int(np.flatnonzero(todo)[0])
         msg = (f"no valid fidelity at thickness (total 2e) {th[k]:.3g} m, voltage {v[k]:.3g} V "
                f"(model {perm.name}): " + "; ".join(why[-3:]))
-    rs = (lambda a: a.reshape(shape))
-    return Escalated(I=rs(I), error=rs(err), B1=rs(B1), core=rs(core), fidelity_used=rs(used),
-                     electrochemistry=rs(elec | valid), layer_separation=rs(layer | valid),
-                     valid=rs(valid), success=rs(valid), message=msg)
+    return climb.result(valid, msg, shape)

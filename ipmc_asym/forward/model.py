@@ -31,10 +31,10 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ipmc_asym.base.registry import FIDELITIES as _FIDELITY_SPECS
-from ipmc_asym.base.registry import compiled_fidelities, fidelity_names
+from ipmc_asym.base.registry import compiled_fidelities
 from ipmc_asym.base.settings import OUTSIDE_REGIMES, STRAIN_LIMIT, STRAIN_LIMIT_SOURCE, VALIDATED_VOLTAGE, VALIDITY_LIMIT
 from ipmc_asym.beam.statics import REGIMES, blocking_force_ratio, solve_beam
-from ipmc_asym.forward.escalation import Escalated, check_tol, moment_escalating, rung_checks
+from ipmc_asym.forward.escalation import Climb, Escalated, check_tol, moment_escalating, rung_checks
 from ipmc_asym.forward.pressure import moment_pressure_escalating
 from ipmc_asym.integral.api import check_fidelity, check_min_thickness, closed_model_id, validity_limit
 from ipmc_asym.integral.samples import moment_samples
@@ -343,14 +343,8 @@ def _moment_per_point_material(th, v, perm, fidelity, material, c_moy, tol, esca
     rho = perm.eps0 / eps_core
     sign = np.sign(v)
     n = th.size
-    I = np.full(n, np.nan)
-    err = np.full(n, np.inf)
+    climb = Climb(n)
     last_err = np.full(n, np.inf)
-    B1 = np.full(n, np.nan)
-    core = np.full(n, np.nan)
-    used = np.full(n, "", dtype=f"U{max(len(f) for f in fidelity_names())}")
-    elec = np.zeros(n, bool)
-    layer = np.zeros(n, bool)
     todo = np.arange(n)
     ladder = SAMPLING_FIDELITIES[SAMPLING_FIDELITIES.index(fidelity):] if escalate else (fidelity,)
     for f in ladder:
@@ -362,9 +356,8 @@ def _moment_per_point_material(th, v, perm, fidelity, material, c_moy, tol, esca
         e_ok, l_ok = rung_checks(Ii, ei, ci, f, limit)
         e_ok &= ei < validity_limit(f)  # the rung's own ceiling (integral.api.validity_limit)
         ok = e_ok & l_ok
-        sel = todo[ok]
-        I[sel], err[sel], core[sel], used[sel] = Ii[ok], ei[ok], ci[ok], f
-        elec[todo], layer[todo], last_err[todo] = e_ok, l_ok, ei
+        climb.take(f, todo, ok, Ii, ei, ci, e_ok, l_ok)
+        last_err[todo] = ei
         todo = todo[~ok]
     valid = np.ones(n, bool)
     valid[todo] = False
@@ -372,8 +365,7 @@ def _moment_per_point_material(th, v, perm, fidelity, material, c_moy, tol, esca
     if todo.size:
         msg = (f"{todo.size} of {n} points are outside the validity of {' / '.join(ladder)} at tolerance "
                f"{limit:g} (worst error estimate {float(np.max(last_err[todo])):.2g})")
-    return Escalated(I=I, error=err, B1=B1, core=core, fidelity_used=used, electrochemistry=elec | valid,
-                     layer_separation=layer | valid, valid=valid, success=valid, message=msg)
+    return climb.result(valid, msg)
 
 
 def forward(length, width, thickness, voltage, *, modulus=None, c_moy=None, material: Material = NAFION_LI,

@@ -39,22 +39,10 @@ import numpy as np
 
 from ipmc_asym.kernels import _generated as G
 from ipmc_asym.kernels import _generated_charge as GC
-from ipmc_asym.kernels._generated_exact import exact_outer
 from ipmc_asym.kernels.closed import b1_model
-from ipmc_asym.kernels.exact import (
-    _S,
-    _W,
-    _X,
-    LENGTH_TOL,
-    Y_SWITCH,
-    _accumulate,
-    _asinh_scaled,
-    _core_fill,
-    _core_layout,
-    _outer_count,
-    _outer_fill,
-)
+from ipmc_asym.kernels.exact import _S, _W, _X, _solve
 from ipmc_asym.kernels.jit import jit
+from ipmc_asym.kernels.quadrature import doubling_panels
 from ipmc_asym.kernels.special import gauss_legendre
 
 __all__ = ["layer_potentials", "charge_exact_point", "kappa_neutral_log", "closed_charge_errors",
@@ -89,6 +77,16 @@ def _ehat(y, rho):
     return rho + (1.0 - rho) * math.exp(y)
 
 
+@jit(inline="always")  # a node of the driver's inner loop: no call per node
+def _w_integrand(u, sg, rho, wt):
+    """``wt (ehat/|s| - 1/u) = wt (ehat u/|s| - 1)/u`` at ``y = sg u``, ``|s| = Dhat(y) = u sqrt(Qhat)``."""
+    y = sg * u
+    return wt * (_ehat(y, rho) * u / G.dhat(y, rho) - 1.0) / u
+
+
+_w_panels = doubling_panels(_w_integrand)
+
+
 @jit
 def _w_side(Y, rho):
     """``W(Y) = ln|Y| + int_0^|Y| (ehat/|s| - 1/u) du`` along the side of sign(Y) (12-point panels)."""
@@ -96,24 +94,7 @@ def _w_side(Y, rho):
     T = abs(Y)
     if T < 1e-3:  # integrand -> sg (1/2 - 2 rho/3) at u = 0; the O(u) rest is < 1e-6 here
         return math.log(T) + sg * (0.5 - 2.0 * rho / 3.0) * T
-    total = 0.0
-    a = 0.0
-    b = min(0.5, T)
-    while True:
-        hm = 0.5 * (b - a)
-        xm = 0.5 * (a + b)
-        s = 0.0
-        for j in range(_GQ_X.shape[0]):
-            u = xm + hm * _GQ_X[j]
-            y = sg * u
-            # ehat/|s| - 1/u = (ehat u/|s| - 1)/u with |s| = Dhat(y) = u sqrt(Qhat)
-            s += _GQ_W[j] * (_ehat(y, rho) * u / G.dhat(y, rho) - 1.0) / u
-        total += hm * s
-        if b >= T:
-            break
-        a = b
-        b = min(2.0 * b, T)
-    return math.log(T) + total
+    return math.log(T) + _w_panels(T, sg, rho, _GQ_X, _GQ_W)
 
 
 @jit
@@ -158,35 +139,6 @@ def closed_charge_errors(lam, Yc, Ya, rho, cc, ca):
 
 
 @jit
-def _length(lam, ends, rho, ell, CF, CG, CY, CH, OE, OS2, OY, OH, npo, OF, OG, acc):
-    """``(L, dL/d ell)`` of the thickness constraint at ``ell`` (both sides)."""
-    n = _X.shape[0]
-    kappa2 = math.exp(-2.0 * ell)
-    L = 0.0
-    dL = 0.0
-    for s in range(2):
-        sgn = 1.0 if s == 0 else -1.0
-        ysw = min(Y_SWITCH, ends[s])
-        V1 = _asinh_scaled(ysw, ell)
-        m, dm = _core_layout(ysw, V1)
-        v_bottom = V1 - dm
-        npc = _core_fill(ysw, sgn, V1, m, rho, _X, 1, CF, CG, CY, CH, v_bottom > 20.0)
-        acc[0] = lam * v_bottom
-        acc[1] = lam * math.tanh(V1)  # int sech^2 dv over the core; the rest is G - sech^2
-        acc[2] = 0.0
-        acc[3] = 0.0
-        _accumulate(lam, CF, CG, CY, CH, npc, acc[0], _W, _S, False, acc)
-        for q in range(npo[s] * n):
-            f, g = exact_outer(OE[s, q], OS2[s, q], kappa2)
-            OF[q] = f
-            OG[q] = g
-        _accumulate(lam, OF, OG, OY[s], OH[s], npo[s], acc[0], _W, _S, False, acc)
-        L += acc[0]
-        dL += acc[1]
-    return L, dL
-
-
-@jit
 def charge_exact_point(lam, A2, rho, Yc, Ya):
     """``(g, Cdhat, t, niter)`` of the exact solution at ``A2 > 0`` (``Yc``, ``Ya`` from :func:`layer_potentials`).
 
@@ -194,58 +146,12 @@ def charge_exact_point(lam, A2, rho, Yc, Ya):
     Newton passes, -1 if the thickness constraint was not met to ``LENGTH_TOL`` (then nothing
     may be reported).
     """
-    n = _X.shape[0]
-    ends = np.empty(2)
-    ends[0] = Yc
-    ends[1] = -Ya
-    nout = max(_outer_count(Yc), _outer_count(-Ya)) * n + 1
-    OE = np.empty((2, nout))
-    OS2 = np.empty((2, nout))
-    OY = np.empty((2, nout))
-    OH = np.empty((2, nout))
-    npo = np.zeros(2, dtype=np.int64)
-    for s in range(2):
-        npo[s] = _outer_fill(ends[s], 1.0 if s == 0 else -1.0, rho, _X, 1, OE[s], OS2[s], OY[s], OH[s])
-    OF = np.empty(nout)
-    OG = np.empty(nout)
-    ncore = 80 * n
-    CF = np.empty(ncore)
-    CG = np.empty(ncore)
-    CY = np.empty(ncore)
-    CH = np.empty(ncore)
-    acc = np.empty(4)
     # int ehat dy over [Ya, Yc] = (1 - rho) e^Yc (1 - e^{-A2}) + rho A2: L <= lam e^ell that
     lo = max(math.log(2.0 / (lam * ((1.0 - rho) * math.exp(Yc) * -math.expm1(-A2) + rho * A2))), -300.0)
-    ell = 1.0 / lam - 0.5 * (math.log(2.0 * min(Yc, Y_SWITCH)) + math.log(2.0 * min(-Ya, Y_SWITCH)))
-    ell = min(max(ell, lo), 1e7)
-    lo_done = False
-    hi = math.inf
-    niter = -1
-    dL = 1.0
-    for it in range(100):
-        L, dL = _length(lam, ends, rho, ell, CF, CG, CY, CH, OE, OS2, OY, OH, npo, OF, OG, acc)
-        r = math.log(0.5 * L)
-        if abs(r) <= LENGTH_TOL:
-            niter = it + 1
-            break
-        if r < 0.0:
-            lo = max(lo, ell)
-            lo_done = True
-        else:
-            hi = min(hi, ell)
-        new = ell - r * L / dL  # Newton on ln L (about linear in ell for kappa >> 1 and << 1)
-        if not (lo < new < hi):
-            if not lo_done:
-                new = lo
-            elif hi == math.inf:
-                new = ell + max(1.0, 2.0 * (ell - lo))
-            else:
-                new = 0.5 * (lo + hi)
-        if new == ell:  # stalled in round-off: accept 100x the tolerance (~1e-12 on sigma)
-            if abs(r) <= 100.0 * LENGTH_TOL:
-                niter = it + 1
-            break
-        ell = new
+    # the moment rung's driver, for the length alone (Newton on ln L: about linear in ell for
+    # kappa >> 1 and << 1); stalled in round-off, 100x the tolerance is accepted (~1e-12 on sigma)
+    ell, niter, res = _solve(lam, Yc, Ya, lo, rho, _X, _W, _S, 1, False)
+    dL = res[0, 1] + res[1, 1]
     Dc = G.dhat(Yc, rho)
     ln_t = -ell - math.log(Dc)
     t2 = math.exp(min(2.0 * ln_t, 700.0))

@@ -153,7 +153,10 @@ def interpreted(func):
     if twin is None:
         fresh = id(py.__globals__) not in _TWIN_GLOBALS
         g = _TWIN_GLOBALS.setdefault(id(py.__globals__), dict(py.__globals__))
-        twin = _TWINS[id(py)] = types.FunctionType(py.__code__, g, py.__name__, py.__defaults__, py.__closure__)
+        # a function compiled per integrand (a factory's closure) calls twins of its cells too
+        cells = None if py.__closure__ is None else tuple(
+            types.CellType(interpreted(c.cell_contents)) for c in py.__closure__)
+        twin = _TWINS[id(py)] = types.FunctionType(py.__code__, g, py.__name__, py.__defaults__, cells)
         twin.__doc__ = py.__doc__
         if fresh:  # after registering the twin: the module's other functions may call it
             _fill_twin_globals(g)

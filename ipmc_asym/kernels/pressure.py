@@ -4,8 +4,9 @@ Derivation in ``derivations/pressure.py`` (paper eqs (4)-(5), static): with
 ``beta = (v1 - M1 v2/M2) C_moy``, ``g0 = 1 - beta (1 + A3)``, ``b0 = beta/g0`` and
 ``m = e^y - 1`` (``y = ln C``), the length element is ``dz = lambda_b ehat_b dy/sqrt(S + kappa^2)``
 with ``lambda_b = lambda/sqrt(g0)``, ``ehat_b = ehat/(1 - b0 m)`` and ``S`` the first-integral
-potential.  That is the form of :mod:`ipmc_asym.kernels.exact`, whose panel layout, Newton on
-``ell = -ln kappa`` and moment accumulation are reused here unchanged; what differs:
+potential.  That is the form of :mod:`ipmc_asym.kernels.exact`, whose driver (panel layout, Newton
+on ``ell = -ln kappa``, moment accumulation: ``make_exact_driver``) is compiled here for this
+integrand; what differs:
 
 * the face values ``(Yc, Ya)`` solve ``V(Yc) - V(Ya) = A2`` (the voltage) and
   ``S(Yc) = S(Ya)`` (electroneutrality, any ``kappa``) by Newton from the paper's ``B1``;
@@ -26,7 +27,6 @@ import math
 import numpy as np
 
 from ipmc_asym.kernels._generated import b1_exact
-from ipmc_asym.kernels._generated_exact import exact_outer
 from ipmc_asym.kernels._generated_pressure import (
     pressure_core_q,
     pressure_ehat,
@@ -35,14 +35,7 @@ from ipmc_asym.kernels._generated_pressure import (
     pressure_s_outer,
     pressure_volt,
 )
-from ipmc_asym.kernels.exact import (
-    LENGTH_TOL,
-    Y_SWITCH,
-    _accumulate,
-    _asinh_scaled,
-    _core_layout,
-    _outer_count,
-)
+from ipmc_asym.kernels.exact import Y_SWITCH, make_exact_driver
 from ipmc_asym.kernels.jit import jit
 from ipmc_asym.kernels.special import gauss_legendre
 
@@ -178,71 +171,30 @@ def face_values(A2, rho, b0, g0):
     return Yc, Ya, r1 <= 1e-12 and r2 <= 1e-12
 
 
-@jit
-def _core_fill(ysw, sgn, V1, m, rho, b0, A3, g0, X, split, F, G, Pn, H, asym):
-    """:func:`ipmc_asym.kernels.exact._core_fill` with ``(ehat_b, Q)`` and ``P(y)`` at the nodes."""
-    n = X.shape[0]
-    em2V1 = math.expm1(-2.0 * V1)
-    p = 0
-    for j in range(m, 0, -1):
-        d_lo = 0.0 if j == 1 else (1.0 if j == 2 else 2.0 ** (j - 2))
-        d_hi = min(1.0 if j == 1 else 2.0 ** (j - 1), V1)
-        hs = (d_hi - d_lo) / split
-        for k in range(split):
-            top = d_hi - k * hs
-            h = 0.5 * hs
-            H[p] = h
-            for i in range(n):
-                dd = top - h * (X[i] + 1.0)
-                sech2 = 0.0
-                if asym:
-                    y = sgn * ysw * math.exp(-dd)
-                    t2 = 1.0
-                else:
-                    vv = V1 - dd
-                    e2v = math.exp(-2.0 * vv)
-                    em = -math.expm1(-2.0 * vv)
-                    y = sgn * ysw * math.exp(-dd) * (em / -em2V1)
-                    th = em / (1.0 + e2v)
-                    t2 = th * th
-                    sech2 = 4.0 * e2v / ((1.0 + e2v) * (1.0 + e2v))
-                e = pressure_ehat(y, rho, b0)
-                t1 = 1.0 + (_q_core(y, rho, b0) - 1.0) * t2
-                f = e / math.sqrt(t1)
-                F[p * n + i] = f
-                G[p * n + i] = f * (1.0 - t2) / t1 - sech2
-                Pn[p * n + i] = _p_of_y(y, A3, b0, g0)
-            p += 1
-    return p
+@jit(inline="always")  # a node of the driver's inner loop: no call per node
+def _core_point(y, t2, par):
+    """``(F, dF/dell, P)`` at a core node: ``(ehat_b, Q)`` in place of the paper's ``(ehat, Qhat)``."""
+    rho, b0, A3, g0 = par
+    e = pressure_ehat(y, rho, b0)
+    t1 = 1.0 + (_q_core(y, rho, b0) - 1.0) * t2
+    f = e / math.sqrt(t1)
+    return f, f * (1.0 - t2) / t1, _p_of_y(y, A3, b0, g0)
 
 
-@jit
-def _outer_fill(Yend, sgn, rho, b0, A3, g0, X, split, E, S2, Pn, H):
-    """``(ehat_b, S, P)`` at the y-nodes (1/2, 1, 2, 4, ... Yend); returns the count of panels."""
-    n = X.shape[0]
-    p = 0
-    a = Y_SWITCH
-    while a < Yend:
-        b = min(2.0 * a, Yend)
-        hs = (b - a) / split
-        for k in range(split):
-            lo = a + k * hs
-            h = 0.5 * hs
-            H[p] = h
-            for i in range(n):
-                y = sgn * (lo + h * (X[i] + 1.0))
-                E[p * n + i] = pressure_ehat(y, rho, b0)
-                S2[p * n + i] = _s_of_y(y, rho, b0)
-                Pn[p * n + i] = _p_of_y(y, A3, b0, g0)
-            p += 1
-        a = b
-    return p
+@jit(inline="always")  # a node of the driver's inner loop: no call per node
+def _outer_point(y, par):
+    """``(ehat_b, S, P)`` at an outer node."""
+    rho, b0, A3, g0 = par
+    return pressure_ehat(y, rho, b0), _s_of_y(y, rho, b0), _p_of_y(y, A3, b0, g0)
+
+
+#: the exact rung's driver with the pressure term: moment weight ``P(y)``, ``par = (rho, b0, A3, g0)``
+_core_fill, _outer_fill, _solve = make_exact_driver(_core_point, _outer_point)
 
 
 @jit
 def moment_pressure_nodes(lam, A2, A3, rho, beta, X, Wt, S, split):
     """:func:`moment_pressure` with given Gauss-Legendre nodes and panels split ``split`` times."""
-    n = X.shape[0]
     g0, b0 = pressure_groups(beta, A3)
     nan = math.nan
     if not g0 > 0.0 or not abs(b0) < 1.0:
@@ -252,92 +204,10 @@ def moment_pressure_nodes(lam, A2, A3, rho, beta, X, Wt, S, split):
         return nan, nan, nan, nan, -1, nan
     lam_b = lam / math.sqrt(g0)
     B1 = math.exp(Yc)
-    ends = (Yc, -Ya)
-    sgns = (1.0, -1.0)
-    nout = max(_outer_count(Yc), _outer_count(-Ya)) * split * n + 1
-    OE = np.empty((2, nout))
-    OS2 = np.empty((2, nout))
-    OP = np.empty((2, nout))
-    OH = np.empty((2, nout))
-    npo = np.zeros(2, dtype=np.int64)
-    for s in range(2):
-        npo[s] = _outer_fill(ends[s], sgns[s], rho, b0, A3, g0, X, split, OE[s], OS2[s], OP[s], OH[s])
-    OF = np.empty(nout)
-    OG = np.empty(nout)
-    ncore = 80 * split * n
-    CF = np.empty((2, ncore))
-    CG = np.empty((2, ncore))
-    CP = np.empty((2, ncore))
-    CH = np.empty((2, ncore))
-    npc = np.zeros(2, dtype=np.int64)
-    frozen = np.zeros(2, dtype=np.bool_)
-    acc = np.empty(4)
-    res = np.empty((2, 5))
-    ell = 1.0 / lam_b - 0.5 * (math.log(2.0 * min(Yc, Y_SWITCH)) + math.log(2.0 * min(-Ya, Y_SWITCH)))
     # sqrt(S + kappa^2) >= kappa and ehat_b is monotone in y: L <= lam_b e^ell max(ehat_b) (Yc - Ya)
     emax = max(pressure_ehat(Yc, rho, b0), pressure_ehat(Ya, rho, b0))
     lo = max(math.log(2.0 / (lam_b * emax * (Yc - Ya))), -300.0)
-    lo_done = False
-    ell = min(max(ell, lo), 1e7)
-    hi = math.inf
-    niter = -1
-    moments = False
-    stalled = False
-    r_prev = math.inf
-    for it in range(100):
-        kappa2 = math.exp(-2.0 * ell)
-        for s in range(2):
-            ysw = min(Y_SWITCH, ends[s])
-            V1 = _asinh_scaled(ysw, ell)
-            m, dm = _core_layout(ysw, V1)
-            v_bottom = V1 - dm
-            asym = v_bottom > 20.0
-            if not (asym and frozen[s]):
-                npc[s] = _core_fill(ysw, sgns[s], V1, m, rho, b0, A3, g0, X, split, CF[s], CG[s], CP[s], CH[s], asym)
-                frozen[s] = asym
-            acc[0] = lam_b * v_bottom
-            acc[1] = lam_b * math.tanh(V1)
-            acc[2] = 0.0
-            acc[3] = 0.0
-            _accumulate(lam_b, CF[s], CG[s], CP[s], CH[s], npc[s], acc[0], Wt, S, moments, acc)
-            zeta1 = acc[0]
-            for q in range(npo[s] * n):
-                f, g = exact_outer(OE[s, q], OS2[s, q], kappa2)
-                OF[q] = f
-                OG[q] = g
-            first = min(split, npo[s]) if ends[s] > 1.0 else npo[s]
-            _accumulate(lam_b, OF, OG, OP[s], OH[s], first, acc[0], Wt, S, moments, acc)
-            zeta1 = acc[0]
-            _accumulate(lam_b, OF[first * n:], OG[first * n:], OP[s, first * n:], OH[s, first:],
-                        npo[s] - first, acc[0], Wt, S, moments, acc)
-            for k in range(4):
-                res[s, k] = acc[k]
-            res[s, 4] = zeta1
-        L = res[0, 0] + res[1, 0]
-        r = math.log(0.5 * L)
-        if moments and (abs(r) <= LENGTH_TOL or (stalled and abs(r) <= 100.0 * LENGTH_TOL)):
-            niter = it + 1
-            break
-        if r < 0.0:
-            lo = max(lo, ell)
-            lo_done = True
-        else:
-            hi = min(hi, ell)
-        linear = frozen[0] and frozen[1]
-        new = ell - ((L - 2.0) if linear else r * L) / (res[0, 1] + res[1, 1])
-        if not (lo < new < hi):
-            if not lo_done:
-                new = lo
-            elif hi == math.inf:
-                new = ell + max(1.0, 2.0 * (ell - lo))
-            else:
-                new = 0.5 * (lo + hi)
-        moments = abs(r) < 1e-7 or linear or abs(r) >= r_prev
-        r_prev = abs(r)
-        if new == ell:
-            moments = True
-            stalled = True
-        ell = new
+    ell, niter, res = _solve(lam_b, Yc, Ya, lo, (rho, b0, A3, g0), X, Wt, S, split, True)
     Lc = res[0, 0]
     La = res[1, 0]
     z0 = 0.5 * (La - Lc)

@@ -22,13 +22,44 @@ from ipmc_asym.kernels._generated import assemble_j, b1_exact, dhat, w_layer
 from ipmc_asym.kernels.jit import jit
 from ipmc_asym.kernels.special import gauss_legendre
 
-__all__ = ["layer_functions", "moment_quadrature", "NODES"]
+__all__ = ["layer_functions", "moment_quadrature", "doubling_panels", "NODES"]
 
 NODES = 10
 _X, _W, _S = gauss_legendre(NODES)
 _X = np.ascontiguousarray(_X)
 _W = np.ascontiguousarray(_W)
 _S = np.ascontiguousarray(_S)
+
+
+def doubling_panels(integrand):
+    """``int_0^T f(u) du`` on Gauss-Legendre panels with breakpoints 0, 1/2, 1, 2, 4, ... ``T``
+    (the layer scheme above), compiled for one ``integrand``.
+
+    ``integrand(u, sgn, par, wt)`` returns ``wt f(u)``, the node's weight applied by the
+    integrand (where it enters the rounding is the integrand's); ``sgn`` and ``par`` are passed
+    on (``y = sgn u``).  Returns the jitted ``panels(T, sgn, par, X, Wt)`` (``T > 0``; ``X``,
+    ``Wt`` the nodes and weights on [-1, 1]).
+    """
+
+    @jit
+    def panels(T, sgn, par, X, Wt):
+        total = 0.0
+        a = 0.0
+        b = min(0.5, T)
+        while True:
+            hm = 0.5 * (b - a)
+            xm = 0.5 * (a + b)
+            s = 0.0
+            for j in range(X.shape[0]):
+                s += integrand(xm + hm * X[j], sgn, par, Wt[j])
+            total += hm * s
+            if b >= T:
+                break
+            a = b
+            b = min(2.0 * b, T)
+        return total
+
+    return panels
 
 
 @jit
