@@ -108,8 +108,8 @@ VISIBLE_TO = {
                   "static state does not depend on D"),
     "viscous_modulus": (("time_mech",), "a time series of deflection or blocking force (the beam's damping; "
                                         "beam dynamic)"),
-    "sheet_resistance": (("impedance",), "an impedance spectrum (f, Z_re, Z_im): the electrode line is modelled in "
-                                         "the frequency domain only"),
+    "sheet_resistance": (("impedance",), "an impedance spectrum (f, Z_re, Z_im): the fit's time-domain model has "
+                                         "ideal electrodes"),
 }
 
 

@@ -48,8 +48,10 @@ reduced circuit, whose error at the optimum is its difference from the PNP solve
 hundredth of the data's relative noise plus that run's own estimate; they escalate to the PNP
 rung (each model evaluation a PNP run: slow) where that error is not below a tenth of the
 data's noise at every value or shifts an estimate by more than a tenth of its standard error.
-The linear model has no PNP rung (``eps -> 0`` at the anode), so time series with it are
-refused.  Spectra are computed by the exact linearised PNP (rounding error only).
+Time series with the linear model are refused: its current stops abruptly when the anode
+layer saturates, the circuit misplaces that stop by more than a tenth of a 5 % noise, and on
+the PNP rung (:mod:`ipmc_asym.dynamics.transient` solves the linear model) a round trip took
+minutes and was not validated.  Spectra are computed by the exact linearised PNP (rounding error only).
 
 Outside every dynamic model (stated in the result's message): water transport and the
 back-relaxation it causes; spectra are small signals about 0 V.
@@ -660,12 +662,12 @@ def fit_dynamic(datasets, free, model="constant", material: Material = NAFION_LI
     has_static = any(isinstance(d, CalibrationData) for d in parts)
     if has_time and ("sheet_resistance" in names or material.sheet_resistance > 0):
         raise ValueError("time series with an electrode sheet resistance: the time-domain model has ideal electrodes "
-                         "(the electrode line is modelled in the frequency domain only); fit sheet_resistance on "
-                         "spectra without the time series")
-    perm = get_model(model)
-    if has_time and perm.eps0 == 0.0 and "eps0" not in names:
-        raise ValueError("time series with the linear model: it has no PNP rung (eps -> 0 at the anode), so the "
-                         "circuit's error cannot be bounded; use the constant or affine model")
+                         "(the time-domain electrode line of step/drive --sheet-resistance is not a rung of the fit); fit "
+                         "sheet_resistance on spectra without the time series")
+    if has_time and get_model(model).eps0 == 0.0 and "eps0" not in names:
+        raise ValueError("time series with the linear model: not validated in the fit (the circuit misplaces the "
+                         "abrupt stop of the current when the anode layer saturates, and a fit on the PNP rung takes "
+                         "minutes); use the constant or affine model")
     if time_fidelity is not None and time_fidelity not in TIME_FIDELITIES:
         raise ValueError(f"time_fidelity must be one of {', '.join(TIME_FIDELITIES)}; got {time_fidelity!r}")
     p = len(names)

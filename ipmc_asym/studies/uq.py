@@ -612,7 +612,7 @@ def _columns(spec, g0, g1):
 
 
 def uq_stream_chunk(task):
-    """Base points ``g0 .. g1-1`` of the design -> their partial statistics (module level: runs on
+    """Base points ``g0`` to ``g1 - 1`` of the design -> their partial statistics (module level: runs on
     workers); the design rows are generated here, so a task is a few numbers."""
     spec, g0, g1 = task
     t0 = time.perf_counter()

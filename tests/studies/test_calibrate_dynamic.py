@@ -214,7 +214,7 @@ def test_parameters_the_data_cannot_see_refused(tmp_path):
         fit_dynamic(step, "sheet_resistance")
     with pytest.raises(ValueError, match="viscous_modulus: .* deflection or blocking force"):
         fit_dynamic(step, "viscous_modulus")
-    with pytest.raises(ValueError, match="linear model: it has no PNP rung"):
+    with pytest.raises(ValueError, match="linear model: not validated in the fit"):
         fit_dynamic(step, "diffusion", model="linear")
     with pytest.raises(ValueError, match="time-domain model has ideal electrodes"):
         fit_dynamic([step, read_file(_spectrum_csv(tmp_path / "i2.csv", Z, seed=1, sigma=False))],
