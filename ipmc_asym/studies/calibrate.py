@@ -138,8 +138,21 @@ _EPS_START = {"eps0": 5e-6, "deps": 1e-3}
 
 
 # ---- data ------------------------------------------------------------------------------------
+class MeasuredColumns:
+    """What every data set of a fit has: ``measured`` and ``sigma`` dicts of columns (NaN where absent)."""
+
+    @property
+    def n_points(self) -> int:
+        """Number of measured values (all columns)."""
+        return int(sum(np.count_nonzero(np.isfinite(v)) for v in self.measured.values()))
+
+    @property
+    def has_sigma(self) -> bool:
+        return all(s is not None for s in self.sigma.values())
+
+
 @dataclass
-class CalibrationData:
+class CalibrationData(MeasuredColumns):
     """Measurements, one entry per CSV row (SI).
 
     Attributes
@@ -161,15 +174,6 @@ class CalibrationData:
     @property
     def n_rows(self) -> int:
         return int(next(iter(self.geometry.values())).size)
-
-    @property
-    def n_points(self) -> int:
-        """Number of measured values (all columns)."""
-        return int(sum(np.count_nonzero(np.isfinite(v)) for v in self.measured.values()))
-
-    @property
-    def has_sigma(self) -> bool:
-        return all(s is not None for s in self.sigma.values())
 
 
 def _parse_cell(col, text):

@@ -81,6 +81,7 @@ from ipmc_asym.studies.calibrate import (
     MAX_DATA_ROWS,
     CalibrationData,
     CalibrationResult,
+    MeasuredColumns,
     _material,
     _multistart_task,
     _perm,
@@ -125,7 +126,7 @@ class _Interp:
 
 
 @dataclass
-class TimeData:
+class TimeData(MeasuredColumns):
     """A time series (SI).
 
     Attributes
@@ -147,21 +148,13 @@ class TimeData:
     kind = "time"
 
     @property
-    def n_points(self) -> int:
-        return int(sum(np.count_nonzero(np.isfinite(v)) for v in self.measured.values()))
-
-    @property
-    def has_sigma(self) -> bool:
-        return all(s is not None for s in self.sigma.values())
-
-    @property
     def kinds(self) -> set:
         mech = {"deflection", "blocking_force"} & set(self.measured)
         return ({"time_mech"} if mech else set()) | ({"time"} if set(self.measured) - mech else set())
 
 
 @dataclass
-class ImpedanceData:
+class ImpedanceData(MeasuredColumns):
     """An impedance spectrum about 0 V (SI; ``Z_phase`` and its sigma in radians).
 
     Attributes
@@ -177,14 +170,6 @@ class ImpedanceData:
     sigma: dict
     source: str = "spectrum"
     kind = "impedance"
-
-    @property
-    def n_points(self) -> int:
-        return int(sum(np.count_nonzero(np.isfinite(v)) for v in self.measured.values()))
-
-    @property
-    def has_sigma(self) -> bool:
-        return all(s is not None for s in self.sigma.values())
 
     @property
     def kinds(self) -> set:
