@@ -177,16 +177,28 @@ def run_chunks(func, tasks, scheduler=None, workers: int | None = None, threads:
     nw = workers or os.cpu_count() or 1
     if hasattr(scheduler, "submit"):
         return _on_client(scheduler, func, tasks, threads, fidelities)
+    with _scheduler_client(scheduler, nw, threads) as client:
+        if client is None:
+            return _on_pool(func, tasks, nw, threads, fidelities)
+        return _on_client(client, func, tasks, threads, fidelities)
+
+
+@contextlib.contextmanager
+def _scheduler_client(scheduler, nw, threads):
+    """The dask client of ``"local"`` (a local cluster of ``nw`` workers) or of an address;
+    ``None`` for ``"local"`` without dask (the caller uses a process pool)."""
     if scheduler == "local":
         try:
             import distributed  # deferred: heavy import (start-up), optional extra
         except ImportError:
-            return _on_pool(func, tasks, nw, threads, fidelities)
+            yield None
+            return
         # the nannies start each worker with this environment (the parent's is untouched)
         with distributed.LocalCluster(n_workers=nw, threads_per_worker=1, processes=True,
                                       dashboard_address=":0", env=worker_env(threads)) as cluster, \
                 distributed.Client(cluster) as client:
-            return _on_client(client, func, tasks, threads, fidelities)
+            yield client
+        return
     try:
         import distributed  # deferred: heavy import (start-up), optional extra
     except ImportError:
@@ -197,7 +209,7 @@ def run_chunks(func, tasks, scheduler=None, workers: int | None = None, threads:
     except (OSError, TimeoutError) as exc:
         raise ValueError(f"--scheduler {scheduler}: cannot connect ({exc.__class__.__name__})") from None
     with client:
-        return _on_client(client, func, tasks, threads, fidelities)
+        yield client
 
 
 def imap_chunks(func, tasks, scheduler=None, workers: int | None = None, threads: int = 1,
@@ -227,28 +239,11 @@ def imap_chunks(func, tasks, scheduler=None, workers: int | None = None, threads
     if hasattr(scheduler, "submit"):
         yield from _window_client(scheduler, func, tasks, threads, fidelities, window)
         return
-    if scheduler == "local":
-        try:
-            import distributed  # deferred: heavy import (start-up), optional extra
-        except ImportError:
+    with _scheduler_client(scheduler, nw, threads) as client:
+        if client is None:
             yield from _window_pool(func, tasks, nw, threads, fidelities, window or 2 * nw)
-            return
-        with distributed.LocalCluster(n_workers=nw, threads_per_worker=1, processes=True,
-                                      dashboard_address=":0", env=worker_env(threads)) as cluster, \
-                distributed.Client(cluster) as client:
+        else:
             yield from _window_client(client, func, tasks, threads, fidelities, window)
-        return
-    try:
-        import distributed  # deferred: heavy import (start-up), optional extra
-    except ImportError:
-        raise ValueError(f"--scheduler {scheduler}: dask.distributed is not installed "
-                         "(pip install \".[dask]\")") from None
-    try:
-        client = distributed.Client(scheduler, timeout="10s")
-    except (OSError, TimeoutError) as exc:
-        raise ValueError(f"--scheduler {scheduler}: cannot connect ({exc.__class__.__name__})") from None
-    with client:
-        yield from _window_client(client, func, tasks, threads, fidelities, window)
 
 
 def _windowed(submit, tasks, window):
