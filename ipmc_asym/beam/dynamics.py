@@ -306,6 +306,21 @@ def _static_small(support, beam: Beam):
     return 0.0, 0.0, 0.0
 
 
+def _clamped_solution(support, part):
+    """``part + c2 xi^2 + c3 xi^3``: a particular solution of a fourth-order beam problem (value and
+    slope already 0 at the clamp ``xi = 0``) completed to meet the far end's conditions: second and
+    third derivatives 0 (clamped-free), value and second derivative 0 (clamped-pinned)."""
+    x2, x3 = P([0, 0, 1.0]), P([0, 0, 0, 1.0])
+    if support == "clamped-free":
+        rows = [(x2.deriv(2)(1), x3.deriv(2)(1)), (x2.deriv(3)(1), x3.deriv(3)(1))]
+        rhs = [-part.deriv(2)(1), -part.deriv(3)(1)]
+    else:
+        rows = [(x2(1), x3(1)), (x2.deriv(2)(1), x3.deriv(2)(1))]
+        rhs = [-part(1), -part.deriv(2)(1)]
+    c2, c3 = np.linalg.solve(np.array(rows, dtype=float), np.array(rhs, dtype=float))
+    return part + c2 * x2 + c3 * x3
+
+
 def _second_static(support, beam: Beam):
     """End values of ``w2 = sum g_n phi_n/omega_n^4`` per unit moment (full electrode).
 
@@ -322,15 +337,7 @@ def _second_static(support, beam: Beam):
     else:
         return 0.0, 0.0, 0.0, 0.0
     part = (w1 * (beam.rhoA * L**4 / EI)).integ(4)  # zero value and slope at xi = 0: the clamp
-    x2, x3 = P([0, 0, 1.0]), P([0, 0, 0, 1.0])
-    if support == "clamped-free":
-        rows = [(x2.deriv(2)(1), x3.deriv(2)(1)), (x2.deriv(3)(1), x3.deriv(3)(1))]
-        rhs = [-part.deriv(2)(1), -part.deriv(3)(1)]
-    else:
-        rows = [(x2(1), x3(1)), (x2.deriv(2)(1), x3.deriv(2)(1))]
-        rhs = [-part(1), -part.deriv(2)(1)]
-    c2, c3 = np.linalg.solve(np.array(rows, dtype=float), np.array(rhs, dtype=float))
-    w2 = part + c2 * x2 + c3 * x3
+    w2 = _clamped_solution(support, part)
     return float(w2(1)), float(w2.deriv(1)(1)) / L, float(w2.deriv(2)(0)) / L**2, float(w2.deriv(3)(1)) / L**3
 
 
@@ -569,7 +576,6 @@ def _moment_kernels(support, beam: Beam):
     if support not in DISTRIBUTED_OUTPUTS:
         raise ValueError(f"a distributed moment is supported on {', '.join(DISTRIBUTED_OUTPUTS)}; got {support!r}")
     L, EI, rhoA = beam.length, beam.EI, beam.rhoA
-    x2, x3 = P([0, 0, 1.0]), P([0, 0, 0, 1.0])
     if support == "clamped-free":
         duals = {"w": P([0, 0, 3.0, -1.0]) * (L**3 / 6.0), "theta": P([0, 0, 0.5]) * L**2}
     else:
@@ -577,14 +583,7 @@ def _moment_kernels(support, beam: Beam):
     out = {}
     for k, u in duals.items():
         part = (u * L**4).integ(4)  # d^4/dxi^4 = L^4 d^4/dx^4; zero value and slope at the clamp
-        if support == "clamped-free":
-            rows = [(x2.deriv(2)(1), x3.deriv(2)(1)), (x2.deriv(3)(1), x3.deriv(3)(1))]
-            rhs = [-part.deriv(2)(1), -part.deriv(3)(1)]
-        else:
-            rows = [(x2(1), x3(1)), (x2.deriv(2)(1), x3.deriv(2)(1))]
-            rhs = [-part(1), -part.deriv(2)(1)]
-        c2, c3 = np.linalg.solve(np.array(rows, dtype=float), np.array(rhs, dtype=float))
-        U = part + c2 * x2 + c3 * x3
+        U = _clamped_solution(support, part)
         k1 = -u.deriv(2) / (EI * L * L)
         k2 = -U.deriv(2) * (rhoA / (EI * EI * L * L))
         if k == "F":  # F = -EI w'''(L)

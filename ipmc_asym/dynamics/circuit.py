@@ -428,14 +428,9 @@ class CircuitStepper:
         if t[0] != self.t_last:
             raise ValueError("each chunk must start at the last time of the previous one (0 at the start)")
         tau = self.tau
-        dt = np.diff(t) / tau
-        k = np.maximum(np.ceil(dt / 5e-3), np.where(dt <= 2.5e-3, 1, self.substeps)).astype(np.int64)
-        if k.sum() > 5_000_000:
-            raise ValueError("duration is too long for the reduced model's fixed substeps (> 1e6 tau in one chunk); "
-                             "use fewer time constants")
-        idx = np.concatenate(([0], np.cumsum(k)))
-        frac = np.arange(idx[-1]) - np.repeat(idx[:-1], k)
-        tt = np.concatenate((np.repeat(t[:-1] / tau, k) + np.repeat(dt / k, k) * frac, [t[-1] / tau]))
+        tt, idx = substep_grid(t, tau, 5e-3, self.substeps,
+                               "duration is too long for the reduced model's fixed substeps (> 1e6 tau in one "
+                               "chunk); use fewer time constants")
         ps = self.fun(tt * tau) / self.VT
         A = np.empty(tt.size)
         s = np.empty(tt.size)
@@ -449,6 +444,22 @@ class CircuitStepper:
         # R C_g = lambda^2 e^2/D is instantaneous on the scale tau); C_g/C_d(0) = lambda
         sigma = self.S * s + self.Cg * ub
         return u, ub, sigma
+
+
+def substep_grid(t, tau, h_max, substeps, too_long):
+    """Fixed substeps between the output times ``t`` (s): each interval of ``dt`` (in ``tau``) split
+    into ``max(ceil(dt/h_max), substeps)`` equal steps (1 where ``dt <= h_max/2``).
+
+    Returns ``(grid, idx)``: the substep times in units of ``tau`` and the index of each output
+    time in the grid.  ``too_long`` is the message refused when the grid would pass 5e6 steps.
+    """
+    dt = np.diff(t) / tau
+    k = np.maximum(np.ceil(dt / h_max), np.where(dt <= 0.5 * h_max, 1, substeps)).astype(np.int64)
+    if k.sum() > 5_000_000:
+        raise ValueError(too_long)
+    idx = np.concatenate(([0], np.cumsum(k)))
+    frac = np.arange(idx[-1]) - np.repeat(idx[:-1], k)
+    return np.concatenate((np.repeat(t[:-1] / tau, k) + np.repeat(dt / k, k) * frac, [t[-1] / tau])), idx
 
 
 def circuit_response(t, phi0_fun, strip: Strip, perm: Permittivity, material: Material, substeps: int = 2):

@@ -32,7 +32,7 @@ from __future__ import annotations
 import numpy as np
 
 from ipmc_asym.beam.dynamics import _propagate, mode_shape, modes, moment_kernels, natural_frequencies
-from ipmc_asym.dynamics.circuit import _shat, strip_beam
+from ipmc_asym.dynamics.circuit import _shat, strip_beam, substep_grid
 from ipmc_asym.dynamics.electrode import _GL_W, _GL_X, _model_id, charge_scale, core_resistance, time_constant
 from ipmc_asym.kernels.jit import jit
 from ipmc_asym.model import groups
@@ -243,14 +243,9 @@ class LineStepper:
         if t[0] != self.t_last:
             raise ValueError("each chunk must start at the last time of the previous one (0 at the start)")
         tau = self.tau
-        dt = np.diff(t) / tau
-        k = np.maximum(np.ceil(dt / self.h_max), np.where(dt <= 0.5 * self.h_max, 1, self.substeps)).astype(np.int64)
-        if k.sum() > 5_000_000:
-            raise ValueError("duration is too long for the line's fixed substeps (> 5e6 in one chunk); "
-                             "use fewer time constants or fewer points a chunk")
-        idx = np.concatenate(([0], np.cumsum(k)))
-        frac = np.arange(idx[-1]) - np.repeat(idx[:-1], k)
-        tt = np.concatenate((np.repeat(t[:-1] / tau, k) + np.repeat(dt / k, k) * frac, [t[-1] / tau]))
+        tt, idx = substep_grid(t, tau, self.h_max, self.substeps,
+                               "duration is too long for the line's fixed substeps (> 5e6 in one chunk); "
+                               "use fewer time constants or fewer points a chunk")
         ps = self.fun(tt * tau) / self.VT
         out = {}
         L = self.strip.length
