@@ -595,6 +595,36 @@ def _start_values(names, model, material):
     return out
 
 
+def check_count(names, n, has_sigma) -> None:
+    """Refuse (one line) more free parameters than ``n`` measured values can determine."""
+    p = len(names)
+    need = p + (0 if has_sigma else 1)
+    if n < need:
+        extra = "" if has_sigma else " (without sigma_ columns one more, to estimate the noise scale)"
+        raise ValueError(f"too many free parameters: {p} ({', '.join(names)}) for {n} measured value(s); "
+                         f"need at least {need}{extra}")
+
+
+def static_ladder(names, fidelity) -> list:
+    """The static rungs a fit climbs: ``fidelity`` alone if forced, else :data:`LADDER`, without the
+    closed-form rungs when ``eps0`` or ``deps`` is free."""
+    if fidelity is not None:
+        if fidelity not in LADDER:
+            raise ValueError(f"fidelity must be one of {', '.join(LADDER)}; got {fidelity!r}")
+        return [fidelity]
+    perm_free = any(k in ("eps0", "deps") for k in names)
+    return [f for f in LADDER if not (perm_free and f in closed_form_fidelities())]
+
+
+def multistart_starts(x0, lo, hi, multistart, seed) -> list:
+    """``x0`` and ``multistart`` more starts, log-uniform in the bounds (seeded)."""
+    starts = [x0]
+    if multistart and multistart > 0:
+        rng = np.random.default_rng(seed)
+        starts += [rng.uniform(lo, hi) for _ in range(int(multistart))]
+    return starts
+
+
 def fit(data: CalibrationData, free, model="constant", material: Material = NAFION_LI,
         fidelity: str | None = None, multistart: int = 0, seed: int = 0, scheduler=None,
         progress: bool | None = False) -> CalibrationResult:
@@ -652,27 +682,13 @@ def fit(data: CalibrationData, free, model="constant", material: Material = NAFI
     check_visible(names, ("static",))
     p = len(names)
     n = data.n_points
-    need = p + (0 if data.has_sigma else 1)
-    if n < need:
-        extra = "" if data.has_sigma else " (without sigma_ columns one more, to estimate the noise scale)"
-        raise ValueError(f"too many free parameters: {p} ({', '.join(names)}) for {n} measured value(s); "
-                         f"need at least {need}{extra}")
+    check_count(names, n, data.has_sigma)
     lo = np.log([bounds[k][0] for k in names])
     hi = np.log([bounds[k][1] for k in names])
     x0 = np.clip(np.log(_start_values(names, model, material)), lo, hi)
-    perm_free = any(k in ("eps0", "deps") for k in names)
-    if fidelity is not None:
-        if fidelity not in LADDER:
-            raise ValueError(f"fidelity must be one of {', '.join(LADDER)}; got {fidelity!r}")
-        ladder = [fidelity]
-    else:
-        ladder = [f for f in LADDER if not (perm_free and f in closed_form_fidelities())]
-
+    ladder = static_ladder(names, fidelity)
     # multistart (fidelity of the first rung; the ladder then refines the best start)
-    starts = [x0]
-    if multistart and multistart > 0:
-        rng = np.random.default_rng(seed)
-        starts += [rng.uniform(lo, hi) for _ in range(int(multistart))]
+    starts = multistart_starts(x0, lo, hi, multistart, seed)
     from ipmc_asym.base.progress import progress as _bar  # deferred: tqdm
 
     bar = _bar(None, "fit", enabled=progress, unit="eval")

@@ -67,7 +67,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ipmc_asym.base.registry import closed_form_fidelities
 from ipmc_asym.base.units import parse_force, parse_length, parse_quantity, parse_time, parse_voltage
 from ipmc_asym.beam.dynamics import Beam, natural_frequencies, viscous_modulus_from_damping_ratio
 from ipmc_asym.dynamics.circuit import WATER_NOTE, step_response
@@ -77,7 +76,6 @@ from ipmc_asym.model.params import NAFION_LI, Material, Strip
 from ipmc_asym.model.permittivity import get_model
 from ipmc_asym.parallel.executors import run_chunks
 from ipmc_asym.studies.calibrate import (
-    LADDER,
     MAX_DATA_ROWS,
     CalibrationData,
     CalibrationResult,
@@ -89,11 +87,14 @@ from ipmc_asym.studies.calibrate import (
     _report,
     _solve,
     _start_values,
+    check_count,
     check_visible,
+    multistart_starts,
     parse_free,
     predict,
     read_data,
     read_rows,
+    static_ladder,
 )
 
 __all__ = ["TIME_MEASURED", "IMPEDANCE_MEASURED", "TimeData", "ImpedanceData", "read_file", "fit_dynamic",
@@ -655,28 +656,14 @@ def fit_dynamic(datasets, free, model="constant", material: Material = NAFION_LI
                          "minutes); use the constant or affine model")
     if time_fidelity is not None and time_fidelity not in TIME_FIDELITIES:
         raise ValueError(f"time_fidelity must be one of {', '.join(TIME_FIDELITIES)}; got {time_fidelity!r}")
-    p = len(names)
     n = sum(d.n_points for d in parts)
-    need = p + (0 if has_sigma else 1)
-    if n < need:
-        extra = "" if has_sigma else " (without sigma_ columns one more, to estimate the noise scale)"
-        raise ValueError(f"too many free parameters: {p} ({', '.join(names)}) for {n} measured value(s); "
-                         f"need at least {need}{extra}")
-    perm_free = any(k in ("eps0", "deps") for k in names)
-    if fidelity is not None:
-        if fidelity not in LADDER:
-            raise ValueError(f"fidelity must be one of {', '.join(LADDER)}; got {fidelity!r}")
-        s_ladder = [fidelity]
-    else:
-        s_ladder = [f for f in LADDER if not (perm_free and f in closed_form_fidelities())]
+    check_count(names, n, has_sigma)
+    s_ladder = static_ladder(names, fidelity)
     t_ladder = list(TIME_FIDELITIES) if time_fidelity is None else [time_fidelity]
     lo = np.log([bounds[k][0] for k in names])
     hi = np.log([bounds[k][1] for k in names])
     x0 = np.clip(np.log(_start(names, model, material, strip, viscous_modulus)), lo, hi)
-    starts = [x0]
-    if multistart and multistart > 0:
-        rng = np.random.default_rng(seed)
-        starts += [rng.uniform(lo, hi) for _ in range(int(multistart))]
+    starts = multistart_starts(x0, lo, hi, multistart, seed)
     bar = _bar(None, "fit", enabled=progress, unit="eval")
     try:
         return _fit_joint(parts, names, bounds, lo, hi, starts, s_ladder, t_ladder, has_static, has_time, has_sigma,
