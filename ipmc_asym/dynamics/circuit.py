@@ -54,20 +54,18 @@ from ipmc_asym.beam.dynamics import (
     transfer,
 )
 from ipmc_asym.dynamics.electrode import (
-    _GL_W,
-    _GL_X,
-    _model_id,
     capacitance_scale,
     charge,
-    charge_hat_point,
     charge_scale,
     core_resistance,
     time_constant,
 )
 from ipmc_asym.dynamics.transient import solve_transient
 from ipmc_asym.forward.model import CHECKS, assumption_warnings, forward, voltage_reason
+from ipmc_asym.integral.api import paper_model_id
 from ipmc_asym.kernels import _generated_charge as GC
-from ipmc_asym.kernels.jit import jit
+from ipmc_asym.kernels.charge import GL_W, GL_X
+from ipmc_asym.kernels.charge_time import integrate_circuit
 from ipmc_asym.model import groups
 from ipmc_asym.model.params import (
     D_CATION_SOURCE,
@@ -293,82 +291,10 @@ class StepResult:
     sigma_error: np.ndarray | None = None
 
 
-@jit
-def _shat(A, rho, mid, X, Wt):
-    """Signed sigma_hat(A) and Cd_hat(|A|) at the thermal voltage A = F u/(R T)."""
-    s, c, _ = charge_hat_point(abs(A), rho, mid, 0, X, Wt)
-    return (s if A >= 0.0 else -s), c
-
-
-@jit
-def _integrate(tt, ps, rho, mid, X, Wt, A_out, s_out, state):
-    """Variable-step BDF2 (first step backward Euler) for ds/dt = (psi0 - A)/2, s = s(A).
-
-    Time in units of tau, voltages in R T/F.  Each implicit step solves the monotone scalar
-    equation a0 s(A) + h A/2 = rhs by Newton with a bisection safeguard.  ``state`` =
-    ``(A, A_prev, s, s_prev, h_prev)`` at ``tt[0]`` on entry (zeros: at rest, uncharged), at
-    ``tt[-1]`` on return: a run split into chunks is the same run.
-    """
-    A = state[0]
-    A_prev = state[1]
-    s = state[2]
-    s_prev = state[3]
-    h_prev = state[4]
-    A_out[0] = A
-    s_out[0] = s
-    for n in range(1, tt.shape[0]):
-        h = tt[n] - tt[n - 1]
-        if h <= 0.0:
-            A_out[n] = A
-            s_out[n] = s
-            continue
-        if h_prev == 0.0:
-            a0 = 1.0
-            rhs = s + 0.5 * h * ps[n]
-        else:
-            w = h / h_prev
-            a0 = (1.0 + 2.0 * w) / (1.0 + w)
-            rhs = (1.0 + w) * s - w * w / (1.0 + w) * s_prev + 0.5 * h * ps[n]
-        # g(x) = a0 s(x) + h x / 2 - rhs is increasing: Newton from the linear predictor, with a
-        # bracket collected on the way (bisection once both ends are known)
-        lo = -math.inf
-        hi = math.inf
-        x = A + (A - A_prev) * (h / h_prev) if h_prev > 0.0 else A
-        for _ in range(200):
-            sx, cx = _shat(x, rho, mid, X, Wt)
-            g = a0 * sx + 0.5 * h * x - rhs
-            if g > 0.0:
-                hi = x
-            else:
-                lo = x
-            xn = x - g / (a0 * cx + 0.5 * h)
-            if not (lo < xn < hi):
-                if math.isinf(lo) or math.isinf(hi):
-                    xn = x - 2.0 * (1.0 + abs(g)) if math.isinf(lo) else x + 2.0 * (1.0 + abs(g))
-                else:
-                    xn = 0.5 * (lo + hi)
-            if abs(xn - x) <= 1e-13 * (1.0 + abs(x)):
-                x = xn
-                break
-            x = xn
-        s_prev = s
-        s, _ = _shat(x, rho, mid, X, Wt)
-        A_prev = A
-        A = x
-        h_prev = h
-        A_out[n] = A
-        s_out[n] = s
-    state[0] = A
-    state[1] = A_prev
-    state[2] = s
-    state[3] = s_prev
-    state[4] = h_prev
-
-
 def quasi_static_forward(u, strip: Strip, perm: Permittivity, material: Material):
     """The forward model (:class:`ipmc_asym.forward.model.ForwardResult`, withheld outputs NaN)
     of the static strip at the layer voltage(s) ``u`` (V); see :func:`quasi_static_mechanics`."""
-    fid = "corrected" if _model_id(perm, "corrected") >= 0 else "quadrature"
+    fid = "corrected" if paper_model_id(perm) >= 0 else "quadrature"
     with np.errstate(all="ignore"):
         return forward(strip.length, strip.width, strip.thickness, np.asarray(u, dtype=float), material=material,
                        model=perm, fidelity=fid).withhold()
@@ -418,7 +344,7 @@ class CircuitStepper:
         self.substeps = int(substeps)
         self.state = np.zeros(5)
         self.rho = perm.eps0 / perm.eps_moy
-        self.mid = _model_id(perm, "corrected")
+        self.mid = paper_model_id(perm)
         self.Cg = float(groups.geometric_capacitance(strip.thickness, perm.eps_moy))
         self.S = charge_scale(perm, material)
         self.t_last = 0.0
@@ -434,7 +360,7 @@ class CircuitStepper:
         ps = self.fun(tt * tau) / self.VT
         A = np.empty(tt.size)
         s = np.empty(tt.size)
-        _integrate(tt, ps, self.rho, self.mid, _GL_X, _GL_W, A, s, self.state)
+        integrate_circuit(tt, ps, self.rho, self.mid, GL_X, GL_W, A, s, self.state)
         A, s = A[idx], s[idx]
         u = self.VT * A
         self.t_last = float(t[-1])

@@ -32,9 +32,11 @@ from __future__ import annotations
 import numpy as np
 
 from ipmc_asym.beam.dynamics import _propagate, mode_shape, modes, moment_kernels, natural_frequencies
-from ipmc_asym.dynamics.circuit import _shat, strip_beam, substep_grid
-from ipmc_asym.dynamics.electrode import _GL_W, _GL_X, _model_id, charge_scale, core_resistance, time_constant
-from ipmc_asym.kernels.jit import jit
+from ipmc_asym.dynamics.circuit import strip_beam, substep_grid
+from ipmc_asym.dynamics.electrode import charge_scale, core_resistance, time_constant
+from ipmc_asym.integral.api import paper_model_id
+from ipmc_asym.kernels.charge import GL_W, GL_X
+from ipmc_asym.kernels.charge_time import integrate_line
 from ipmc_asym.model import groups
 from ipmc_asym.model.params import Material, Strip, check_finite
 from ipmc_asym.model.permittivity import Permittivity
@@ -56,109 +58,6 @@ def line_weights(n_segments: int, length: float):
     w = np.full(n + 1, h)
     w[[0, -1]] = 0.5 * h
     return np.linspace(0.0, float(length), n + 1), w
-
-
-@jit
-def _integrate_line(tt, ps, rho, mid, X, Wt, G, A_out, P_out, s_out, A, A_prev, s, s_prev, P, hp):
-    """BDF2 for ``ds_j/dt = (psi_j - A_j)/2`` (time in tau, voltages in R T/F) on the ladder.
-
-    ``psi_0 = ps`` (the drive); ``psi_{j-1} - 2 psi_j + psi_{j+1} = G_j (psi_j - A_j)``.  ``A``,
-    ``A_prev``, ``s``, ``s_prev``, ``P`` (node voltages) and ``hp[0]`` (last step) are the state,
-    updated in place; ``A_out``, ``P_out``, ``s_out`` get every step's values.  Returns the number
-    of steps whose Newton iteration did not converge (0 on success).
-    """
-    n1 = A.shape[0]
-    nn = n1 - 1
-    F = np.empty(n1)
-    d = np.empty(n1)
-    x = np.empty(n1)
-    dA = np.empty(n1)
-    rhs = np.empty(n1)
-    cp = np.empty(n1)
-    dp = np.empty(n1)
-    dpsi = np.zeros(n1)
-    bad = 0
-    for j in range(n1):
-        A_out[0, j] = A[j]
-        P_out[0, j] = P[j]
-        s_out[0, j] = s[j]
-    for k in range(1, tt.shape[0]):
-        h = tt[k] - tt[k - 1]
-        if h <= 0.0:
-            for j in range(n1):
-                A_out[k, j] = A[j]
-                P_out[k, j] = P[j]
-                s_out[k, j] = s[j]
-            continue
-        h_prev = hp[0]
-        if h_prev == 0.0:
-            a0 = 1.0
-            for j in range(n1):
-                rhs[j] = s[j]
-        else:
-            w = h / h_prev
-            a0 = (1.0 + 2.0 * w) / (1.0 + w)
-            for j in range(n1):
-                rhs[j] = (1.0 + w) * s[j] - w * w / (1.0 + w) * s_prev[j]
-        for j in range(n1):
-            x[j] = A[j] + (A[j] - A_prev[j]) * (h / h_prev) if h_prev > 0.0 else A[j]
-        P[0] = ps[k]
-        hh = 0.5 * h
-        done = False
-        for _ in range(200):
-            for j in range(n1):
-                sx, cx = _shat(x[j], rho, mid, X, Wt)
-                F[j] = a0 * sx + hh * (x[j] - P[j]) - rhs[j]
-                d[j] = a0 * cx + hh
-            # tridiagonal system for the node corrections dpsi_1..dpsi_N (dpsi_0 = 0: the drive)
-            for j in range(1, n1):
-                g = G[j]
-                if j < nn:
-                    diag = -2.0 - g + g * hh / d[j]
-                    e = P[j - 1] - 2.0 * P[j] + P[j + 1] - g * (P[j] - x[j])
-                else:
-                    diag = -1.0 - g + g * hh / d[j]
-                    e = P[j - 1] - P[j] - g * (P[j] - x[j])
-                r = -e + g * F[j] / d[j]
-                if j == 1:
-                    m = diag
-                    dp[j] = r / m
-                else:
-                    m = diag - cp[j - 1]
-                    dp[j] = (r - dp[j - 1]) / m
-                cp[j] = (1.0 / m) if j < nn else 0.0
-            dpsi[nn] = dp[nn]
-            for j in range(nn - 1, 0, -1):
-                dpsi[j] = dp[j] - cp[j] * dpsi[j + 1]
-            big = 0.0
-            for j in range(n1):
-                dA[j] = (-F[j] + hh * dpsi[j]) / d[j]
-                if abs(dA[j]) > big:
-                    big = abs(dA[j])
-            lim = 1.0 if big <= 2.0 else 2.0 / big
-            conv = True
-            for j in range(n1):
-                x[j] += lim * dA[j]
-                if j > 0:
-                    P[j] += lim * dpsi[j]
-                if abs(lim * dA[j]) > 1e-13 * (1.0 + abs(x[j])) or abs(lim * dpsi[j]) > 1e-13 * (1.0 + abs(P[j])):
-                    conv = False
-            if conv:
-                done = True
-                break
-        if not done:
-            bad += 1
-        for j in range(n1):
-            s_prev[j] = s[j]
-            sx, _ = _shat(x[j], rho, mid, X, Wt)
-            s[j] = sx
-            A_prev[j] = A[j]
-            A[j] = x[j]
-            A_out[k, j] = A[j]
-            P_out[k, j] = P[j]
-            s_out[k, j] = s[j]
-        hp[0] = h
-    return bad
 
 
 class _Ladder:
@@ -215,7 +114,7 @@ class LineStepper:
         self.h_max = 5e-3 * min(1.0, max(self.t_line, 0.05))
         self.substeps = int(substeps)
         self.rho = perm.eps0 / perm.eps_moy
-        self.mid = _model_id(perm, "corrected")
+        self.mid = paper_model_id(perm)
         self.Cg = float(groups.geometric_capacitance(strip.thickness, perm.eps_moy))
         self.S = charge_scale(perm, material)
         self.segments = n
@@ -232,7 +131,7 @@ class LineStepper:
         A = np.empty((tt.size, k))
         P = np.empty((tt.size, k))
         s = np.empty((tt.size, k))
-        bad = _integrate_line(tt, ps, self.rho, self.mid, _GL_X, _GL_W, lad.G, A, P, s, lad.A, lad.A_prev, lad.s,
+        bad = integrate_line(tt, ps, self.rho, self.mid, GL_X, GL_W, lad.G, A, P, s, lad.A, lad.A_prev, lad.s,
                               lad.s_prev, lad.P, lad.hp)
         if bad:
             raise RuntimeError(f"electrode line: the implicit step did not converge at {bad} substeps")

@@ -68,7 +68,7 @@ from ipmc_asym.model.params import NAFION_LI, Material, Strip
 from ipmc_asym.model.permittivity import MODELS, Permittivity, get_model
 
 __all__ = ["FIDELITIES", "MomentResult", "moment_integral", "moment", "groups_arrays", "check_fidelity",
-           "check_min_thickness", "invalid_message", "validity_limit", "interpret_small"]
+           "check_min_thickness", "invalid_message", "validity_limit", "interpret_small", "paper_model_id"]
 
 #: the rung names, cheapest first (tuple; the specs: ``registry.FIDELITIES``)
 FIDELITIES = fidelity_names()
@@ -590,21 +590,34 @@ def moment(thickness, voltage, model="constant", fidelity="quadrature", *, mater
                         fidelity=fidelity, model=perm.name, success=success, message=message)
 
 
-def closed_model_id(perm: Permittivity, fidelity: str) -> int:
-    """Model id of the closed-form kernels (-1 for ``quadrature``/``exact``: any rho).
+def paper_model_id(perm: Permittivity) -> int:
+    """Registry id of the paper's model that ``perm`` is (same name, eps0 and eps_moy - eps0), else -1.
 
-    The closed forms are derived for the paper's three (eps0, eps_moy - eps0) pairs only.
+    The kernels specialised per model take this id; -1 selects their generic-rho form.
+    """
+    paper = MODELS.get(perm.name)
+    if paper is None or (perm.eps0, perm.deps) != (paper.eps0, paper.deps):
+        return -1
+    return _MODEL_SPECS[perm.name].id
+
+
+def closed_model_id(perm: Permittivity, fidelity: str) -> int:
+    """Model id of the closed-form moment kernels (-1 for ``quadrature``/``exact``: any rho).
+
+    The closed forms of ``I`` are derived for the paper's three (eps0, eps_moy - eps0) pairs
+    only: a one-line ``ValueError`` for any other model at a closed-form rung.  (The charge's
+    closed forms hold for any rho: :func:`paper_model_id`.)
     """
     if not _FIDELITY_SPECS[fidelity].closed_form:
         return -1
-    paper = MODELS.get(perm.name)
-    if paper is None or (perm.eps0, perm.deps) != (paper.eps0, paper.deps):
+    mid = paper_model_id(perm)
+    if mid < 0:
         raise ValueError(
             f"closed forms ({fidelity!r}) are derived for the paper's constant, linear and affine "
             f"models only; use fidelity 'quadrature' or 'bvp' for {perm.name!r} with "
             f"eps0={perm.eps0:g}, eps_moy-eps0={perm.deps:g} F/m"
         )
-    return _MODEL_SPECS[perm.name].id
+    return mid
 
 
 def _bvp_loop(thickness, voltage, perm, mat, I, err, B1, core, progress):

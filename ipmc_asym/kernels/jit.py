@@ -9,6 +9,7 @@ no Numba setting of the user's process is changed.
 
 from __future__ import annotations
 
+import ast
 import hashlib
 import os
 import types
@@ -20,32 +21,112 @@ from numba.core import caching
 __all__ = ["jit", "jit_parallel", "prange", "CACHE_DIR", "interpreted"]
 
 
+#: names whose import from this module marks a module that defines jitted code
+_DECORATORS = frozenset({"jit", "jit_parallel"})
+
+
+def _package_imports(path: Path, root: Path):
+    """``(imports, defines_jitted)`` of one package module, read with ``ast``: the package's
+    module files its module-level imports name, and whether it imports a decorator of this
+    module.  Module level only: a jitted function reaches other code through its module's
+    globals, which the module-level imports bind (a deferred import inside a function is
+    plain Python, never compiled)."""
+    tree = ast.parse(path.read_bytes(), filename=str(path))
+    pkg = root.name
+    found, jitted = set(), False
+
+    def add(dotted: str) -> None:
+        parts = dotted.split(".")
+        if parts[0] != pkg:
+            return
+        base = root.joinpath(*parts[1:])
+        for cand in (base.with_suffix(".py"), base / "__init__.py"):
+            if cand.is_file():
+                found.add(cand)
+                return
+
+    nodes = list(tree.body)
+    while nodes:  # module level, including the bodies of module-level if/try blocks
+        node = nodes.pop()
+        if isinstance(node, ast.Import):
+            for a in node.names:
+                add(a.name)
+        elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+            add(node.module)
+            for a in node.names:
+                add(f"{node.module}.{a.name}")  # ``from pkg.sub import module``
+            if node.module == __name__ and any(a.name in _DECORATORS for a in node.names):
+                jitted = True
+        elif isinstance(node, (ast.If, ast.Try)):
+            nodes += node.body + node.orelse + getattr(node, "finalbody", []) + \
+                [b for h in getattr(node, "handlers", []) for b in h.body]
+    return found, jitted
+
+
 def hashed_sources() -> list:
-    """The modules that define jitted functions (and what they inline: ``settings`` values
-    such as ``EXACT_STATED_ERROR`` are frozen into the compiled sweep driver)."""
-    here = Path(__file__).resolve().parents[1]
-    return sorted([here / "base" / "settings.py", *(here / "kernels").glob("*.py"),
-                   *(here / "integral").glob("*.py"), here / "dynamics" / "electrode.py",
-                   here / "dynamics" / "circuit.py", here / "dynamics" / "line_time.py", here / "io" / "textfmt.py",
-                   here / "beam" / "dynamics.py"])
+    """The files the compiled code depends on: every package module that imports :func:`jit` or
+    :func:`jit_parallel` from here, plus every package module those import, transitively
+    (module-level imports, read with ``ast``; ``settings`` values such as
+    ``EXACT_STATED_ERROR`` are frozen into the compiled drivers).  Sorted paths."""
+    root = Path(__file__).resolve().parents[1]
+    graph = {}
+
+    def imports(p):
+        if p not in graph:
+            graph[p] = _package_imports(p, root)
+        return graph[p]
+
+    # only a file that names this module can import from it: parse those, then what they reach
+    me = __name__.encode()
+    todo = [p for p in root.rglob("*.py") if me in p.read_bytes() and imports(p)[1]]
+    seen = set(todo)
+    while todo:
+        for q in imports(todo.pop())[0]:
+            if q not in seen:
+                seen.add(q)
+                todo.append(q)
+    return sorted(seen)
+
+
+def _memo_sources(here: Path, base: str) -> list:
+    """:func:`hashed_sources`, memoised on disk under the hash of every package source: parsing
+    the import graph costs ~0.1-0.5 s a process, reading and hashing the files ~10 ms."""
+    files = sorted(here.rglob("*.py"))
+    h = hashlib.sha256()
+    for p in files:
+        h.update(p.relative_to(here).as_posix().encode())
+        h.update(p.read_bytes())
+    memo = Path(base, "ipmc_asym", f"sources-{h.hexdigest()[:16]}.txt")
+    try:
+        return [here / r for r in memo.read_text().split()]
+    except OSError:
+        pass
+    out = hashed_sources()
+    try:
+        memo.parent.mkdir(parents=True, exist_ok=True)
+        memo.write_text("\n".join(p.relative_to(here).as_posix() for p in out))
+    except OSError:  # a read-only cache: the list is recomputed next time
+        pass
+    return out
 
 
 def _cache_dir() -> str:
-    """Numba's on-disk cache, keyed by a hash of this package's sources.
+    """Numba's on-disk cache, keyed by a hash of the sources the compiled code depends on.
 
     Numba invalidates a cached function when ITS file changes, not when a function it
     calls from another module does (a sweep driver in integral.py inlines the kernels of
-    kernels/*.py).  Keying the whole cache on the sources of every module with jitted code
-    makes any edit or upgrade start from a clean cache.  ``NUMBA_CACHE_DIR``, if set, wins.
+    kernels/*.py).  Keying the whole cache on the sources of :func:`hashed_sources` (the
+    import graph of every module with jitted code) makes any edit or upgrade start from a
+    clean cache.  ``NUMBA_CACHE_DIR``, if set, wins.
     """
     if os.environ.get("NUMBA_CACHE_DIR"):
         return os.environ["NUMBA_CACHE_DIR"]
     here = Path(__file__).resolve().parents[1]
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
     h = hashlib.sha256()
-    for p in hashed_sources():
+    for p in _memo_sources(here, base):
         h.update(p.relative_to(here).as_posix().encode())
         h.update(p.read_bytes())
-    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
     return os.path.join(base, "ipmc_asym", f"numba-{nb.__version__}-{h.hexdigest()[:16]}")
 
 

@@ -1,4 +1,4 @@
-"""The Numba cache is keyed on every module that defines jitted code."""
+"""The Numba cache is keyed on every module that defines jitted code and what it imports."""
 
 import re
 from pathlib import Path
@@ -13,6 +13,44 @@ def test_cache_key_covers_every_jitted_module():
               if re.search(r"^@(jit|jit_parallel)\b", p.read_text(), re.M)}
     assert jitted, "no jitted modules found"
     assert jitted <= {p.resolve() for p in _jit.hashed_sources()}
+
+
+def test_cache_key_covers_what_compiled_code_reaches():
+    """Independent of the ``ast`` walk: at run time, every jitted function's module, and every
+    package module or jitted function bound in that module's globals (what Numba may inline),
+    is among the hashed sources."""
+    import importlib
+    import pkgutil
+    import types
+
+    root = Path(ipmc_asym.__file__).parent
+    hashed = {p.resolve() for p in _jit.hashed_sources()}
+    reached = set()
+    for mod in pkgutil.walk_packages(ipmc_asym.__path__, "ipmc_asym."):
+        if mod.name.startswith("ipmc_asym.cli") or mod.name.endswith("__main__"):
+            continue
+        m = importlib.import_module(mod.name)
+        for f in vars(m).values():
+            if not _jit._is_jitted(f) or not f.py_func.__module__.startswith("ipmc_asym."):
+                continue
+            g = f.py_func.__globals__
+            reached.add(Path(g["__file__"]).resolve())
+            for v in g.values():
+                if isinstance(v, types.ModuleType) and v.__name__.startswith("ipmc_asym."):
+                    reached.add(Path(v.__file__).resolve())
+                elif _jit._is_jitted(v) and v.py_func.__module__.startswith("ipmc_asym."):
+                    reached.add(Path(v.py_func.__globals__["__file__"]).resolve())
+    assert any(p.parent.name != "kernels" for p in reached)  # integral/, io/, beam/ hold drivers too
+    missing = sorted(str(p.relative_to(root)) for p in reached - hashed)
+    assert missing == []
+
+
+def test_memoised_source_list_is_the_computed_one(tmp_path):
+    root = Path(ipmc_asym.__file__).resolve().parent
+    fresh = _jit._memo_sources(root, str(tmp_path))  # computes and stores
+    again = _jit._memo_sources(root, str(tmp_path))  # reads the stored list
+    assert [p.resolve() for p in again] == [p.resolve() for p in fresh] == [p.resolve() for p in _jit.hashed_sources()]
+    assert len(list(tmp_path.rglob("sources-*.txt"))) == 1
 
 
 def test_flags_set_in_one_place():

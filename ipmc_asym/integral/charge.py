@@ -1,0 +1,197 @@
+"""Static electrode charge and differential capacitance at every fidelity.
+
+Gauss's law with blocking electrodes (seed paper section 4): the face ``z = -e`` (where
+``phi0`` is applied) carries the surface charge ``sigma = D_z(-e)`` per unit area, the face
+``z = +e`` carries ``-sigma`` (``D_z(e) = D_z(-e)`` by electroneutrality).  Derived in
+``derivations/charge.py`` (generated into :mod:`ipmc_asym.kernels._generated_charge`):
+
+* ``sigma = S Dhat(ln B1)`` with ``S = sqrt(phi4 C_moy eps_core R T)`` (C/m^2) for a neutral core:
+  the lambda-expansion of the face induction stops at first order, so ``leading`` and
+  ``corrected`` give the same closed form;
+* ``C_d = dsigma/dphi0 = (eps_core/lambda_D) chat_c chat_a/(chat_c + chat_a)``: the two layer
+  capacitances ``chat = exprel(Y) w(Y)`` in series (analytic derivative);
+  ``C_d(0) = eps_core/(2 lambda_D)`` (Debye-Hueckel, thick strip);
+* ``Q = sigma 2l L`` and the apparent permittivity ``eps_app = C_d 2e`` that a capacitance
+  measurement on the strip (parallel-plate reading) would report.
+
+Fidelities: ``leading``/``corrected`` (closed form), ``quadrature`` (``sigma`` as the layer
+integral ``int_0^{Yc} chat dy`` by Gauss-Legendre panels, generic-rho kernels), ``exact`` (the
+exact solution at any thickness, :mod:`ipmc_asym.kernels.charge_exact`: ``sigma = S sqrt(Dhat^2 +
+kappa^2)``, ``C_d`` by implicit differentiation of the thickness constraint; ``C_d(0) = eps_core
+coth(e/lambda_D)/(2 lambda_D)``), ``bvp`` (face value of ``D`` from the full BVP; ``C_d`` by a
+central difference of two BVP solves with a Richardson error estimate).  The closed forms'
+error estimates are twice the neutral-core asymptotics of their difference from the exact
+solution (``kernels/charge_exact.py``), or twice the measured difference where that exceeds
+``NEAR_LIMIT``.  ``Yc = ln B1`` comes from the generated small-voltage series below
+``A2 = 0.25`` (no cancellation), and ``sigma = C_d_secant phi0`` is formed without ``A2^2``, so
+``sigma -> C_d(0) phi0`` down to 0 V and subnormal voltages.  Thickness is the TOTAL ``2e``; SI
+throughout.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ipmc_asym.base.registry import FIDELITIES as _FIDELITY_SPECS
+from ipmc_asym.base.settings import BVP_STATED_ERROR, VALIDITY_LIMIT
+from ipmc_asym.integral.api import check_fidelity, check_min_thickness, paper_model_id
+from ipmc_asym.kernels.charge import GL_W, GL_X, charge_sweep
+from ipmc_asym.model import groups
+from ipmc_asym.model.params import NAFION_LI, Material, Strip, check_positive
+from ipmc_asym.model.permittivity import Permittivity, get_model
+
+__all__ = ["ChargeResult", "charge", "charge_scale", "capacitance_scale", "SUBNORMAL"]
+
+#: largest subnormal magnitude: below it a float carries an absolute rounding of 2^-1075
+SUBNORMAL = 2.2250738585072014e-308
+
+
+@dataclass
+class ChargeResult:
+    """Static electrode charge and capacitance; arrays broadcast from the inputs (SI).
+
+    Attributes
+    ----------
+    sigma : ndarray   surface charge of the face z = -e (where phi0 is applied), C/m^2; odd in phi0
+    Q : ndarray       total charge of that electrode ``sigma * width * length`` (C)
+    C_diff : ndarray  differential capacitance per area ``dsigma/dphi0``, F/m^2
+    eps_app : ndarray apparent permittivity ``C_diff * thickness`` (TOTAL 2e), F/m
+    error : ndarray   relative error estimate of ``sigma`` and of ``Q`` (including the rounding of a
+                      subnormal result: 1 where ``Q`` underflows to 0 at ``|phi0|`` ~ 1e-323 V)
+    error_C_diff : ndarray  relative error estimate of ``C_diff`` (and of ``eps_app``)
+    core : ndarray    neutral core left between the layers (units of e)
+    valid : ndarray of bool  both error estimates below ``VALIDITY_LIMIT``
+    fidelity, model : str
+    """
+
+    sigma: np.ndarray
+    Q: np.ndarray
+    C_diff: np.ndarray
+    eps_app: np.ndarray
+    error: np.ndarray
+    error_C_diff: np.ndarray
+    core: np.ndarray
+    valid: np.ndarray
+    fidelity: str
+    model: str
+
+
+def charge_scale(perm: Permittivity, material: Material) -> float:
+    """``S = sqrt(phi4 C_moy eps_core R T)`` (C/m^2): ``sigma = S Dhat`` (derivations/charge.py)."""
+    m = material
+    return math.sqrt(m.phi4 * m.C_moy * perm.eps_moy * m.R * m.T)
+
+
+def capacitance_scale(perm: Permittivity, material: Material) -> float:
+    """``S F/(R T) = eps_core/lambda_D`` (F/m^2): ``C_d = that * Cdhat``."""
+    return charge_scale(perm, material) * groups.inverse_thermal_voltage(material)
+
+
+def charge(thickness, voltage, model="constant", fidelity="corrected", *, width=5.0e-3, length=0.02,
+           material: Material | None = None) -> ChargeResult:
+    """Electrode charge ``sigma``, ``Q``, differential capacitance and apparent permittivity.
+
+    Parameters
+    ----------
+    thickness : float or array_like
+        TOTAL thickness ``2e`` (m), > 0.
+    voltage : float or array_like
+        ``phi0`` (V), any sign (``sigma`` is odd, ``C_diff`` even); broadcast with ``thickness``.
+    model : {"constant", "linear", "affine"}, Permittivity or callable
+        A callable ``eps(C)`` needs ``fidelity="bvp"``.
+    fidelity : {"leading", "corrected", "quadrature", "exact", "bvp"}
+    width, length : float
+        TOTAL width ``2l`` and length ``L`` (m), for ``Q = sigma 2l L``.
+    material : Material, optional (default ``nafion-li``)
+
+    Returns
+    -------
+    ChargeResult
+        Arrays of the broadcast shape (0-d for scalar inputs), SI.
+    """
+    check_fidelity(fidelity)
+    perm = get_model(model)
+    mat = NAFION_LI if material is None else material
+    w = check_positive("width (total, 2l)", width, "m")
+    L = check_positive("length", length, "m")
+    th = np.asarray(thickness, dtype=float)
+    v = np.asarray(voltage, dtype=float)
+    if not np.all(np.isfinite(th)) or np.any(th <= 0):
+        raise ValueError("thickness (total, 2e) must be finite and > 0 m")
+    if not np.all(np.isfinite(v)):
+        raise ValueError("voltage must be finite (volts)")
+    th, v = np.broadcast_arrays(th, v)
+    if perm.is_custom and fidelity != "bvp":
+        raise ValueError(f"a custom eps(C) needs fidelity 'bvp'; got fidelity {fidelity!r}")
+    check_min_thickness(th)
+    if fidelity == "bvp":
+        sig, cdv, err, errc, core = _bvp(th, v, perm, mat)
+    else:
+        A2 = np.abs(np.asarray(groups.A2(v, mat), dtype=float)).reshape(-1)
+        lam = np.asarray(groups.debye_length(th, perm.eps_moy, mat), dtype=float).reshape(-1)
+        rho = perm.eps0 / perm.eps_moy
+        outs = [np.empty(A2.size) for _ in range(5)]
+        charge_sweep(np.ascontiguousarray(A2), np.ascontiguousarray(lam), rho, paper_model_id(perm),
+                     _FIDELITY_SPECS[fidelity].kernel_code, GL_X, GL_W, *outs)
+        g, cdh, err, errc, core = (o.reshape(th.shape) for o in outs)
+        # sigma = (S F/RT) (sigma_hat/A2) phi0: odd in phi0, -> C_d(0) phi0, no A2^2 formed
+        sig = capacitance_scale(perm, mat) * g * v
+        cdv = capacitance_scale(perm, mat) * cdh
+        err = err + _subnormal_rounding(sig) + _subnormal_rounding(sig * w * L, sig)
+    valid = (err < VALIDITY_LIMIT) & (errc < VALIDITY_LIMIT)
+    return ChargeResult(sigma=sig, Q=sig * w * L, C_diff=cdv, eps_app=cdv * th, error=err,
+                        error_C_diff=errc, core=core, valid=valid, fidelity=fidelity, model=perm.name)
+
+
+
+def _subnormal_rounding(x, nonzero=None):
+    """Relative rounding of subnormal results (absolute 2^-1075); 1 where ``x`` underflowed to 0
+    although ``nonzero`` (the value it was computed from) is not 0."""
+    x = np.asarray(x, dtype=float)
+    ref = x if nonzero is None else np.asarray(nonzero, dtype=float)
+    ax = np.abs(x)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        out = np.where((ax > 0.0) & (ax < SUBNORMAL), 5e-324 / ax, 0.0)
+    return np.where((ax == 0.0) & (ref != 0.0), 1.0, out)
+
+
+def _bvp_sigma(thickness, voltage, perm, mat):
+    from ipmc_asym.bvp.solver import solve  # deferred: scipy.integrate is heavy (start-up of the closed forms)
+
+    with np.errstate(all="ignore"):
+        try:
+            r = solve(Strip(thickness=thickness, voltage=voltage), perm, mat)
+        except (ArithmeticError, FloatingPointError):
+            r = None
+    if r is None or not r.success or not np.all(np.isfinite(r.D)):
+        raise RuntimeError(f"BVP did not converge at thickness={thickness:g} m, voltage={voltage:g} V "
+                           f"({'no finite solution' if r is None else r.message}); try fidelity 'exact'")
+    # D_bar = D_z/(e phi4 F C_moy) at the face z = -1 (mirrored for a negative voltage)
+    return 0.5 * thickness * mat.phi4 * mat.F * mat.C_moy * float(r.D[0])
+
+
+def _bvp(th, v, perm, mat):
+    """Point by point: sigma from the BVP face value, C_d by central differences (Richardson)."""
+    sig = np.empty(th.shape)
+    cd = np.empty(th.shape)
+    err = np.full(th.shape, BVP_STATED_ERROR)
+    errc = np.empty(th.shape)
+    core = np.full(th.shape, 2.0)
+    VT = groups.thermal_voltage(mat)
+    for idx in np.ndindex(th.shape):
+        t, u = float(th[idx]), float(v[idx])
+        sig[idx] = _bvp_sigma(t, u, perm, mat)
+        h = 1e-3 * VT * max(1.0, abs(u) / VT) ** 0.5
+        f = {k: _bvp_sigma(t, u + k * h, perm, mat) if k else sig[idx] for k in (-2, -1, 1, 2)}
+        d1 = (f[1] - f[-1]) / (2 * h)
+        d2 = (f[2] - f[-2]) / (4 * h)
+        cd[idx] = (4 * d1 - d2) / 3  # Richardson: O(h^4)
+        if cd[idx] == 0.0:  # below the resolution of the difference quotient: no relative bound
+            errc[idx] = math.inf
+        else:
+            errc[idx] = (abs(d1 - d2) / 3 + 4 * BVP_STATED_ERROR * abs(sig[idx]) / h) / abs(cd[idx])
+    return sig, cd, err, errc, core
+
