@@ -40,8 +40,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ipmc_asym.base.ladder import climb, escalation_note, rungs_from
 from ipmc_asym.base.registry import check_choice
-from ipmc_asym.base.settings import VALIDATED_VOLTAGE
 from ipmc_asym.beam.dynamics import (
     CLAMPED_OUTPUTS,
     DEFAULT_MODES,
@@ -61,7 +61,7 @@ from ipmc_asym.dynamics.electrode import (
     time_constant,
 )
 from ipmc_asym.dynamics.transient import solve_transient
-from ipmc_asym.forward.model import CHECKS, assumption_warnings, forward, voltage_reason
+from ipmc_asym.forward.model import assumption_warnings, forward
 from ipmc_asym.integral.api import paper_model_id
 from ipmc_asym.kernels import _generated_charge as GC
 from ipmc_asym.kernels.charge import GL_W, GL_X
@@ -291,13 +291,14 @@ class StepResult:
     sigma_error: np.ndarray | None = None
 
 
-def quasi_static_forward(u, strip: Strip, perm: Permittivity, material: Material):
+def quasi_static_forward(u, strip: Strip, perm: Permittivity, material: Material, checked_voltage=None):
     """The forward model (:class:`ipmc_asym.forward.model.ForwardResult`, withheld outputs NaN)
-    of the static strip at the layer voltage(s) ``u`` (V); see :func:`quasi_static_mechanics`."""
+    of the static strip at the layer voltage(s) ``u`` (V); see :func:`quasi_static_mechanics`.
+    ``checked_voltage``: the voltage its ``voltage`` check concerns (default ``u``)."""
     fid = "corrected" if paper_model_id(perm) >= 0 else "quadrature"
     with np.errstate(all="ignore"):
         return forward(strip.length, strip.width, strip.thickness, np.asarray(u, dtype=float), material=material,
-                       model=perm, fidelity=fid).withhold()
+                       model=perm, fidelity=fid, checked_voltage=checked_voltage).withhold()
 
 
 def quasi_static_mechanics(u, strip: Strip, perm: Permittivity, material: Material):
@@ -467,32 +468,50 @@ def step_response(voltage=1.0, duration=None, *, strip: Strip | None = None, mod
         tgrid, keep = _beam_grid(tgrid, dyn.period)
     sig_err = np.full(tgrid.size, np.nan)
     opts = dict(pnp_options or {})
-    r = None
     if tol is not None:
         tol = check_finite("tol", tol, "a relative tolerance in [1e-8, 0.5)")
         if not 1e-8 <= tol < 0.5:
             raise ValueError(f"tol must be in [1e-8, 0.5) (relative on sigma); got {tol!r}")
         opts["tol"] = min(tol, 9e-3)
+    pnp_ref = []  # the PNP run that bounds the circuit's error: also the pnp rung
+
+    def evaluate(f, idx):
+        if f == "circuit":
+            sigma, u, J = circuit_response(tgrid, fun, s, perm, m)
+            err = sig_err
+            if tol is not None:
+                r, err = _circuit_error(sigma, tgrid, fun, s, perm, m, opts)
+                pnp_ref.append(r)
+            return sigma, u, J, err
+        return pnp_ref[0] if pnp_ref else solve_transient(tgrid, fun, s, perm, m, **opts)
+
+    def checks(f, r, idx):
+        if f == "pnp":
+            return bool(r.success), f"transient PNP solver failed: {r.message}"
+        if tol is None:  # no error bound: the circuit is taken as it is
+            return True, ""
+        err = r[3]
+        scale = float(np.max(np.abs(r[0])))
+        bad = err > tol * scale
+        # validity window: from the first output time after which every later one meets tol
+        extra["valid_from"] = (float(tgrid[0]) if not bad.any() else
+                               float(tgrid[np.nonzero(bad)[0][-1] + 1]) if not bad[-1] else None)
+        extra["circuit_error_max_rel"] = float(np.max(err)) / scale
+        return not bad.any(), (f"the circuit's error bound {extra['circuit_error_max_rel']:.2g} (relative) exceeds "
+                               f"tol = {tol:g}")
+
+    lad = climb(rungs_from(STEP_FIDELITIES, fidelity), evaluate, checks)
+    if lad.left.size:
+        raise RuntimeError(lad.message(f"thickness (total 2e) {s.thickness:.3g} m, voltage {float(voltage):.3g} V "
+                                       f"(model {perm.name})"))
+    for a, b in zip(lad.steps, lad.steps[1:]):
+        notes.append(escalation_note(a.rung, b.rung, lad.why[lad.steps.index(a)]))
+    fidelity = lad.last.rung
     if fidelity == "circuit":
-        sigma, u, J = circuit_response(tgrid, fun, s, perm, m)
+        sigma, u, J, sig_err = lad.last.result
         success, message = True, "reduced model integrated (variable-step BDF2, 2 substeps per output interval)"
-        if tol is not None:
-            r, sig_err = _circuit_error(sigma, tgrid, fun, s, perm, m, opts)
-            scale = float(np.max(np.abs(sigma)))
-            bad = sig_err > tol * scale
-            # validity window: from the first output time after which every later one meets tol
-            extra["valid_from"] = (float(tgrid[0]) if not bad.any() else
-                                   float(tgrid[np.nonzero(bad)[0][-1] + 1]) if not bad[-1] else None)
-            extra["circuit_error_max_rel"] = float(np.max(sig_err)) / scale
-            if bad.any():
-                fidelity = "pnp"
-                notes.append(f"fidelity escalated circuit -> pnp: the circuit's error bound "
-                             f"{extra['circuit_error_max_rel']:.2g} (relative) exceeds tol = {tol:g}")
-    if fidelity == "pnp":
-        if r is None:
-            r = solve_transient(tgrid, fun, s, perm, m, **opts)
-        if not r.success:
-            raise RuntimeError(f"transient PNP solver failed: {r.message}")
+    else:
+        r = lad.last.result
         sig_err = r.sigma_error
         sigma, J = r.sigma, r.current_density
         # the voltage left across the layers: phi0 minus the ohmic drop of the core (exact at
@@ -505,17 +524,11 @@ def step_response(voltage=1.0, duration=None, *, strip: Strip | None = None, mod
                      "extra['M_A_profiles']")
         extra = dict(extra, M_A_profiles=r.M_A_profiles)
     # every time point through the forward model and its checks (the same as estimate's)
-    fr = quasi_static_forward(u, s, perm, m)
-    checks = {c: np.asarray(getattr(fr, c), bool).reshape(-1) for c in CHECKS}
-    warns = assumption_warnings(fr)
     applied = fun(tgrid)
     # the voltage check concerns the applied voltage too (the layers' one lags behind it)
-    over = np.abs(applied) > VALIDATED_VOLTAGE
-    if np.any(over & checks["voltage"]):
-        checks["voltage"] = checks["voltage"] & ~over
-        bad = ~checks["voltage"]
-        warns = [w for w in warns if "VALIDATED_VOLTAGE" not in w]
-        warns.append(voltage_reason(np.max(np.abs(applied))) + f" [{int(bad.sum())} of {bad.size} points]")
+    fr = quasi_static_forward(u, s, perm, m, checked_voltage=np.where(np.abs(applied) > np.abs(u), applied, u))
+    checks = {c: a.reshape(-1) for c, a in fr.checks_mask.items()}
+    warns = assumption_warnings(fr)
     M, th, w, Fb = (np.asarray(getattr(fr, k), dtype=float) for k in ("M_A", "theta", "w", "F_block"))
     if dyn is not None:
         thd, wd, Fd = dyn.advance(tgrid, M, th, w, Fb)

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ipmc_asym.base.ladder import climb, rungs_from
 from ipmc_asym.base.registry import fidelity_names
 from ipmc_asym.integral.api import check_fidelity
 from ipmc_asym.integral.charge import SUBNORMAL, ChargeResult, capacitance_scale, charge, charge_scale
@@ -32,20 +33,23 @@ def charge_escalated(thickness: float, voltage: float, model="constant", fidelit
     Raises ``ValueError`` (one line) where no rung from ``fidelity`` up is valid.
     """
     check_fidelity(fidelity)
-    ladder = fidelity_names()
-    last = None
-    for rung in ladder[ladder.index(fidelity):]:
-        last = charge(thickness, voltage, model, rung, **kw)
-        if bool(last.valid):
-            return last
-        if float(voltage) != 0.0 and min(abs(float(last.sigma)), abs(float(last.Q))) < SUBNORMAL:
+
+    def checks(f, r, idx):
+        if bool(r.valid):
+            return True, ""
+        if float(voltage) != 0.0 and min(abs(float(r.sigma)), abs(float(r.Q))) < SUBNORMAL:
             # no rung helps: the value itself is below the normal range of a double
             raise ValueError(f"voltage {float(voltage):g} V is too small: sigma or Q = sigma 2l L falls below "
                              f"{SUBNORMAL:.3g} (doubles lose relative precision there; relative rounding "
-                             f"{float(last.error):.2g})")
-    raise ValueError(f"no fidelity from {fidelity!r} up is valid for model {get_model(model).name!r} (last rung "
-                     f"{last.fidelity!r}: error estimates {float(last.error):.2g} / {float(last.error_C_diff):.2g})")
+                             f"{float(r.error):.2g})")
+        return False, f"error estimates {float(r.error):.2g} / {float(r.error_C_diff):.2g}"
 
+    lad = climb(rungs_from(fidelity_names(), fidelity), lambda f, idx: charge(thickness, voltage, model, f, **kw),
+                checks)
+    if lad.left.size:
+        raise ValueError(lad.message(f"thickness (total 2e) {float(thickness):.3g} m, voltage {float(voltage):.3g} V "
+                                     f"(model {get_model(model).name})"))
+    return lad.last.result
 
 
 def layer_voltage(sigma, model="constant", material: Material | None = None):

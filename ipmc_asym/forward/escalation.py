@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ipmc_asym.base.ladder import SkipRung, climb, rungs_from
 from ipmc_asym.base.registry import FIDELITIES as _FIDELITY_SPECS
 from ipmc_asym.base.registry import fidelity_names
 from ipmc_asym.base.settings import VALIDITY_LIMIT
@@ -19,7 +20,8 @@ from ipmc_asym.integral.api import ANY_THICKNESS, check_fidelity, check_min_thic
 from ipmc_asym.model.params import NAFION_LI, Material
 from ipmc_asym.model.permittivity import get_model
 
-__all__ = ["moment_escalating", "Escalated", "Climb", "check_tol", "rung_checks", "ladder_inputs"]
+__all__ = ["moment_escalating", "Escalated", "Climb", "check_tol", "rung_checks", "ladder_inputs", "rung_reason",
+           "where_point"]
 
 
 def check_tol(tol, what="tol"):
@@ -148,42 +150,58 @@ def moment_escalating(thickness, voltage, model="constant", fidelity="quadrature
     """
     tol, limit, th, v, shape = ladder_inputs(thickness, voltage, fidelity, tol)
     perm = get_model(model)
-    n = th.size
-    climb = Climb(n)
-    todo = np.ones(n, bool)
-    why = []
-    names = fidelity_names()
-    rungs = names[names.index(fidelity):] if escalate else (fidelity,)
-    for f in rungs:
-        idx = np.flatnonzero(todo)
-        if idx.size == 0:
-            break
+    return _moment_ladder(th, v, perm, fidelity, material, limit, escalate, progress).result(shape)
+
+
+class _Recorded:
+    """A :class:`Climb` filled by a :func:`~ipmc_asym.base.ladder.climb`; ``result`` adds its
+    validity and its one-line message (``where`` names a flat point)."""
+
+    def __init__(self, climb: Climb, ladder, where):
+        self.climb, self.ladder, self.where = climb, ladder, where
+
+    def result(self, shape=None) -> Escalated:
+        lad = self.ladder
+        msg = lad.message(self.where(int(lad.left[0]))) if lad.left.size else ""
+        return self.climb.result(lad.valid, msg, shape)
+
+
+def where_point(th, v, perm) -> callable:
+    """``k -> "thickness ..., voltage ... (model ...)"``: the flat point ``k`` named in a message."""
+    return lambda k: f"thickness (total 2e) {th[k]:.3g} m, voltage {v[k]:.3g} V (model {perm.name})"
+
+
+def rung_reason(I_k, error_k, l_ok_k, limit, message=""):
+    """Why a rung's value is not valid at one point: the solver's message, or the error bound
+    above the limit (and the layers overlapping)."""
+    if message:
+        return message
+    return f"error bound {float(error_k):.2g} > {limit:g}" + ("" if l_ok_k else ", electrode layers overlap")
+
+
+def _moment_ladder(th, v, perm, fidelity, material, limit, escalate, progress) -> _Recorded:
+    """The climb of :func:`moment_escalating` on checked flat inputs."""
+    rec = Climb(th.size)
+
+    def evaluate(f, idx):
         if perm.is_custom and _FIDELITY_SPECS[f].compiled:
-            why.append(f"{f}: not available for a custom eps(C)")
-            continue
+            raise SkipRung("not available for a custom eps(C)")
         try:
-            r = moment(th[idx], v[idx], perm, f, material=material,
-                       progress=(False if _FIDELITY_SPECS[f].compiled else progress))
+            return moment(th[idx], v[idx], perm, f, material=material,
+                          progress=(False if _FIDELITY_SPECS[f].compiled else progress))
         except ValueError as exc:  # e.g. closed forms for a non-paper Permittivity
-            why.append(f"{f}: {exc}")
-            continue
+            raise SkipRung(str(exc)) from None
+
+    def checks(f, r, idx):
         e_ok, l_ok = rung_checks(r.I, r.error, r.core, f, limit)
         # r.valid adds the rung's own ceiling (registry) to the checks here
         ok = e_ok & l_ok & np.asarray(r.success) & np.asarray(r.valid)
-        sel = climb.take(f, idx, ok, r.I, r.error, r.core, e_ok, l_ok, B1=r.B1)
-        todo[sel] = False
-        bad = ~ok
-        if np.any(bad):
-            k = int(np.flatnonzero(bad)[0])
-            if r.message and not r.success[k]:
-                why.append(f"{f}: {r.message}")
-            else:
-                why.append(f"{f}: error bound {float(r.error[k]):.2g} > {limit:g}"
-                           + ("" if l_ok[k] else ", electrode layers overlap"))
-    valid = ~todo
-    msg = ""
-    if np.any(todo):
-        k = int(np.flatnonzero(todo)[0])
-        msg = (f"no valid fidelity at thickness (total 2e) {th[k]:.3g} m, voltage {v[k]:.3g} V "
-               f"(model {perm.name}): " + "; ".join(why[-3:]))
-    return climb.result(valid, msg, shape)
+        rec.take(f, idx, ok, r.I, r.error, r.core, e_ok, l_ok, B1=r.B1)
+        if np.all(ok):
+            return ok, ""
+        k = int(np.flatnonzero(~ok)[0])
+        solver = r.message if (r.message and not r.success[k]) else ""
+        return ok, rung_reason(r.I[k], r.error[k], l_ok[k], limit, solver)
+
+    lad = climb(rungs_from(fidelity_names(), fidelity, escalate), evaluate, checks, th.size)
+    return _Recorded(rec, lad, where_point(th, v, perm))

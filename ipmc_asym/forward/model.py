@@ -30,11 +30,20 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from ipmc_asym.base.ladder import climb, rungs_from
 from ipmc_asym.base.registry import FIDELITIES as _FIDELITY_SPECS
 from ipmc_asym.base.registry import compiled_fidelities
 from ipmc_asym.base.settings import OUTSIDE_REGIMES, STRAIN_LIMIT, STRAIN_LIMIT_SOURCE, VALIDATED_VOLTAGE, VALIDITY_LIMIT
 from ipmc_asym.beam.statics import REGIMES, blocking_force_ratio, solve_beam
-from ipmc_asym.forward.escalation import Climb, Escalated, check_tol, moment_escalating, rung_checks
+from ipmc_asym.forward.escalation import (
+    Climb,
+    Escalated,
+    check_tol,
+    moment_escalating,
+    rung_checks,
+    rung_reason,
+    where_point,
+)
 from ipmc_asym.forward.pressure import moment_pressure_escalating
 from ipmc_asym.integral.api import check_fidelity, check_min_thickness, closed_model_id, validity_limit
 from ipmc_asym.integral.samples import moment_samples
@@ -187,11 +196,13 @@ class ForwardResult:
     fidelity_used : ndarray of str   rung that produced ``I`` ("" where none)
     escalated : ndarray of bool   ``fidelity_used`` is a rung above the requested one
     electrochemistry, layer_separation, beam_regime, blocked_regime, strain, voltage, slender : ndarray of bool
-        the checks (:data:`CHECKS`)
+        the checks (:data:`CHECKS`); also :attr:`checks_mask` ``[name]`` (the voltage itself is
+        ``inputs["voltage"]``)
     moment_valid : ndarray of bool   a rung is valid (``I`` computed)
     valid : ndarray of bool   every check
     strain_limit : float   ``Material.strain_limit`` the strain check used
-    message : str    why the first invalid point fails ("" if every point is valid)
+    message : str    why the first invalid point fails ("" if every point is valid): no valid rung, else
+        its first failed model assumption in the order of :data:`CHECKS` (:func:`assumption_warnings`' line)
     moment_message : str   why the first point without a valid rung has none ("" if none)
     beam_warnings : list of str   :func:`ipmc_asym.beam.statics.solve_beam` warnings
     fidelity : str   the rung requested
@@ -230,6 +241,12 @@ class ForwardResult:
     fidelity: str = ""
     strain_limit: float = STRAIN_LIMIT
     inputs: dict = field(default_factory=dict, repr=False)
+
+    @property
+    def checks_mask(self) -> dict:
+        """``{check: bool array}`` of every check of :data:`CHECKS`, in that order (the check
+        booleans; ``.voltage``, ``.strain``, ... are the same arrays under the check's name)."""
+        return {c: np.asarray(getattr(self, c), bool) for c in CHECKS}
 
     def checks(self, index=()) -> dict:
         """``{check: bool}`` of one point (``index`` into the arrays; ``()`` for 0-d results)."""
@@ -293,22 +310,27 @@ def assumption_warnings(r: "ForwardResult", index=None) -> list:
         bad = np.flatnonzero(sel & ok_m & ~np.asarray(getattr(r, c), bool).reshape(-1))
         if bad.size == 0:
             continue
-        j = int(bad[0])
         count = "" if index is not None or size == 1 else f" [{len(bad)} of {size} points; first shown]"
-        if c == "strain":
-            line = strain_reason(np.asarray(r.max_strain).reshape(-1)[j], r.strain_limit)
-        elif c == "beam_regime":
-            line = regime_reason(str(np.asarray(r.regime).reshape(-1)[j]), np.asarray(r.theta).reshape(-1)[j])
-        elif c == "blocked_regime":
-            line = blocked_reason(np.asarray(r.theta).reshape(-1)[j])
-        elif c == "voltage":
-            line = voltage_reason(np.asarray(r.inputs["voltage"]).reshape(-1)[j])
-        else:
-            q = {k: float(np.asarray(r.inputs[k]).reshape(-1)[j]) for k in ("length", "width", "thickness")}
-            out += [x + count for x in slender_warnings(q["length"], q["width"], q["thickness"])]
-            continue
-        out.append(line + count)
+        out += [x + count for x in _reasons(r, c, int(bad[0]))]
     return out
+
+
+def _reasons(r: "ForwardResult", c: str, j: int) -> list:
+    """The line(s) of the failed model assumption ``c`` at the flat point ``j`` (one per
+    failed slenderness ratio); what :func:`assumption_warnings` and ``ForwardResult.message`` say."""
+    def at(a):
+        return np.asarray(a).reshape(-1)[j]
+
+    if c == "strain":
+        return [strain_reason(at(r.max_strain), r.strain_limit)]
+    if c == "beam_regime":
+        return [regime_reason(str(at(r.regime)), at(r.theta))]
+    if c == "blocked_regime":
+        return [blocked_reason(at(r.theta))]
+    if c == "voltage":
+        return [voltage_reason(at(r.inputs.get("checked_voltage", r.inputs["voltage"])))]
+    q = {k: float(at(r.inputs[k])) for k in ("length", "width", "thickness")}
+    return slender_warnings(q["length"], q["width"], q["thickness"])
 
 
 def distinct_pairs(code):
@@ -342,35 +364,36 @@ def _moment_per_point_material(th, v, perm, fidelity, material, c_moy, tol, esca
     A3 = groups.A3(material, c_moy)
     rho = perm.eps0 / eps_core
     sign = np.sign(v)
-    n = th.size
-    climb = Climb(n)
-    last_err = np.full(n, np.inf)
-    todo = np.arange(n)
-    ladder = SAMPLING_FIDELITIES[SAMPLING_FIDELITIES.index(fidelity):] if escalate else (fidelity,)
-    for f in ladder:
-        if todo.size == 0:
-            break
-        mid = closed_model_id(perm, f)
-        Ii, ei, ci = np.empty(todo.size), np.empty(todo.size), np.empty(todo.size)
-        moment_samples(lam[todo], A2[todo], A3[todo], rho, mid, _FIDELITY_SPECS[f].kernel_code, sign[todo], Ii, ei, ci)
+    rec = Climb(th.size)
+
+    def evaluate(f, idx):
+        Ii, ei, ci = np.empty(idx.size), np.empty(idx.size), np.empty(idx.size)
+        moment_samples(lam[idx], A2[idx], A3[idx], rho, closed_model_id(perm, f), _FIDELITY_SPECS[f].kernel_code,
+                       sign[idx], Ii, ei, ci)
+        return Ii, ei, ci
+
+    def checks(f, r, idx):
+        Ii, ei, ci = r
         e_ok, l_ok = rung_checks(Ii, ei, ci, f, limit)
         e_ok &= ei < validity_limit(f)  # the rung's own ceiling (integral.api.validity_limit)
         ok = e_ok & l_ok
-        climb.take(f, todo, ok, Ii, ei, ci, e_ok, l_ok)
-        last_err[todo] = ei
-        todo = todo[~ok]
-    valid = np.ones(n, bool)
-    valid[todo] = False
+        rec.take(f, idx, ok, Ii, ei, ci, e_ok, l_ok)
+        if np.all(ok):
+            return ok, ""
+        k = int(np.flatnonzero(~ok)[0])
+        return ok, rung_reason(Ii[k], ei[k], l_ok[k], min(limit, validity_limit(f)))
+
+    lad = climb(rungs_from(SAMPLING_FIDELITIES, fidelity, escalate), evaluate, checks, th.size)
     msg = ""
-    if todo.size:
-        msg = (f"{todo.size} of {n} points are outside the validity of {' / '.join(ladder)} at tolerance "
-               f"{limit:g} (worst error estimate {float(np.max(last_err[todo])):.2g})")
-    return climb.result(valid, msg)
+    if lad.left.size:
+        k = int(lad.left[0])
+        msg = lad.message(where_point(th, v, perm)(k) + f", c_moy {float(c_moy[k]):.3g} mol/m^3")
+    return rec.result(lad.valid, msg)
 
 
 def forward(length, width, thickness, voltage, *, modulus=None, c_moy=None, material: Material = NAFION_LI,
             model="constant", fidelity="quadrature", tol=None, escalate: bool = True,
-            pair_code=None, pressure_term: bool = False) -> ForwardResult:
+            pair_code=None, pressure_term: bool = False, checked_voltage=None) -> ForwardResult:
     """Mechanical outputs of the strip(s), with the validity checks (SI units).
 
     Parameters
@@ -404,6 +427,10 @@ def forward(length, width, thickness, voltage, *, modulus=None, c_moy=None, mate
         ``beta = (v1 - M1 v2/M2) C_moy`` from ``material``): ``I`` from the rungs that hold it,
         ``exact`` then ``bvp`` (:func:`ipmc_asym.forward.pressure.moment_pressure_escalating`;
         a cheaper ``fidelity`` starts there).  Default off: the paper's model.
+    checked_voltage : array_like, optional
+        The voltage (V) the ``voltage`` check concerns, where it is not ``voltage`` itself (a
+        transient: the applied voltage, which the layers' voltage lags behind); kept in
+        ``inputs["checked_voltage"]``.  Default ``voltage``.
 
     All inputs broadcast to one shape ``S``.
 
@@ -472,7 +499,8 @@ def forward(length, width, thickness, voltage, *, modulus=None, c_moy=None, mate
         tb = np.abs(np.asarray(b.theta, dtype=float).reshape(-1)) * (1.0 - 0.5 * psi)
     blocked_ok = ok & (tb <= 0.5 * np.pi)
     strain_ok = ok & (strain <= material.strain_limit)
-    volt_ok = ok & (np.abs(v) <= VALIDATED_VOLTAGE)
+    cv = v if checked_voltage is None else np.broadcast_to(np.asarray(checked_voltage, float), shape).reshape(-1)
+    volt_ok = ok & (np.abs(cv) <= VALIDATED_VOLTAGE)
     slender = ok & np.broadcast_to(slender_ok(L, wd, th), (k,))
     elec = rows(r.electrochemistry.reshape(-1))
     layer = rows(r.layer_separation.reshape(-1))
@@ -481,33 +509,23 @@ def forward(length, width, thickness, voltage, *, modulus=None, c_moy=None, mate
             for c in ("theta", "w", "w_small", "x_tip", "y_tip", "F_block", "F_block_small", "small_error",
                       "block_error")}
     reg = masked(np.asarray(b.regime), "")
-    message = ""
-    if not bool(np.all(valid)):
-        j = int(np.argmin(valid))
-        if not ok[j]:
-            message = r.message
-        elif not strain_ok[j]:
-            message = strain_reason(strain[j], material.strain_limit)
-        elif not beam_regime[j]:
-            message = regime_reason(reg[j], mech["theta"][j])
-        elif not blocked_ok[j]:
-            message = blocked_reason(mech["theta"][j])
-        elif not volt_ok[j]:
-            message = voltage_reason(v[j])
-        else:
-            message = slender_warnings(L[j], wd[j], th[j])[0]
-
     def rs(a):
         return np.asarray(a).reshape(shape)
 
-    return ForwardResult(
+    out = ForwardResult(
         I=rs(I), M_A=rs(masked(Mok, np.nan)), regime=rs(reg), regime_code=rs(rcode),
         max_strain=rs(masked(strain, np.nan)), B1=rs(rows(r.B1.reshape(-1))), error=rs(rows(r.error.reshape(-1))),
         fidelity_used=rs(used), escalated=rs((used != fidelity) & (used != "")),
         electrochemistry=rs(elec), layer_separation=rs(layer), beam_regime=rs(beam_regime),
         blocked_regime=rs(blocked_ok), strain=rs(strain_ok),
-        voltage=rs(volt_ok), slender=rs(slender), moment_valid=rs(ok), valid=rs(valid), message=message,
+        voltage=rs(volt_ok), slender=rs(slender), moment_valid=rs(ok), valid=rs(valid),
         moment_message=r.message, beam_warnings=list(b.warnings), fidelity=fidelity,
         strain_limit=float(material.strain_limit),
-        inputs={"length": rs(L), "width": rs(wd), "thickness": rs(th), "voltage": rs(v)},
+        inputs={"length": rs(L), "width": rs(wd), "thickness": rs(th), "voltage": rs(v),
+                **({} if checked_voltage is None else {"checked_voltage": rs(cv)})},
         **{c: rs(a) for c, a in mech.items()})
+    if not bool(np.all(valid)):  # the first invalid point, its first failed check in the order of CHECKS
+        j = int(np.argmin(valid))
+        failed = [c for c in ASSUMPTION_CHECKS if not out.checks_mask[c].reshape(-1)[j]]
+        out.message = r.message if not ok[j] else _reasons(out, failed[0], j)[0]
+    return out

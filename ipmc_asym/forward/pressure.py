@@ -10,10 +10,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from ipmc_asym.base.registry import fidelity_names
-from ipmc_asym.forward.escalation import Escalated, ladder_inputs
+from ipmc_asym.base.ladder import climb, rungs_from
+from ipmc_asym.forward.escalation import Climb, Escalated, ladder_inputs, rung_reason, where_point
 from ipmc_asym.integral.pressure import PRESSURE_FIDELITIES, moment_pressure_term
 from ipmc_asym.model.params import NAFION_LI, Material
+from ipmc_asym.model.permittivity import get_model
 
 __all__ = ["moment_pressure_escalating"]
 
@@ -32,34 +33,22 @@ def moment_pressure_escalating(thickness, voltage, model="constant", fidelity="e
             raise ValueError(f"pressure_term: fidelity {fidelity!r} does not hold the pressure term; use one of "
                              f"{', '.join(PRESSURE_FIDELITIES)} (or allow escalation)")
         fidelity = PRESSURE_FIDELITIES[0]
-    rungs = PRESSURE_FIDELITIES[PRESSURE_FIDELITIES.index(fidelity):] if escalate else (fidelity,)
-    n = th.size
-    I = np.full(n, np.nan)
-    err = np.full(n, np.inf)
-    B1 = np.full(n, np.nan)
-    used = np.full(n, "", dtype=f"U{max(len(f) for f in fidelity_names())}")
-    todo = np.arange(n)
-    why = ""
-    for f in rungs:
-        if todo.size == 0:
-            break
-        r = moment_pressure_term(th[todo], v[todo], model, f, material)
+    perm = get_model(model)
+    rec = Climb(th.size)
+
+    def checks(f, r, idx):
         with np.errstate(invalid="ignore"):
             ok = r.success & np.isfinite(r.I) & (r.error <= limit)
-        sel = todo[ok]
-        I[sel], err[sel], B1[sel], used[sel] = r.I[ok], r.error[ok], r.B1[ok], f
-        if not np.all(ok):
-            why = r.message or f"{f}: error bound above {limit:g}"
-        todo = todo[~ok]
-    valid = np.ones(n, bool)
-    valid[todo] = False
-    msg = ""
-    if todo.size:
-        k = int(todo[0])
-        msg = (f"no valid fidelity with the pressure term at thickness (total 2e) {th[k]:.3g} m, voltage "
-               f"{v[k]:.3g} V: {why}")
-    core = np.where(valid, np.inf, np.nan)  # both rungs hold at any thickness
-    rs = (lambda a: a.reshape(shape))
-    return Escalated(I=rs(I), error=rs(err), B1=rs(B1), core=rs(core), fidelity_used=rs(used),
-                     electrochemistry=rs(valid.copy()), layer_separation=rs(np.ones(n, bool)), valid=rs(valid),
-                     success=rs(valid), message=msg)
+        # both rungs hold at any thickness: the core is not a check (inf where kept)
+        rec.take(f, idx, ok, r.I, r.error, np.full(idx.size, np.inf), ok, np.ones(idx.size, bool), B1=r.B1)
+        if np.all(ok):
+            return ok, ""
+        k = int(np.flatnonzero(~ok)[0])
+        return ok, rung_reason(r.I[k], r.error[k], True, limit, r.message)
+
+    lad = climb(rungs_from(PRESSURE_FIDELITIES, fidelity, escalate),
+                lambda f, idx: moment_pressure_term(th[idx], v[idx], perm, f, material), checks, th.size)
+    msg = lad.message(where_point(th, v, perm)(int(lad.left[0])), what="with the pressure term") if lad.left.size else ""
+    out = rec.result(lad.valid, msg, shape)
+    out.layer_separation = np.ones(shape, bool)
+    return out

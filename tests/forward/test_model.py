@@ -92,7 +92,10 @@ def test_withholding_and_flags():
     # what a flag concerns: the free strip past a quarter turn flags theta, not the blocking force
     assert list(r.flag_mask("theta")) == [False, True, True, False]
     assert list(r.flag_mask("F_block")) == [False, True, False, False]
-    assert "strain" in r.message  # the first invalid point is 1
+    # the first invalid point is 1; its first failed assumption in the order of CHECKS, the line
+    # assumption_warnings gives for it
+    assert "multi-turn" in r.message and r.message == assumption_warnings(r, (1,))[0]
+    assert r.checks_mask["voltage"] is not r.inputs["voltage"] and list(r.checks_mask["voltage"]) == list(r.voltage)
     assert r.checks(2) == {"electrochemistry": True, "layer_separation": True, "beam_regime": False,
                            "blocked_regime": True, "strain": True, "voltage": True, "slender": True}
     # the nominal strip at 5 V (kappa L = 7.4): the blocked strip itself passes a quarter turn,
