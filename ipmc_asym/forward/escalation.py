@@ -7,7 +7,6 @@ rung gets NaN and the reason (:attr:`Escalated.message`).
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -16,22 +15,12 @@ from ipmc_asym.base.ladder import SkipRung, climb, rungs_from
 from ipmc_asym.base.registry import FIDELITIES as _FIDELITY_SPECS
 from ipmc_asym.base.registry import fidelity_names
 from ipmc_asym.base.settings import VALIDITY_LIMIT
-from ipmc_asym.integral.api import ANY_THICKNESS, check_fidelity, check_min_thickness, moment
+from ipmc_asym.integral.api import ANY_THICKNESS, _moment, check_fidelity, check_min_thickness
 from ipmc_asym.model.params import NAFION_LI, Material
-from ipmc_asym.model.permittivity import get_model
+from ipmc_asym.model.request import Request, check_tol
 
 __all__ = ["moment_escalating", "Escalated", "Climb", "check_tol", "rung_checks", "ladder_inputs", "rung_reason",
-           "where_point"]
-
-
-def check_tol(tol, what="tol"):
-    """``tol`` if it is a relative tolerance in (0, 1), else a one-line ``ValueError``."""
-    if tol is None:
-        return None
-    if isinstance(tol, bool) or not isinstance(tol, (int, float, np.floating)) or not math.isfinite(tol) \
-            or not 0.0 < float(tol) < 1.0:
-        raise ValueError(f"{what} must be a relative tolerance in (0, 1), e.g. 0.01 for 1 %; got {tol!r}")
-    return float(tol)
+           "where_point", "moment_ladder", "flat_inputs"]
 
 
 def rung_checks(I, error, core, fidelity: str, limit: float):
@@ -109,6 +98,16 @@ class Climb:
                          message=message)
 
 
+def flat_inputs(thickness, voltage):
+    """``(thickness, voltage, shape)``: the inputs broadcast and flattened, the thickness floor
+    checked (one-line ``ValueError``)."""
+    th, v = np.broadcast_arrays(np.asarray(thickness, float), np.asarray(voltage, float))
+    shape = th.shape
+    th, v = th.reshape(-1), v.reshape(-1)
+    check_min_thickness(th)
+    return th, v, shape
+
+
 def ladder_inputs(thickness, voltage, fidelity, tol):
     """The checked inputs of a ladder climb: ``(tol, limit, thickness, voltage, shape)`` with the
     inputs broadcast and flattened, ``limit = min(tol, VALIDITY_LIMIT)``, the fidelity and the
@@ -116,10 +115,7 @@ def ladder_inputs(thickness, voltage, fidelity, tol):
     check_fidelity(fidelity)
     tol = check_tol(tol)
     limit = VALIDITY_LIMIT if tol is None else min(tol, VALIDITY_LIMIT)
-    th, v = np.broadcast_arrays(np.asarray(thickness, float), np.asarray(voltage, float))
-    shape = th.shape
-    th, v = th.reshape(-1), v.reshape(-1)
-    check_min_thickness(th)
+    th, v, shape = flat_inputs(thickness, voltage)
     return tol, limit, th, v, shape
 
 
@@ -148,9 +144,9 @@ def moment_escalating(thickness, voltage, model="constant", fidelity="quadrature
     -------
     Escalated
     """
-    tol, limit, th, v, shape = ladder_inputs(thickness, voltage, fidelity, tol)
-    perm = get_model(model)
-    return _moment_ladder(th, v, perm, fidelity, material, limit, escalate, progress).result(shape)
+    req = Request(model, fidelity, tol, escalate)
+    th, v, shape = flat_inputs(thickness, voltage)
+    return moment_ladder(th, v, req, material, progress).result(shape)
 
 
 class _Recorded:
@@ -179,16 +175,18 @@ def rung_reason(I_k, error_k, l_ok_k, limit, message=""):
     return f"error bound {float(error_k):.2g} > {limit:g}" + ("" if l_ok_k else ", electrode layers overlap")
 
 
-def _moment_ladder(th, v, perm, fidelity, material, limit, escalate, progress) -> _Recorded:
-    """The climb of :func:`moment_escalating` on checked flat inputs."""
+def moment_ladder(th, v, req: Request, material: Material, progress=None) -> _Recorded:
+    """The climb of :func:`moment_escalating` on checked flat inputs (thickness floor held) and a
+    :class:`~ipmc_asym.model.request.Request`; ``.result(shape)`` is the :class:`Escalated`."""
+    perm, limit = req.model, req.limit
     rec = Climb(th.size)
 
     def evaluate(f, idx):
         if perm.is_custom and _FIDELITY_SPECS[f].compiled:
             raise SkipRung("not available for a custom eps(C)")
         try:
-            return moment(th[idx], v[idx], perm, f, material=material,
-                          progress=(False if _FIDELITY_SPECS[f].compiled else progress))
+            return _moment(th[idx], v[idx], perm, f, material,
+                           progress=(False if _FIDELITY_SPECS[f].compiled else progress))
         except ValueError as exc:  # e.g. closed forms for a non-paper Permittivity
             raise SkipRung(str(exc)) from None
 
@@ -203,5 +201,5 @@ def _moment_ladder(th, v, perm, fidelity, material, limit, escalate, progress) -
         solver = r.message if (r.message and not r.success[k]) else ""
         return ok, rung_reason(r.I[k], r.error[k], l_ok[k], limit, solver)
 
-    lad = climb(rungs_from(fidelity_names(), fidelity, escalate), evaluate, checks, th.size)
+    lad = climb(rungs_from(fidelity_names(), req.fidelity, req.escalate), evaluate, checks, th.size)
     return _Recorded(rec, lad, where_point(th, v, perm))

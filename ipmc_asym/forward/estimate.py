@@ -20,11 +20,11 @@ import numpy as np
 
 from ipmc_asym.base.registry import check_choice
 from ipmc_asym.forward.escalation import Escalated, check_tol, moment_escalating
-from ipmc_asym.forward.model import CHECKS, FREE_STRIP_KEYS, MECHANICAL_KEYS, assumption_warnings, forward
-from ipmc_asym.integral.api import check_fidelity, check_min_thickness
+from ipmc_asym.forward.model import CHECKS, FREE_STRIP_KEYS, MECHANICAL_KEYS, _forward, assumption_warnings
 from ipmc_asym.model.groups import pressure_beta
 from ipmc_asym.model.params import NAFION_LI, Material, Strip, debye_length
-from ipmc_asym.model.permittivity import MODELS, get_model
+from ipmc_asym.model.permittivity import MODELS
+from ipmc_asym.model.request import Request
 
 __all__ = ["evaluate", "estimate_rows", "RESULT_KEYS", "CHECKS", "moment_escalating", "Escalated",
            "check_tol", "FREE_STRIP_KEYS", "MECHANICAL_KEYS"]
@@ -77,15 +77,13 @@ def evaluate(strip: Strip, model="constant", fidelity="quadrature", material: Ma
         ``error_estimate`` bounds the relative error of ``I`` (hence of ``M_A``, ``theta``,
         ``w_small``, ``F_block_small``).
     """
-    check_fidelity(fidelity)
-    tol = check_tol(tol)
+    req = Request(model, fidelity, tol, escalate, pressure_term)
     check_choice("on_invalid", on_invalid, ("raise", "nan"))
-    perm = get_model(model)
-    check_min_thickness(strip.thickness)  # before the groups, which overflow for a 1e-300 m strip
+    perm = req.model
     t0 = time.perf_counter()
+    # the Strip holds its checks (the thickness floor: no 1e-300 m strip reaches the groups)
     g = perm.groups(strip, material)
-    r = forward(strip.length, strip.width, strip.thickness, strip.voltage, material=material, model=perm,
-                fidelity=fidelity, tol=tol, escalate=escalate, pressure_term=pressure_term)
+    r = _forward(strip.length, strip.width, strip.thickness, strip.voltage, req, material=material)
     settled = bool(r.moment_valid)
     if not settled and on_invalid == "raise":
         raise ValueError(r.moment_message)
@@ -149,8 +147,9 @@ def estimate_rows(strip: Strip, models=("constant", "linear", "affine"), fidelit
                      pressure_term=pressure_term) for m in models]
 
 
-def model_list(name: str) -> list[str]:
+def model_list(name: str) -> list:
+    """The models ``name`` stands for: the paper's three for ``"all"``, else ``[name]`` (checked
+    when its request is built)."""
     if name == "all":
         return list(MODELS)
-    get_model(name)
     return [name]

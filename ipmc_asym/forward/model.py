@@ -38,19 +38,18 @@ from ipmc_asym.beam.statics import REGIMES, blocking_force_ratio, solve_beam
 from ipmc_asym.forward.escalation import (
     Climb,
     Escalated,
-    check_tol,
-    moment_escalating,
+    moment_ladder,
     rung_checks,
     rung_reason,
     where_point,
 )
 from ipmc_asym.forward.pressure import moment_pressure_escalating
-from ipmc_asym.integral.api import check_fidelity, check_min_thickness, closed_model_id, validity_limit
+from ipmc_asym.integral.api import check_min_thickness, closed_model_id, validity_limit
 from ipmc_asym.integral.samples import moment_samples
 from ipmc_asym.model import groups
 from ipmc_asym.model.limits import slender_ok, slender_warnings
 from ipmc_asym.model.params import NAFION_LI, Material, moment_scale, second_moment
-from ipmc_asym.model.permittivity import get_model
+from ipmc_asym.model.request import Request
 
 __all__ = ["forward", "ForwardResult", "CHECKS", "NUMERICAL_CHECKS", "ASSUMPTION_CHECKS", "FLAGS", "MOMENT_KEYS",
            "FREE_STRIP_KEYS", "MECHANICAL_KEYS", "TIP_POSITION_KEYS", "WITHHOLD", "SAMPLING_FIDELITIES",
@@ -348,7 +347,7 @@ def distinct_pairs(code):
 
 
 def _moment_per_point_material(th, v, perm, fidelity, material, c_moy, tol, escalate) -> Escalated:
-    """:func:`moment_escalating` with ``C_moy`` per point (flat arrays): the compiled rungs of
+    """:func:`moment_escalating` with ``C_moy`` per point (flat arrays, thickness floor held): the compiled rungs of
     :data:`SAMPLING_FIDELITIES` through :func:`ipmc_asym.integral.samples.moment_samples`,
     whose ``A3 = -rho2 Z3/(C_moy F)`` and ``lam`` are arrays.  Same validity as
     :func:`moment_escalating`: error bound <= ``min(tol, VALIDITY_LIMIT)`` and below the rung's
@@ -356,7 +355,6 @@ def _moment_per_point_material(th, v, perm, fidelity, material, c_moy, tol, esca
     if fidelity not in SAMPLING_FIDELITIES:
         raise ValueError(f"fidelity {fidelity!r} is not available with a per-point c_moy; use one of "
                          f"{', '.join(SAMPLING_FIDELITIES)}")
-    check_min_thickness(th)
     limit = VALIDITY_LIMIT if tol is None else min(tol, VALIDITY_LIMIT)
     eps_core = perm.eps0 + perm.deps
     lam = groups.debye_length(th, eps_core, material, c_moy)  # core Debye length / e
@@ -445,15 +443,25 @@ def forward(length, width, thickness, voltage, *, modulus=None, c_moy=None, mate
         Unknown fidelity, bad ``tol``, a thickness below ``settings.MIN_THICKNESS``, a
         non-positive length or stiffness (one line each).
     """
-    check_fidelity(fidelity)
-    tol = check_tol(tol)
-    perm = get_model(model)
+    req = Request(model, fidelity, tol, escalate, pressure_term)
+    return _forward(length, width, thickness, voltage, req, modulus=modulus, c_moy=c_moy, material=material,
+                    pair_code=pair_code, checked_voltage=checked_voltage, floor_checked=False)
+
+
+def _forward(length, width, thickness, voltage, req: Request, *, modulus=None, c_moy=None,
+             material: Material = NAFION_LI, pair_code=None, checked_voltage=None,
+             floor_checked: bool = True) -> ForwardResult:
+    """:func:`forward` for a checked :class:`~ipmc_asym.model.request.Request` (and, with
+    ``floor_checked``, thicknesses known to be >= ``settings.MIN_THICKNESS``: a ``Strip``'s)."""
+    perm, fidelity, tol, escalate, pressure_term = req.model, req.fidelity, req.tol, req.escalate, req.pressure_term
     E = material.E if modulus is None else modulus
     C = material.C_moy if c_moy is None else c_moy
     L, wd, th, v, E, C = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in
                                                (length, width, thickness, voltage, E, C)))
     shape = L.shape
     L, wd, th, v, E, C = (a.reshape(-1) for a in (L, wd, th, v, E, C))
+    if not floor_checked:
+        check_min_thickness(th)
     k = L.size
     A5 = moment_scale(wd, th, v, material.F, material.C_moy if c_moy is None else C)
     EI = E * second_moment(wd, th)
@@ -471,8 +479,7 @@ def forward(length, width, thickness, voltage, *, modulus=None, c_moy=None, mate
             raise ValueError("pressure_term: a per-point c_moy is not available with the pressure term")
         r = moment_pressure_escalating(pairs(th), pairs(v), perm, fidelity, material, tol=tol, escalate=escalate)
     elif c_moy is None:
-        r = moment_escalating(pairs(th), pairs(v), perm, fidelity, material, tol=tol, escalate=escalate,
-                              progress=False)
+        r = moment_ladder(pairs(th), pairs(v), req, material, progress=False).result()
     else:
         r = _moment_per_point_material(pairs(th), pairs(v), perm, fidelity, material, pairs(C), tol, escalate)
     used = rows(r.fidelity_used.reshape(-1))

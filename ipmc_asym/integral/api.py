@@ -64,8 +64,9 @@ from ipmc_asym.kernels.exact import moment_exact
 from ipmc_asym.kernels.jit import interpreted, jit, jit_parallel, prange
 from ipmc_asym.kernels.quadrature import moment_quadrature
 from ipmc_asym.model import groups
-from ipmc_asym.model.params import NAFION_LI, Material, Strip
+from ipmc_asym.model.params import NAFION_LI, Material, Strip, check_min_thickness
 from ipmc_asym.model.permittivity import MODELS, Permittivity, get_model
+from ipmc_asym.model.request import check_fidelity
 
 __all__ = ["FIDELITIES", "MomentResult", "moment_integral", "moment", "groups_arrays", "check_fidelity",
            "check_min_thickness", "invalid_message", "validity_limit", "interpret_small", "paper_model_id"]
@@ -78,10 +79,6 @@ ANY_THICKNESS = any_thickness_fidelities()
 #: ``{name: kernel_code}`` of the compiled rungs (the registry's flags; read by ``bench.suite``
 #: and the tests of the bare driver)
 _ORDER = {k: f.kernel_code for k, f in _FIDELITY_SPECS.items() if f.compiled}
-
-
-def check_fidelity(fidelity: str) -> str:
-    return check_choice("fidelity", fidelity, FIDELITIES)
 
 
 @dataclass
@@ -134,11 +131,17 @@ def groups_arrays(thickness, voltage, perm: Permittivity, material: Material):
 
     ``lam = sqrt(eps_core R T / (e^2 phi4 F^2 C_moy))`` does not depend on the voltage.
     """
+    return _groups_arrays(thickness, voltage, perm, material)
+
+
+def _groups_arrays(thickness, voltage, perm: Permittivity, material: Material, floor: bool = True):
+    """:func:`groups_arrays`; ``floor=False``: the thickness floor is known to hold."""
     th = np.asarray(thickness, dtype=float)
     v = np.asarray(voltage, dtype=float)
     if not np.all(np.isfinite(th)) or np.any(th <= 0):
         raise ValueError("thickness (total, 2e) must be finite and > 0 m")
-    check_min_thickness(th)
+    if floor:
+        check_min_thickness(th)
     if not np.all(np.isfinite(v)):
         raise ValueError("voltage must be finite (volts)")
     th, v = np.broadcast_arrays(th, v)
@@ -146,21 +149,6 @@ def groups_arrays(thickness, voltage, perm: Permittivity, material: Material):
     lam = groups.debye_length(th, eps_core, material)
     rho = perm.eps0 / eps_core
     return lam, groups.A2(v, material), groups.A3(material), rho, np.sign(v)
-
-
-def check_min_thickness(thickness) -> None:
-    """One-line ``ValueError`` where a TOTAL thickness is below ``settings.MIN_THICKNESS``.
-
-    No rung describes such a film (the continuum model itself does not): refuse at once
-    instead of sending the caller to a BVP that takes seconds and then fails.
-    """
-    th = np.asarray(thickness, dtype=float)
-    smallest = float(np.fmin.reduce(th, axis=None)) if th.size else math.inf  # NaN-blind, no copy
-    if smallest < MIN_THICKNESS:
-        raise ValueError(
-            f"thickness (total, 2e) = {smallest:.3g} m is below {MIN_THICKNESS:g} m: "
-            "the continuum model does not describe films spanning only a few ionic clusters "
-            "(settings.MIN_THICKNESS, docs/design.md)")
 
 
 #: where core/lam >= CORE_X_FLOOR the core interaction 4 exp(-core/lam) is bounded by its
@@ -560,8 +548,14 @@ def moment(thickness, voltage, model="constant", fidelity="quadrature", *, mater
         Arrays of the broadcast shape (0-d arrays for scalar inputs).
     """
     check_fidelity(fidelity)
-    perm = get_model(model)
-    mat = _material(material, material_kw)
+    return _moment(thickness, voltage, get_model(model), fidelity, _material(material, material_kw), progress,
+                   floor_checked=False)
+
+
+def _moment(thickness, voltage, perm: Permittivity, fidelity: str, mat: Material, progress=None, *,
+            floor_checked: bool = True) -> MomentResult:
+    """:func:`moment` on checked arguments (a rung name, a resolved model, a material; with
+    ``floor_checked`` the thickness is known to be >= ``settings.MIN_THICKNESS``)."""
     if perm.is_custom and fidelity != "bvp":
         raise ValueError(f"a custom eps(C) needs fidelity 'bvp' (closed forms exist for "
                          f"constant, linear, affine); got fidelity {fidelity!r}")
@@ -571,14 +565,14 @@ def moment(thickness, voltage, model="constant", fidelity="quadrature", *, mater
         gperm = Permittivity("secant", eps0=e0, deps=de)
     if fidelity != "bvp":
         I, valid, (err, B1, core, lam, A2), (bad_th, bad_v, _) = _fused(thickness, voltage, gperm, mat, fidelity,
-                                                                       full=True)
+                                                                       full=True, floor=not floor_checked)
         if bad_th:
             raise ValueError("thickness (total, 2e) must be finite and > 0 m")
         if bad_v:
             raise ValueError("voltage must be finite (volts)")
         return MomentResult(I=I, error=err, B1=B1, core=core, lam=lam, A2=A2, valid=valid,
                             fidelity=fidelity, model=perm.name, success=np.ones(I.shape, bool))
-    lam, A2, A3, rho, sign = groups_arrays(thickness, voltage, gperm, mat)
+    lam, A2, A3, rho, sign = _groups_arrays(thickness, voltage, gperm, mat, floor=not floor_checked)
     shape = lam.shape
     I = np.empty(shape)
     err = np.empty(shape)
@@ -750,12 +744,13 @@ def _lean_integral(thickness, voltage, model, fidelity, material, material_kw):
     return I, valid, n_invalid
 
 
-def _fused(thickness, voltage, perm: Permittivity, mat: Material, fidelity: str, full: bool):
+def _fused(thickness, voltage, perm: Permittivity, mat: Material, fidelity: str, full: bool, floor: bool = True):
     """Run the fused driver on broadcast inputs (TOTAL thickness in m, volts).
 
     Returns ``(I, valid, bookkeeping, counts)``: ``bookkeeping`` is ``(error, B1, core, lam,
     A2)`` if ``full``, else ``()`` and ``I`` is NaN where invalid (what :func:`moment_integral`
     returns); ``counts`` are the driver's (bad thicknesses, bad voltages, invalid points).
+    ``floor``: check the thickness floor (False where the caller has).
     """
     th = np.asarray(thickness, dtype=np.float64)
     v = np.asarray(voltage, dtype=np.float64)
@@ -763,7 +758,8 @@ def _fused(thickness, voltage, perm: Permittivity, mat: Material, fidelity: str,
     I = np.empty(shape)
     valid = np.empty(shape, dtype=np.bool_)
     extra = tuple(np.empty(shape) for _ in range(5)) if full else ()
-    check_min_thickness(th)
+    if floor:  # False: the caller's Strip or edge check holds it
+        check_min_thickness(th)
     outs = [a.reshape(-1) for a in extra] if full else [np.empty(0)] * 5
     counts = _run_driver(_sweep_fused, I.size, fidelity, (
         _flat_input(th, shape), _flat_input(v, shape), *_driver_constants(perm, mat, fidelity),

@@ -29,7 +29,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ipmc_asym.base.settings import STRAIN_LIMIT
+from ipmc_asym.base.settings import MIN_THICKNESS, STRAIN_LIMIT
 from ipmc_asym.base.units import parse_pressure
 from ipmc_asym.model import material_data
 from ipmc_asym.model.groups import Groups, debye_length, make_groups, moment_scale
@@ -52,6 +52,7 @@ __all__ = [
     "MATERIALS",
     "check_positive",
     "check_finite",
+    "check_min_thickness",
     "make_groups",
     "moment_scale",
     "debye_length",
@@ -117,6 +118,21 @@ def check_finite(name: str, value, allowed: str = "a finite number") -> float:
     if not math.isfinite(v):
         raise ValueError(f"{name} must be {allowed}; got {value!r}")
     return v
+
+
+def check_min_thickness(thickness) -> None:
+    """One-line ``ValueError`` where a TOTAL thickness is below ``settings.MIN_THICKNESS``.
+
+    No rung describes such a film (the continuum model itself does not): refuse at once
+    instead of sending the caller to a BVP that takes seconds and then fails.
+    """
+    th = np.asarray(thickness, dtype=float)
+    smallest = float(np.fmin.reduce(th, axis=None)) if th.size else math.inf  # NaN-blind, no copy
+    if smallest < MIN_THICKNESS:
+        raise ValueError(
+            f"thickness (total, 2e) = {smallest:.3g} m is below {MIN_THICKNESS:g} m: "
+            "the continuum model does not describe films spanning only a few ionic clusters "
+            "(settings.MIN_THICKNESS, docs/design.md)")
 
 
 def check_positive(name: str, value, unit: str = "") -> float:
@@ -388,6 +404,7 @@ class Strip:
         check_positive("length", self.length, "m")
         check_positive("width (total, 2l)", self.width, "m")
         check_positive("thickness (total, 2e)", self.thickness, "m")
+        check_min_thickness(self.thickness)  # a Strip is checked once, here: its users trust it
         check_finite("voltage", self.voltage, "a finite number of volts")
 
     @property
