@@ -401,7 +401,7 @@ duration_type = arg_type(_duration, "duration")
 
 
 def _waveform(text):
-    from ipmc_asym.dynamics.entry import Drive  # deferred: the dynamics stack is loaded by the commands using it
+    from ipmc_asym.dynamics.entry import Drive  # deferred: heavy module, start-up (the dynamic commands only)
 
     return Drive.parse(text).source
 
@@ -435,7 +435,7 @@ def frequency_type(name):
 def add_beam_options(p, default=None):
     """``--beam`` (default the library's one, :data:`ipmc_asym.dynamics.entry.DEFAULT_BEAM`, unless a command
     has its own reason) and ``--viscous-modulus``."""
-    from ipmc_asym.dynamics.entry import BEAM_CHOICES, DEFAULT_BEAM
+    from ipmc_asym.dynamics.entry import BEAM_CHOICES, DEFAULT_BEAM  # deferred: heavy module, start-up (the dynamic commands only)
 
     default = DEFAULT_BEAM if default is None else default
     p.add_argument("--beam", default=default, choices=BEAM_CHOICES,
@@ -457,7 +457,7 @@ def add_solver_option(p, command, *, dest, choices, default, help):
 
 
 def _segments_conv(text):
-    from ipmc_asym.dynamics.line_time import MAX_SEGMENTS
+    from ipmc_asym.dynamics.line_time import MAX_SEGMENTS  # deferred: heavy module, start-up (the dynamic commands only)
 
     v = count_type("--line-segments", 2)(text)
     if v > MAX_SEGMENTS:
@@ -467,7 +467,7 @@ def _segments_conv(text):
 
 def add_line_options(p):
     """``--sheet-resistance`` and ``--line-segments`` of the time-domain electrode line (step, drive)."""
-    from ipmc_asym.dynamics.line_time import DEFAULT_SEGMENTS, MAX_SEGMENTS
+    from ipmc_asym.dynamics.line_time import DEFAULT_SEGMENTS, MAX_SEGMENTS  # deferred: heavy module, start-up (the dynamic commands only)
 
     p.add_argument("--sheet-resistance", dest="sheet_resistance", type=sheet_resistance_type, default=0.0,
                    help="sheet resistance of each electrode (2.5ohm/sq; a bare number is Ohm/sq; default 0 = ideal "
@@ -488,7 +488,7 @@ def _electrode_conv(text):
 
 def add_support_options(p):
     """``--support`` and ``--electrode`` (freq, drive)."""
-    from ipmc_asym.beam.dynamics import SUPPORTS
+    from ipmc_asym.beam.dynamics import SUPPORTS  # deferred: heavy module, start-up (the dynamic commands only)
 
     p.add_argument("--support", default=None, choices=SUPPORTS,
                    help="strip support: clamped-free and clamped-pinned give the default outputs (free tip w, theta; "

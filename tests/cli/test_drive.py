@@ -117,7 +117,7 @@ def test_drive_and_step_with_a_sheet_resistance(tmp_path, capsys):
     (["drive", "--waveform", "step:1V", "--duration", "1s", "--points", "11", "--sheet-resistance", "2.5", "--beam",
       "dynamic"], "--points"),
     (["step", "--sheet-resistance", "2.5", "--fidelity", "pnp"], "fidelity pnp"),
-    (["step", "--sheet-resistance", "2.5", "--tol", "1e-3"], "--tol"),
+    (["step", "--sheet-resistance", "2.5", "--tol", "1e-3"], "tol"),
     (["step", "--sheet-resistance", "-2ohm/sq"], "--sheet-resistance"),
     (["step", "--line-segments", "1000"], "--line-segments"),
 ])

@@ -70,3 +70,26 @@ def test_one_beam_default(command, need):
     from ipmc_asym.dynamics.circuit import frequency_response
     assert inspect.signature(frequency_response).parameters["beam"].default == DEFAULT_BEAM
     assert "beam" not in inspect.signature(transfer_function).parameters  # passed through to frequency_response
+
+
+def test_phases_in_degrees_in_and_out(tmp_path, capsys):
+    """freq writes phases in degrees; fit reads Z_phase in degrees (a value may say rad)."""
+    import json
+
+    import numpy as np
+
+    from ipmc_asym.cli import main
+    from ipmc_asym.dynamics.circuit import frequency_response
+    from ipmc_asym.model.params import Strip
+    from ipmc_asym.studies.calibrate_dynamic import read_file
+
+    assert main(["freq", "--from", "1Hz", "--to", "10Hz", "--points", "3", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    r = frequency_response(np.geomspace(1.0, 10.0, 3), strip=Strip())
+    assert out["units"]["w_phase"] == "deg" and np.allclose(out["w_phase"], np.angle(r.H_w) * 180 / np.pi, rtol=1e-14)
+    deg, rad = tmp_path / "deg.csv", tmp_path / "rad.csv"
+    deg.write_text("f,Z_abs,Z_phase\n1,100,-45\n10,50,-30\n")
+    rad.write_text(f"f,Z_abs,Z_phase\n1,100,{-np.pi / 4!r}rad\n10,50,{-np.pi / 6!r}rad\n")
+    a, b = read_file(str(deg), Strip()), read_file(str(rad), Strip())
+    assert np.allclose(a.measured["Z_phase"], b.measured["Z_phase"], rtol=1e-14, atol=0)
+    assert np.allclose(a.measured["Z_phase"], [-np.pi / 4, -np.pi / 6], rtol=1e-14)
