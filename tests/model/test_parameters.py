@@ -59,3 +59,18 @@ def test_fit_and_uq_tables_are_the_parameter_table():
     # uq reads the alias as the canonical name, with the parameter's units
     u = parse_uncertain({"E": {"dist": "normal", "mean": "130MPa", "sd": "10MPa"}})
     assert u == parse_uncertain({"modulus": {"dist": "normal", "mean": 1.3e8, "sd": 1e7}})
+
+
+def test_every_field_is_a_material_field_and_the_files_spell_it_as_an_alias():
+    import dataclasses
+
+    from ipmc_asym.model.material_data import MATERIAL_FIELDS
+    from ipmc_asym.model.params import Material
+
+    fields = {f.name for f in dataclasses.fields(Material)}
+    for p in PARAMETERS.values():
+        if p.field is not None:
+            assert p.field in fields, p.name
+            # the material files (material_data) key a parameter by its Material field: the table knows that name
+            if p.field in MATERIAL_FIELDS:
+                assert canonical(p.field) == p.name
