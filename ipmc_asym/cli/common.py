@@ -12,7 +12,16 @@ import re
 import sys
 
 from ipmc_asym.base.settings import MIN_THICKNESS
-from ipmc_asym.base.units import parse_diffusion, parse_length, parse_pressure, parse_voltage
+from ipmc_asym.base.units import (
+    fmt_length,
+    parse_diffusion,
+    parse_length,
+    parse_pressure,
+    parse_quantity,
+    parse_sheet_resistance,
+    parse_time,
+    parse_voltage,
+)
 from ipmc_asym.integral.api import check_min_thickness
 from ipmc_asym.model.limits import bare_number_warning, material_warnings, range_warning
 from ipmc_asym.model.params import Strip, material_from_spec
@@ -22,7 +31,9 @@ __all__ = ["UsageError", "Parser", "add_strip_options", "add_material_options", 
            "material_from_args", "strip_from_args",
            "arg_type", "count_type", "join_negative_values", "fmt_num", "c_moy_label", "length_type", "pressure_type",
            "voltage_type", "tol_type", "first_run_notice", "diffusion_type", "sidecar_path", "add_size_option", "check_size_caps",
-           "seed_type", "model_help"]
+           "seed_type", "model_help", "viscous_modulus_type", "duration_type", "waveform_type", "sheet_resistance_type",
+           "frequency_type", "add_beam_options", "SOLVER_ALIASES", "add_solver_option", "add_line_options",
+           "add_support_options", "support_from_args", "CLAMPED_UNITS", "print_clamped"]
 
 
 class UsageError(Exception):
@@ -360,3 +371,163 @@ def first_run_notice():
     if not (os.path.isdir(CACHE_DIR) and any(f.endswith(".nbi") for _, _, fs in os.walk(CACHE_DIR) for f in fs)):
         sys.stderr.write("ipmc-asym: compiling the Numba kernels (first run after install, ~10-30 s)...\n")
         sys.stderr.flush()
+
+
+# ---- the dynamic commands' options (step, drive, freq, fit): one definition each -------------------------
+
+_VISCOSITY = {"Pa s": 1.0, "Pa*s": 1.0, "Pa.s": 1.0, "kPa s": 1e3, "kPa*s": 1e3, "MPa s": 1e6, "MPa*s": 1e6}
+
+
+def viscous_modulus_type(name="--viscous-modulus"):
+    """The Kelvin-Voigt viscous modulus eta_E (Pa s, ``'2kPa s'``), >= 0."""
+    def conv(text):
+        v = parse_quantity(name, str(text).replace("·", " ").strip(), _VISCOSITY, "viscous modulus (Pa s)")
+        if v < 0:
+            raise ValueError(f"{name} must be >= 0 Pa s (e.g. 0, 1e4, '2kPa s'); got {text!r}")
+        return v
+
+    return arg_type(conv, name)
+
+
+def _duration(text):
+    v = parse_time("--duration", text)
+    if v <= 0:
+        raise ValueError(f"--duration must be > 0 (e.g. 0.5s, 200ms); got {text!r}")
+    return v
+
+
+#: ``--duration``: an end time > 0 (s, ``200ms``)
+duration_type = arg_type(_duration, "duration")
+
+
+def _waveform(text):
+    from ipmc_asym.dynamics.entry import Drive  # deferred: heavy module, start-up (the dynamic commands only)
+
+    return Drive.parse(text).source
+
+
+#: ``--waveform SPEC`` (the grammar of :func:`ipmc_asym.dynamics.waveforms.parse_waveform`) -> a Waveform
+waveform_type = arg_type(_waveform, "--waveform")
+
+
+def _sheet_conv(text):
+    v = parse_sheet_resistance("--sheet-resistance", text)
+    if v < 0:
+        raise ValueError(f"--sheet-resistance must be >= 0 Ohm/sq (e.g. 2.5ohm/sq); got {text!r}")
+    return v
+
+
+#: ``--sheet-resistance``: Ohm/sq of each electrode (``2.5ohm/sq``; a bare number is Ohm/sq), >= 0
+sheet_resistance_type = arg_type(_sheet_conv, "--sheet-resistance")
+
+
+def frequency_type(name):
+    """A frequency > 0 (Hz, ``1kHz``)."""
+    def conv(text):
+        v = parse_quantity(name, text, {"Hz": 1.0, "kHz": 1e3, "mHz": 1e-3, "MHz": 1e6}, "frequency")
+        if v <= 0:
+            raise ValueError(f"{name} must be > 0 Hz (e.g. 0.1Hz, 1kHz); got {text!r}")
+        return v
+
+    return arg_type(conv, name)
+
+
+def add_beam_options(p, default=None):
+    """``--beam`` (default the library's one, :data:`ipmc_asym.dynamics.entry.DEFAULT_BEAM`, unless a command
+    has its own reason) and ``--viscous-modulus``."""
+    from ipmc_asym.dynamics.entry import BEAM_CHOICES, DEFAULT_BEAM  # deferred: heavy module, start-up (the dynamic commands only)
+
+    default = DEFAULT_BEAM if default is None else default
+    p.add_argument("--beam", default=default, choices=BEAM_CHOICES,
+                   help=f"strip mechanics: dynamic (inertia, Kelvin-Voigt damping, resonances) or quasi-static "
+                        f"(default {default})")
+    p.add_argument("--viscous-modulus", dest="viscous_modulus", type=viscous_modulus_type(), default=0.0,
+                   help="Kelvin-Voigt viscous modulus eta_E (Pa s; '2kPa s'); default 0: no source gives a value")
+
+
+#: the time/frequency solver option of every command: ``--solver``; the names it had per command stay aliases
+SOLVER_ALIASES = {"step": "--fidelity", "freq": "--method", "fit": "--time-fidelity"}
+
+
+def add_solver_option(p, command, *, dest, choices, default, help):
+    """``--solver`` (and the command's older name, :data:`SOLVER_ALIASES`, writing the same ``dest``)."""
+    old = SOLVER_ALIASES.get(command)
+    p.add_argument("--solver", *((old,) if old else ()), dest=dest, default=default, choices=choices,
+                   help=help + (f" ({old} is the same option)" if old else ""))
+
+
+def _segments_conv(text):
+    from ipmc_asym.dynamics.line_time import MAX_SEGMENTS  # deferred: heavy module, start-up (the dynamic commands only)
+
+    v = count_type("--line-segments", 2)(text)
+    if v > MAX_SEGMENTS:
+        raise ValueError(f"--line-segments must be an integer in [2, {MAX_SEGMENTS}]; got {text!r}")
+    return v
+
+
+def add_line_options(p):
+    """``--sheet-resistance`` and ``--line-segments`` of the time-domain electrode line (step, drive)."""
+    from ipmc_asym.dynamics.line_time import DEFAULT_SEGMENTS, MAX_SEGMENTS  # deferred: heavy module, start-up (the dynamic commands only)
+
+    p.add_argument("--sheet-resistance", dest="sheet_resistance", type=sheet_resistance_type, default=0.0,
+                   help="sheet resistance of each electrode (2.5ohm/sq; a bare number is Ohm/sq; default 0 = ideal "
+                        "electrodes, the uniform strip): the strip as a discretised RC line driven at the clamp "
+                        "(circuit fidelity); adds the columns sigma_error and w_error (its stated error)")
+    p.add_argument("--line-segments", dest="line_segments", type=arg_type(_segments_conv, "--line-segments"),
+                   default=DEFAULT_SEGMENTS,
+                   help=f"N: the line is run with 2N segments (reported) and N (its error estimate); default "
+                        f"{DEFAULT_SEGMENTS}, at most {MAX_SEGMENTS}")
+
+
+def _electrode_conv(text):
+    parts = str(text).split(":")
+    if len(parts) != 2:
+        raise ValueError(f"--electrode must be X1:X2, the covered part of the length (e.g. 2mm:18mm); got {text!r}")
+    return tuple(parse_length("--electrode", v.strip()) for v in parts)
+
+
+def add_support_options(p):
+    """``--support`` and ``--electrode`` (freq, drive)."""
+    from ipmc_asym.beam.dynamics import SUPPORTS  # deferred: heavy module, start-up (the dynamic commands only)
+
+    p.add_argument("--support", default=None, choices=SUPPORTS,
+                   help="strip support: clamped-free and clamped-pinned give the default outputs (free tip w, theta; "
+                        "blocked tip F_block); clamped-clamped adds the clamps' reaction moments and forces M_root, "
+                        "M_tip, F_root, F_tip and the midspan deflection w_mid (small displacements)")
+    p.add_argument("--electrode", type=arg_type(_electrode_conv, "--electrode"), default=None,
+                   help="X1:X2 covered part of the length (e.g. 2mm:18mm, 0 <= X1 < X2 <= L; default the whole strip): "
+                        "the active moment acts there only, the beam outputs are small-displacement")
+
+
+def support_from_args(args, strip):
+    """``(support, electrode)`` checked against the strip and the other options (one-line ValueError)."""
+    el = args.electrode
+    if el is not None:
+        x1, x2 = el
+        if not 0.0 <= x1 < x2 <= strip.length:
+            raise ValueError(f"--electrode X1:X2 must satisfy 0 <= X1 < X2 <= L = {fmt_length(strip.length)}; "
+                             f"got {fmt_length(x1)}:{fmt_length(x2)}")
+    if el is not None or args.support == "clamped-clamped":
+        what = "--support clamped-clamped" if args.support == "clamped-clamped" else "--electrode"
+        if getattr(args, "sheet_resistance", None):
+            raise ValueError(f"{what} is not supported with --sheet-resistance (the electrode line's moment is "
+                             "distributed over the full strip, free or blocked tip)")
+    return args.support, el
+
+
+#: units of the clamped-clamped outputs (drive's columns; freq's amplitudes per volt)
+CLAMPED_UNITS = {"M_root": "N m (reaction moment of the clamp x = 0)", "M_tip": "N m (reaction moment of the clamp x = L)",
+                 "F_root": "N (force of the clamp x = 0 on the strip, +z)",
+                 "F_tip": "N (force of the clamp x = L on the strip, +z; the sign of F_block)",
+                 "w_mid": "m (deflection at x = L/2)"}
+
+
+def print_clamped(t_name, t, rows, per=""):
+    """Text table of the clamped-clamped outputs (``rows``: dict name -> values at ``t``; ``per``: "/V" for amplitudes)."""
+    print(f"clamped-clamped: {t_name:>9s} {f'|M_root| [N m{per}]' if per else 'M_root [N m]':>13s} "
+          f"{f'|M_tip| [N m{per}]' if per else 'M_tip [N m]':>13s} {f'|F_root| [mN{per}]' if per else 'F_root [mN]':>12s} "
+          f"{f'|F_tip| [mN{per}]' if per else 'F_tip [mN]':>12s} {f'|w_mid| [mm{per}]' if per else 'w_mid [mm]':>11s}")
+    for i in range(len(t)):
+        r = {k: float(v[i]) + 0.0 for k, v in rows.items()}
+        print(f"                 {float(t[i]):9.4g} {r['M_root']:13.5g} {r['M_tip']:13.5g} {r['F_root'] * 1e3:12.5g} "
+              f"{r['F_tip'] * 1e3:12.5g} {r['w_mid'] * 1e3:11.5g}")

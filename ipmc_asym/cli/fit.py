@@ -9,23 +9,24 @@ from ipmc_asym.base.registry import fidelity_names, model_names
 from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import (
     add_size_option,
+    add_solver_option,
     add_strip_options,
-    arg_type,
     count_type,
     diffusion_type,
     fmt_num,
     material_from_args,
     model_help,
     seed_type,
+    sheet_resistance_type,
     strip_from_args,
+    viscous_modulus_type,
+    waveform_type,
 )
-from ipmc_asym.cli.drive import _waveform, viscous_modulus_type
-from ipmc_asym.cli.freq import _sheet
 from ipmc_asym.dynamics.circuit import BEAM_CHOICES
 from ipmc_asym.io.fileio import FIGURE_FORMATS, check_output_path
 from ipmc_asym.io.jsonio import dumps
 from ipmc_asym.parallel.executors import check_scheduler
-from ipmc_asym.studies.calibrate import FREE_PARAMETERS, MAX_DATA_ROWS, CalibrationData, fit, parse_free
+from ipmc_asym.studies.calibrate import FREE_ALIASES, FREE_PARAMETERS, MAX_DATA_ROWS, CalibrationData, fit, parse_free
 from ipmc_asym.studies.calibrate_dynamic import TIME_FIDELITIES, fit_dynamic, read_file
 
 #: data files of one fit (each read into memory, at most --max-rows rows)
@@ -55,27 +56,28 @@ def register(sub):
     p.add_argument("data", metavar="DATA.csv", nargs="+",
                    help="measurements (header row; SI or values with units); several files are fitted together")
     p.add_argument("--free", required=True, metavar="NAME[,NAME...]",
-                   help=f"free parameters among {', '.join(FREE_PARAMETERS)} (D = diffusion); optional bounds "
+                   help=f"free parameters among {', '.join(FREE_PARAMETERS)} "
+                        f"({', '.join(f'{a} = {k}' for a, k in FREE_ALIASES.items())}); optional bounds "
                         f"NAME=LO:HI with units (modulus=50MPa:500MPa, D=1e-11m2/s:1e-9m2/s)")
     p.add_argument("--model", default="constant", choices=list(model_names()), help=model_help("constant"))
     p.add_argument("--fidelity", default=None, choices=list(fidelity_names()),
                    help="force a fidelity (default: cheapest with error < 1/10 of the data's)")
     add_strip_options(p)
-    p.add_argument("--waveform", type=arg_type(_waveform, "--waveform"), default=None, metavar="SPEC",
+    p.add_argument("--waveform", type=waveform_type, default=None, metavar="SPEC",
                    help="drive of the time series without a voltage column (as drive --waveform: 'step:0.5V', "
                         "'sine:1V@2Hz', 'csv:V.csv')")
     p.add_argument("--diffusion", type=diffusion_type(), default=None,
                    help="cation diffusion coefficient D when not free, and the start when free (1e-10m2/s)")
-    p.add_argument("--sheet-resistance", dest="sheet_resistance", type=_sheet, default=None,
+    p.add_argument("--sheet-resistance", dest="sheet_resistance", type=sheet_resistance_type, default=None,
                    help="electrode sheet resistance (Ohm/sq) of the spectra when not free, the start when free")
     p.add_argument("--beam", default=None, choices=BEAM_CHOICES,
                    help="mechanics of the time series (default: dynamic when viscous_modulus is free, else "
                         "quasi-static)")
     p.add_argument("--viscous-modulus", dest="viscous_modulus", type=viscous_modulus_type(), default=0.0,
                    help="Kelvin-Voigt viscous modulus (Pa s) when not free, the start when free (default 0)")
-    p.add_argument("--time-fidelity", default=None, choices=TIME_FIDELITIES,
-                   help="force the time series' rung (default: circuit, escalated to pnp where its error is too "
-                        "large; its error is checked either way)")
+    add_solver_option(p, "fit", dest="time_fidelity", default=None, choices=TIME_FIDELITIES,
+                      help="force the time series' rung (default: circuit, escalated to pnp where its error is too "
+                           "large; its error is checked either way)")
     add_size_option(p, "--multistart", default=0, maximum=MAX_MULTISTART, minimum=0, metavar="N",
                     help="N extra starts, log-uniform in the bounds; the best is kept")
     p.add_argument("--max-rows", type=count_type("--max-rows"), default=MAX_DATA_ROWS,

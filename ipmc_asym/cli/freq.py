@@ -5,23 +5,29 @@ from __future__ import annotations
 import numpy as np
 
 from ipmc_asym.base.registry import model_names
-from ipmc_asym.base.units import fmt_length, parse_quantity, parse_sheet_resistance
+from ipmc_asym.base.units import fmt_length
 from ipmc_asym.beam.dynamics import CLAMPED_OUTPUTS
 from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import (
+    CLAMPED_UNITS,
+    add_beam_options,
     add_size_option,
+    add_solver_option,
     add_strip_options,
-    arg_type,
+    add_support_options,
     diffusion_type,
     fmt_num,
+    frequency_type,
     material_from_args,
     model_help,
+    print_clamped,
+    sheet_resistance_type,
     strip_from_args,
+    support_from_args,
     voltage_type,
 )
-from ipmc_asym.cli.drive import CLAMPED_UNITS, add_beam_options, add_support_options, print_clamped, support_from_args
-from ipmc_asym.dynamics.circuit import FREQ_METHODS, frequency_response
-from ipmc_asym.dynamics.line import line_response
+from ipmc_asym.dynamics.circuit import FREQ_METHODS
+from ipmc_asym.dynamics.entry import spectrum
 from ipmc_asym.dynamics.reduction import transfer_function
 from ipmc_asym.io.fileio import atomic_write, check_output_path
 from ipmc_asym.io.jsonio import dumps
@@ -31,41 +37,21 @@ from ipmc_asym.io.jsonio import dumps
 MAX_POINTS = 10**5
 
 
-def _freq(name):
-    def conv(text):
-        v = parse_quantity(name, text, {"Hz": 1.0, "kHz": 1e3, "mHz": 1e-3, "MHz": 1e6}, "frequency")
-        if v <= 0:
-            raise ValueError(f"{name} must be > 0 Hz (e.g. 0.1Hz, 1kHz); got {text!r}")
-        return v
-
-    return arg_type(conv, name)
-
-
-def _sheet_conv(text):
-    v = parse_sheet_resistance("--sheet-resistance", text)
-    if v < 0:
-        raise ValueError(f"--sheet-resistance must be >= 0 Ohm/sq (e.g. 2.5ohm/sq); got {text!r}")
-    return v
-
-
-_sheet = arg_type(_sheet_conv, "--sheet-resistance")
-
-
 def register(sub):
     p = sub.add_parser("freq", help=SUMMARIES["freq"])
     add_strip_options(p, voltage=False, mechanics=False)
-    p.add_argument("--from", dest="f1", type=_freq("--from"), required=True, help="first frequency (e.g. 0.01Hz)")
-    p.add_argument("--to", dest="f2", type=_freq("--to"), required=True, help="last frequency (e.g. 1kHz)")
+    p.add_argument("--from", dest="f1", type=frequency_type("--from"), required=True, help="first frequency (e.g. 0.01Hz)")
+    p.add_argument("--to", dest="f2", type=frequency_type("--to"), required=True, help="last frequency (e.g. 1kHz)")
     add_size_option(p, "--points", default=50, maximum=MAX_POINTS, minimum=2, help="log-spaced points")
     p.add_argument("--model", default="constant", choices=list(model_names()), help=model_help("constant"))
-    p.add_argument("--method", default="pnp-linear", choices=FREQ_METHODS,
-                   help="pnp-linear (exact linearised PNP, closed form) or circuit (R + 1/(i w C_d))")
+    add_solver_option(p, "freq", dest="method", default="pnp-linear", choices=FREQ_METHODS,
+                      help="pnp-linear (exact linearised PNP, closed form) or circuit (R + 1/(i w C_d))")
     p.add_argument("--diffusion", type=diffusion_type(), default=None,
                    help="cation diffusion coefficient D (1e-10m2/s, 1e-6cm2/s; a bare number is m^2/s)")
     p.add_argument("--voltage", type=voltage_type("--voltage"), default=0.0,
-                   help="DC bias (e.g. 0.5V): small signal about the biased static state (method circuit)")
-    add_beam_options(p, "dynamic")
-    p.add_argument("--sheet-resistance", dest="sheet_resistance", type=_sheet, default=None,
+                   help="DC bias (e.g. 0.5V): small signal about the biased static state (--solver circuit)")
+    add_beam_options(p)
+    p.add_argument("--sheet-resistance", dest="sheet_resistance", type=sheet_resistance_type, default=None,
                    help="sheet resistance of each electrode (2.5ohm/sq; a bare number is Ohm/sq; default 0 = ideal): "
                         "Z and w of the RC line along the strip, driven at the clamp")
     add_support_options(p)
@@ -104,25 +90,18 @@ def run(args):
         raise ValueError("--export models the full-electrode strip (free tip): not with --support clamped-clamped or "
                          "--electrode")
     f = np.geomspace(args.f1, args.f2, args.points)
-    if args.voltage != 0.0 and args.method != "circuit":
-        raise ValueError("--voltage (a DC bias) needs --method circuit: pnp-linear is the linearisation about 0 V")
-    if args.sheet_resistance is not None:
-        # the electrode line: Z at the clamp, the distributed moment into the quasi-static or modal beam
-        r = line_response(f, strip=strip, model=args.model, material=material, method=args.method,
-                          sheet_resistance=args.sheet_resistance, beam=args.beam,
-                          viscous_modulus=args.viscous_modulus, voltage=args.voltage)
-    else:
-        r = frequency_response(f, strip=strip, model=args.model, material=material, method=args.method,
-                               beam=args.beam, viscous_modulus=args.viscous_modulus, voltage=args.voltage,
-                               **({} if support is None and electrode is None else
-                                  {"support": support, "electrode": electrode}))
-    cols = {"f": r.f, "Z_re": r.Z.real, "Z_im": r.Z.imag, "w_amp": r.w_amp, "w_phase": r.w_phase,
-            "theta_amp": np.abs(r.H_theta), "theta_phase": np.angle(r.H_theta),
-            "F_amp": np.abs(r.H_F), "F_phase": np.angle(r.H_F)}
+    # the library chooses the solver (dynamics.entry.spectrum): the electrode line with --sheet-resistance
+    r = spectrum(f, strip, model=args.model, material=material, method=args.method, beam=args.beam,
+                 viscous_modulus=args.viscous_modulus, voltage=args.voltage, sheet_resistance=args.sheet_resistance,
+                 support=support, electrode=electrode)
+    # phases in degrees, as every phase the commands read or write (drive's sine PHASE_deg, fit's Z_phase)
+    cols = {"f": r.f, "Z_re": r.Z.real, "Z_im": r.Z.imag, "w_amp": r.w_amp, "w_phase": np.degrees(r.w_phase),
+            "theta_amp": np.abs(r.H_theta), "theta_phase": np.angle(r.H_theta, deg=True),
+            "F_amp": np.abs(r.H_F), "F_phase": np.angle(r.H_F, deg=True)}
     if r.error is not None:
         cols["error"] = r.error
     for n in CLAMPED_OUTPUTS if clamped else ():
-        cols[f"{n}_amp"], cols[f"{n}_phase"] = np.abs(r.H_clamped[n]), np.angle(r.H_clamped[n])
+        cols[f"{n}_amp"], cols[f"{n}_phase"] = np.abs(r.H_clamped[n]), np.angle(r.H_clamped[n], deg=True)
     head = {"tau": r.tau, "model": r.model, "method": r.method, "thickness_total": strip.thickness,
             "f_d": r.f_d, "voltage": args.voltage, "beam": args.beam,
             "viscous_modulus": args.viscous_modulus,
@@ -130,15 +109,15 @@ def run(args):
             "error_max": None if r.error is None else r.error_max,
             "reference": "pnp-linear (exact linearised Nernst-Planck/Gauss)",
             "electrode_area": strip.width * strip.length, "diffusion_coefficient": material.D,
-            "units": {"f": "Hz", "Z": "Ohm (strip, electrode area 2l L)", "w_amp": "m/V", "w_phase": "rad",
-                      "theta_amp": "rad/V (free tip)", "theta_phase": "rad", "F_amp": "N/V (blocked tip)",
-                      "F_phase": "rad", "error": "relative, of Z and w against pnp-linear"},
+            "units": {"f": "Hz", "Z": "Ohm (strip, electrode area 2l L)", "w_amp": "m/V", "w_phase": "deg",
+                      "theta_amp": "rad/V (free tip)", "theta_phase": "deg", "F_amp": "N/V (blocked tip)",
+                      "F_phase": "deg", "error": "relative, of Z and w against pnp-linear"},
             "notes": r.notes + [f"about phi0 = {args.voltage:g} V; w from the layers' charge, small displacements"]}
     if support is not None or electrode is not None:
         head["support"] = support
         head["electrode"] = None if electrode is None else list(electrode)
         head["units"].update({f"{n}_amp": CLAMPED_UNITS[n].replace(" (", "/V (", 1) for n in CLAMPED_OUTPUTS if clamped})
-        head["units"].update({f"{n}_phase": "rad" for n in CLAMPED_OUTPUTS if clamped})
+        head["units"].update({f"{n}_phase": "deg" for n in CLAMPED_OUTPUTS if clamped})
     if args.sheet_resistance is not None:
         head["sheet_resistance"] = args.sheet_resistance
         head["units"]["sheet_resistance"] = "Ohm/sq (each electrode)"
@@ -173,7 +152,7 @@ def run(args):
               + (f"; clamped-clamped {', '.join(f'{v:.4g}' for v in head['resonances']['clamped-clamped'])} Hz"
                  if clamped else ""))
     ecol = "error" in cols
-    print(f"{'f [Hz]':>11s} {'Z_re [Ohm]':>12s} {'Z_im [Ohm]':>12s} {'|w|/V [mm/V]':>13s} {'phase [rad]':>11s}"
+    print(f"{'f [Hz]':>11s} {'Z_re [Ohm]':>12s} {'Z_im [Ohm]':>12s} {'|w|/V [mm/V]':>13s} {'phase [deg]':>11s}"
           + (f" {'error':>9s}" if ecol else ""))
     for i in range(f.size):
         print(f"{fmt_num(f[i], '11.4g')} {fmt_num(cols['Z_re'][i], '12.5g')} {fmt_num(cols['Z_im'][i], '12.5g')} "

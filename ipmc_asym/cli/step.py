@@ -10,13 +10,16 @@ import sys
 import numpy as np
 
 from ipmc_asym.base.registry import model_names
-from ipmc_asym.base.units import fmt_length, parse_time
+from ipmc_asym.base.units import fmt_length
 from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import (
+    add_beam_options,
+    add_line_options,
     add_size_option,
+    add_solver_option,
     add_strip_options,
-    arg_type,
     diffusion_type,
+    duration_type,
     first_run_notice,
     fmt_num,
     material_from_args,
@@ -24,17 +27,14 @@ from ipmc_asym.cli.common import (
     sidecar_path,
     strip_from_args,
     tol_type,
+    waveform_type,
 )
-from ipmc_asym.cli.drive import add_beam_options, add_line_options
-from ipmc_asym.dynamics.circuit import STEP_FIDELITIES, step_response, waveform
+from ipmc_asym.dynamics.circuit import STEP_FIDELITIES
 from ipmc_asym.dynamics.drive import (
     CHECK_COLUMNS,  # per time point: the forward model's checks, as drive
     LINE_COLUMNS,
-    drive_chunks,
-    drive_info,
-    drive_response,
 )
-from ipmc_asym.dynamics.waveforms import parse_waveform
+from ipmc_asym.dynamics.entry import time_response
 from ipmc_asym.forward.model import CHECKS
 from ipmc_asym.io.fileio import atomic_write, check_output_path
 from ipmc_asym.io.jsonio import dumps
@@ -47,13 +47,6 @@ MAX_POINTS = 10**5
 #: 1e5 points reach 1 GB); applies where --max-points is left at its default
 MAX_POINTS_PNP = 10**4
 
-
-
-def _duration(text):
-    v = parse_time("--duration", text)
-    if v <= 0:
-        raise ValueError(f"--duration must be > 0 (e.g. 0.5s, 200ms); got {text!r}")
-    return v
 
 
 def _num(x, scale):
@@ -85,57 +78,43 @@ def _sidecar(args, strip, taus, fidelity, drive, beam, notes, **extra) -> None:
         fh.write(json.dumps(meta, indent=1) + "\n")
 
 
-def _stream_csv(args, strip, material, models) -> int:
-    """``step --out F.csv`` at circuit fidelity with the quasi-static beam: each model's rows are
-    computed and written chunk by chunk (:func:`ipmc_asym.dynamics.drive.drive_chunks`: the same
-    circuit, the same forward model and checks per time point), so the memory does not grow with
-    ``--points``; the other cases (pnp, ``--tol``, the dynamic beam, ``--json``) run in memory."""
+def _stream_csv(args, strip, resps) -> int:
+    """``step --out F.csv`` on a stepped path (:func:`ipmc_asym.dynamics.entry.time_response` with
+    ``stream=True``: the circuit at the quasi-static beam, or the electrode line): each model's rows are
+    computed and written chunk by chunk, so the memory does not grow with ``--points``."""
+    models = list(resps)
     many = len(models) > 1
-    drive = "step" if args.waveform is None else args.waveform.spec
-    wave = args.waveform if args.waveform is not None else waveform("step", strip.voltage)
-    line = dict(sheet_resistance=args.sheet_resistance, line_segments=args.line_segments)
-    # the uniform strip streams with the quasi-static beam only; the electrode line with either
-    beam = args.beam if args.sheet_resistance > 0.0 else "quasi-static"
-    dyn = dict(viscous_modulus=args.viscous_modulus) if beam == "dynamic" else {}
-    infos = {m: drive_info(strip, m, material, beam, **dyn, **line) for m in models}
-    columns = COLUMNS + (LINE_COLUMNS if args.sheet_resistance > 0.0 else ())
+    r0 = resps[models[0]]
+    line = r0.path == "line"
+    columns = COLUMNS + (LINE_COLUMNS if line else ())
     seen, n_rows = {}, 0
     with atomic_write(args.out) as fh:
         wr = csv.writer(fh)
         wr.writerow((("model",) if many else ()) + columns + CHECK_COLUMNS)
-        for mname in models:
-            duration = args.duration if args.duration is not None else 5.0 * infos[mname]["tau"]
-            for ch in drive_chunks(wave, duration, args.points, strip=strip, model=mname, material=material,
-                                   beam=beam, **dyn, **line):
+        for mname, resp in resps.items():
+            for ch in resp.chunks:
                 for w in ch["warnings"]:
                     seen.setdefault((mname, w.split(":")[0]), f"{mname}: {w}" if many else w)
                 _write_rows(wr, mname if many else None, [ch[c] for c in columns],
                             [np.asarray(ch[c]) != 0.0 for c in CHECK_COLUMNS])
                 n_rows += ch["t"].size
-    _sidecar(args, strip, {m: infos[m]["tau"] for m in models}, "circuit", drive, beam,
-             infos[models[0]]["notes"], warnings=list(seen.values()),
+    _sidecar(args, strip, {m: resps[m].info["tau"] for m in models}, "circuit", r0.drive.spec, r0.info["beam"],
+             r0.info["notes"], warnings=list(seen.values()),
              **({"sheet_resistance": args.sheet_resistance, "line_segments": 2 * args.line_segments}
-                if args.sheet_resistance > 0.0 else {}))
+                if line else {}))
     for w in seen.values():
         sys.stderr.write(f"step: warning: {w}\n")
     sys.stderr.write(f"step: {n_rows} rows -> {args.out} (streamed; metadata: {sidecar_path(args.out)})\n")
     return 0
 
 
-def _line_in_memory(args, strip, material, models) -> int:
-    """``step --sheet-resistance`` printed or as ``--json``: the electrode line (drive_response: the
-    ladder of reduced circuits, the forward model at every node, its stated error) per model."""
-    line = dict(sheet_resistance=args.sheet_resistance, line_segments=args.line_segments)
-    drive = "step" if args.waveform is None else args.waveform.spec
-    wave = args.waveform if args.waveform is not None else waveform("step", strip.voltage)
+def _line_in_memory(args, strip, material, resps) -> int:
+    """``step --sheet-resistance`` printed or as ``--json``: the electrode line (the ladder of reduced
+    circuits, the forward model at every node, its stated error) per model."""
+    models = list(resps)
+    drive = resps[models[0]].drive.spec
     columns = COLUMNS + LINE_COLUMNS
-    out = {}
-    for mname in models:
-        info = drive_info(strip, mname, material, args.beam, args.viscous_modulus, **line)
-        duration = args.duration if args.duration is not None else 5.0 * info["tau"]
-        r = drive_response(wave, duration, args.points, strip=strip, model=mname, material=material,
-                           beam=args.beam, viscous_modulus=args.viscous_modulus, **line)
-        out[mname] = (info, r)
+    out = {m: (resp.info, resp.columns) for m, resp in resps.items()}
     if args.json:
         def one(info, r):
             return {"tau": info["tau"], "R": info["R"], "model": info["model"], "fidelity": "circuit",
@@ -170,10 +149,10 @@ def _line_in_memory(args, strip, material, models) -> int:
 def register(sub):
     p = sub.add_parser("step", help=SUMMARIES["step"])
     add_strip_options(p)
-    p.add_argument("--duration", type=arg_type(_duration, "duration"), default=None,
+    p.add_argument("--duration", type=duration_type, default=None,
                    help="end time (e.g. 0.2s, 50ms; default 5 tau)")
-    p.add_argument("--fidelity", default="circuit", choices=STEP_FIDELITIES,
-                   help="circuit (reduced nonlinear capacitor) or pnp (transient Nernst-Planck/Gauss)")
+    add_solver_option(p, "step", dest="fidelity", default="circuit", choices=STEP_FIDELITIES,
+                      help="circuit (reduced nonlinear capacitor) or pnp (transient Nernst-Planck/Gauss)")
     p.add_argument("--model", default="constant", choices=list(model_names()) + ["all"],
                    help=model_help("constant") + "; all: each in turn")
     p.add_argument("--diffusion", type=diffusion_type(), default=None,
@@ -184,10 +163,10 @@ def register(sub):
                         "default: no estimate for the circuit, 1e-6 for pnp")
     add_size_option(p, "--points", default=1000, maximum=MAX_POINTS, minimum=2,
                     help=f"output times (with --fidelity pnp at most {MAX_POINTS_PNP:.0e} unless --max-points is given)")
-    p.add_argument("--waveform", type=arg_type(parse_waveform, "--waveform"), default=None,
+    p.add_argument("--waveform", type=waveform_type, default=None,
                    help="instead of the step of --voltage: a SPEC such as 'sine:1V@10Hz' or 'step:1V+square:0.1V@5Hz' "
                         "(see ipmc-asym drive --help)")
-    add_beam_options(p, "quasi-static")
+    add_beam_options(p)
     add_line_options(p)
     p.add_argument("--out", default=None, metavar="F.csv",
                    help="CSV file (header row t, phi0, sigma, current_density, M_A, theta, w, check_* and valid per "
@@ -209,22 +188,19 @@ def run(args):
     strip = strip_from_args(args)
     first_run_notice()
     models = list(model_names()) if args.model == "all" else [args.model]
-    if args.sheet_resistance > 0.0:
-        for bad, why in ((args.fidelity != "circuit", "--fidelity pnp"), (args.tol is not None, "--tol")):
-            if bad:
-                raise ValueError(f"--sheet-resistance with {why}: the electrode line is a ladder of reduced circuits "
-                                 f"(its discretisation error is stated); drop {why}")
-        if not args.out or args.json:
-            return _line_in_memory(args, strip, material, models)
-        return _stream_csv(args, strip, material, models)
-    if args.out and args.fidelity == "circuit" and args.tol is None and args.beam == "quasi-static" and not args.json:
-        return _stream_csv(args, strip, material, models)
-    kind = args.waveform if args.waveform is not None else "step"
-    results = {}
-    for mname in models:
-        results[mname] = step_response(strip.voltage, args.duration, strip=strip, model=mname, fidelity=args.fidelity,
-                                       material=material, points=args.points, waveform_kind=kind, beam=args.beam,
-                                       viscous_modulus=args.viscous_modulus, tol=args.tol)
+    # the library chooses the solver (dynamics.entry.time_path): rows streamed to --out where a stepped
+    # path serves, the in-memory solve otherwise
+    resps = {m: time_response(strip, args.waveform, duration=args.duration, points=args.points, model=m,
+                              material=material, fidelity=args.fidelity, tol=args.tol, beam=args.beam,
+                              viscous_modulus=args.viscous_modulus, sheet_resistance=args.sheet_resistance,
+                              line_segments=args.line_segments, stream=bool(args.out) and not args.json)
+             for m in models}
+    path = resps[models[0]].path
+    if path == "line" and resps[models[0]].chunks is None:
+        return _line_in_memory(args, strip, material, resps)
+    if path != "memory":
+        return _stream_csv(args, strip, resps)
+    results = {m: resp.result for m, resp in resps.items()}
 
     columns = COLUMNS + (("sigma_error",) if args.tol is not None else ())
 

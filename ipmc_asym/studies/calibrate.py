@@ -57,16 +57,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ipmc_asym.base.registry import closed_form_fidelities, fidelity_names
-from ipmc_asym.base.units import (
-    parse_diffusion,
-    parse_force,
-    parse_length,
-    parse_pressure,
-    parse_quantity,
-    parse_sheet_resistance,
-    parse_voltage,
-)
+from ipmc_asym.base.units import parse_force, parse_length, parse_voltage
 from ipmc_asym.beam.statics import blocking_force_ratio
+from ipmc_asym.model.parameters import ALIASES, PARAMETERS, parse_value, with_values
 from ipmc_asym.model.params import NAFION_LI, Material, Strip
 from ipmc_asym.model.permittivity import Permittivity, get_model
 from ipmc_asym.parallel.executors import run_chunks
@@ -82,35 +75,15 @@ __all__ = [
     "fit",
 ]
 
-#: free parameters: name -> (unit, default bounds, what it sets).  Names as the CLI/sweeps use.
-FREE_PARAMETERS = {
-    "modulus": ("Pa", (1e6, 1e11), "Young's modulus E"),
-    "c_moy": ("mol/m^3", (10.0, 1e5), "mean cation concentration C_moy"),
-    "eps0": ("F/m", (1e-10, 1.0), "permittivity at C = 0, eps0"),
-    "deps": ("F/m", (1e-10, 1.0), "eps_moy - eps0"),
-    # seen by time series and impedance spectra only (calibrate_dynamic.fit_dynamic; VISIBLE_TO)
-    "diffusion": ("m^2/s", (1e-14, 1e-7), "cation diffusion coefficient D"),
-    "viscous_modulus": ("Pa s", (1.0, 1e9), "viscous modulus eta_E = E tau_v of the Kelvin-Voigt law (eq. (3))"),
-    "sheet_resistance": ("Ohm/sq", (1e-3, 1e4), "sheet resistance R_s of each electrode"),
-}
+#: free parameters: name -> (unit, default bounds, what it sets), from the one parameter table
+#: (model.parameters.PARAMETERS); names as the CLI/sweeps use
+FREE_PARAMETERS = {k: (p.unit, p.bounds, p.long_name) for k, p in PARAMETERS.items()}
 #: other names a --free item may take (the key) for a name of FREE_PARAMETERS (the value)
-FREE_ALIASES = {"D": "diffusion", "E": "modulus", "R_s": "sheet_resistance", "eta_E": "viscous_modulus"}
+FREE_ALIASES = {a: k for a, k in ALIASES.items() if k in FREE_PARAMETERS}
 #: which kinds of data rows see each free parameter (static: deflection/blocking force at rest;
 #: time: a transient t -> current/charge/deflection/force; impedance: a spectrum f -> Z), and
 #: for a parameter no kind present sees, the data that would identify it
-VISIBLE_TO = {
-    "modulus": (("static", "time_mech"), "deflection or blocking-force data (static rows or a time series)"),
-    "c_moy": (("static", "time", "time_mech", "impedance"), "any data"),
-    "eps0": (("static", "time", "time_mech", "impedance"), "any data"),
-    "deps": (("static", "time", "time_mech", "impedance"), "any data"),
-    "diffusion": (("time", "time_mech", "impedance"),
-                  "a time series (t, current/charge/deflection) or an impedance spectrum (f, Z_re, Z_im): the "
-                  "static state does not depend on D"),
-    "viscous_modulus": (("time_mech",), "a time series of deflection or blocking force (the beam's damping; "
-                                        "beam dynamic)"),
-    "sheet_resistance": (("impedance",), "an impedance spectrum (f, Z_re, Z_im): the fit's time-domain model has "
-                                         "ideal electrodes"),
-}
+VISIBLE_TO = {k: (p.seen_by, p.identify) for k, p in PARAMETERS.items()}
 
 
 def check_visible(names, kinds) -> None:
@@ -351,28 +324,9 @@ def parse_free(spec) -> dict:
     return out
 
 
-#: units accepted on the bounds of --free (besides a bare SI number)
-_BOUND_UNITS = {
-    "c_moy": ({"mol/m^3": 1.0, "mol/m3": 1.0, "mM": 1.0, "M": 1e3, "mol/L": 1e3}, "concentration"),
-    "eps0": ({"F/m": 1.0}, "permittivity"),
-    "deps": ({"F/m": 1.0}, "permittivity"),
-    "viscous_modulus": ({"Pa s": 1.0, "Pa*s": 1.0, "Pa.s": 1.0, "kPa s": 1e3, "MPa s": 1e6}, "viscous modulus"),
-}
-
-
 def _bound(k, x):
-    if k == "modulus":
-        return parse_pressure(k, x)
-    if k == "diffusion":
-        return parse_diffusion(f"--free {k}", x)
-    if k == "sheet_resistance":
-        return parse_sheet_resistance(f"--free {k}", x)
-    if k in _BOUND_UNITS:
-        return parse_quantity(f"--free {k}", x, *_BOUND_UNITS[k])
-    try:
-        return float(x)
-    except (TypeError, ValueError):
-        raise ValueError(f"--free {k}: bound {x!r} is not a number ({FREE_PARAMETERS[k][0]})") from None
+    """A bound of ``--free k`` in SI (a bare number or a value with one of the parameter's units)."""
+    return parse_value(k, x, k if k == "modulus" else f"--free {k}")
 
 
 # ---- forward model ---------------------------------------------------------------------------
@@ -385,16 +339,8 @@ def _perm(model, values):
 
 
 def _material(material: Material, values) -> Material:
-    kw = {}
-    if "modulus" in values:
-        kw["E"] = float(values["modulus"])
-    if "c_moy" in values:
-        kw["c_moy"] = float(values["c_moy"])
-    if "diffusion" in values:
-        kw["D"] = float(values["diffusion"])
-    if "sheet_resistance" in values:
-        kw["sheet_resistance"] = float(values["sheet_resistance"])
-    return material.with_(**kw) if kw else material
+    """``material`` with the fitted material fields of ``values`` (model.parameters.with_values)."""
+    return with_values(material, values)
 
 
 def predict(values: dict, geometry: dict, model="constant", fidelity="leading",

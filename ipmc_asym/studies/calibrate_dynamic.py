@@ -111,7 +111,8 @@ _CURRENT = {"A": 1.0, "mA": 1e-3, "uA": 1e-6, "µA": 1e-6, "nA": 1e-9}
 _CHARGE = {"C": 1.0, "mC": 1e-3, "uC": 1e-6, "µC": 1e-6, "nC": 1e-9}
 _OHM = {"Ohm": 1.0, "ohm": 1.0, "Ω": 1.0, "kOhm": 1e3, "kohm": 1e3, "kΩ": 1e3, "mOhm": 1e-3, "MOhm": 1e6}
 _HZ = {"Hz": 1.0, "kHz": 1e3, "mHz": 1e-3, "MHz": 1e6}
-_DEG = {"deg": 1.0, "°": 1.0}
+#: the phase of an impedance spectrum: degrees, as every phase the commands read or write; a value may say rad
+_DEG = {"deg": 1.0, "°": 1.0, "rad": 180.0 / math.pi}
 
 
 # ---- data ------------------------------------------------------------------------------------

@@ -69,7 +69,7 @@ from ipmc_asym.beam.dynamics import first_resonance
 from ipmc_asym.forward.model import CHECKS, forward
 from ipmc_asym.model.materials import citations
 from ipmc_asym.model.params import NOMINAL_STRIP, Material, check_positive, named_material
-from ipmc_asym.studies.uq import _transform, parse_uncertain
+from ipmc_asym.studies.uq import UNCERTAIN_MATERIAL, _transform, parse_uncertain
 
 __all__ = ["DesignSpec", "DesignResult", "design", "parse_spec", "load_spec", "OUTPUTS", "INPUTS", "CONSTRAINABLE",
            "STEP_MIN", "ACTIVE_RTOL", "MAX_COMBOS", "MAX_PARETO_POINTS", "MAX_SAMPLES"]
@@ -262,7 +262,7 @@ def parse_spec(spec: dict, name: str = "design") -> DesignSpec:
     if "uncertain" in spec:
         unc = parse_uncertain(spec["uncertain"])
         for k in unc:
-            if k not in ("modulus", "c_moy"):
+            if k not in UNCERTAIN_MATERIAL:
                 raise ValueError(f"uncertain.{k}: a robust design samples modulus and c_moy only "
                                  "(the strip's dimensions and voltage are the design)")
         rb = spec.get("robust", {})

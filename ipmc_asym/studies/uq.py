@@ -86,18 +86,21 @@ import numpy as np
 
 from ipmc_asym.base.settings import CHUNK_ROWS
 from ipmc_asym.base.streamstats import SKETCH_K, Moments, QuantileSketch
-from ipmc_asym.base.units import parse_length, parse_pressure, parse_voltage
+from ipmc_asym.base.units import parse_length, parse_voltage
 from ipmc_asym.forward.model import CHECKS, SAMPLING_FIDELITIES, assumption_warnings, forward
 from ipmc_asym.io.datasets import VARIABLES
+from ipmc_asym.model.parameters import ALIASES, PARAMETERS, material_value, parse_value
 from ipmc_asym.model.permittivity import get_model
 from ipmc_asym.parallel.executors import chunk_slices, imap_chunks
 from ipmc_asym.studies.scene_schema import load_scene, parse_scene
 
 __all__ = ["UNCERTAIN", "DISTRIBUTIONS", "OUTPUT_UNITS", "UQResult", "parse_uncertain", "run_uq",
-           "evaluate_samples", "uq_chunk", "uq_stream_chunk", "QUANTILES", "STORE_SAMPLES"]
+           "evaluate_samples", "uq_chunk", "uq_stream_chunk", "QUANTILES", "STORE_SAMPLES", "UNCERTAIN_MATERIAL"]
 
 #: uncertain names -> (unit, long name), as the datasets label them
 UNCERTAIN = {k: VARIABLES[k] for k in ("length", "width", "thickness", "voltage", "modulus", "c_moy")}
+#: the uncertain names that are material parameters (model.parameters: their aliases, units and values)
+UNCERTAIN_MATERIAL = tuple(k for k in UNCERTAIN if k in PARAMETERS)
 DISTRIBUTIONS = {
     "normal": ("mean", "sd"),
     "lognormal": ("median", "sigma"),
@@ -128,11 +131,9 @@ def _quantity(name, key, v):
         return parse_length(where, v)
     if name == "voltage":
         return parse_voltage(where, v)
-    if name == "modulus":
-        return parse_pressure(where, v)
-    if isinstance(v, str):
+    if name == "c_moy" and isinstance(v, str):
         raise ValueError(f"{where}: c_moy is a plain number in mol/m^3; got {v!r}")
-    return float(v)
+    return parse_value(name, v, where)
 
 
 def parse_uncertain(table) -> dict:
@@ -141,6 +142,7 @@ def parse_uncertain(table) -> dict:
         raise ValueError("[uncertain] must be a non-empty table of name = {dist = ..., ...}")
     out = {}
     for name, spec in table.items():
+        name = ALIASES.get(name, name) if ALIASES.get(name) in UNCERTAIN else name  # E = modulus, ...
         if name not in UNCERTAIN:
             raise ValueError(f"[uncertain]: unknown parameter {name!r}; allowed: {', '.join(UNCERTAIN)}")
         if not isinstance(spec, dict) or "dist" not in spec:
@@ -354,8 +356,8 @@ def _scene_parts(scene):
         if o not in OUTPUT_UNITS:
             raise ValueError(f"uq: output {o!r} is not available for sampling; use {', '.join(OUTPUT_UNITS)}")
     base = {k: float(pts[k][0]) for k in ("length", "width", "thickness", "voltage")}
-    base["modulus"] = material.E
-    base["c_moy"] = material.C_moy
+    for k in UNCERTAIN_MATERIAL:
+        base[k] = material_value(material, k)
     return name, model, material, base, unc, outputs, tol
 
 

@@ -42,7 +42,8 @@ def test_drive_flags_time_points_like_estimate(capsys):
 
 
 def test_drive_json_and_step_model_all(capsys):
-    assert main(["drive", "--waveform", "triangle:1V@5Hz", "--duration", "0.1s", "--points", "201", "--json"]) == 0
+    assert main(["drive", "--waveform", "triangle:1V@5Hz", "--duration", "0.1s", "--points", "201", "--beam", "dynamic",
+                 "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert len(out["w"]) == 201 and out["resonances"]["clamped-free"][0] == pytest.approx(22.55, rel=1e-3)
     assert any("Darcy" in n for n in out["notes"])
@@ -55,7 +56,7 @@ def test_drive_json_and_step_model_all(capsys):
 
 def test_freq_bias_and_beam(capsys):
     assert main(["freq", "--from", "10Hz", "--to", "40Hz", "--points", "3", "--method", "circuit", "--voltage", "0.5V",
-                 "--json"]) == 0
+                 "--beam", "dynamic", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["voltage"] == 0.5 and out["beam"] == "dynamic" and len(out["F_amp"]) == 3
     assert any("Darcy" in n for n in out["notes"])
@@ -63,7 +64,7 @@ def test_freq_bias_and_beam(capsys):
 
 @pytest.mark.parametrize("args,word", [
     (["drive", "--waveform", "sin:1V@1Hz", "--duration", "1s"], "--waveform"),
-    (["drive", "--waveform", "sine:1V@1Hz", "--duration", "10s", "--points", "100"], "points"),
+    (["drive", "--waveform", "sine:1V@1Hz", "--duration", "10s", "--points", "100", "--beam", "dynamic"], "points"),
     (["drive", "--waveform", "sine:1V@1Hz", "--duration", "1s", "--points", "2e6", "--json"], "--json"),
     (["drive", "--waveform", "sine:1V@1Hz", "--duration", "1s", "--viscous-modulus", "-1"], "viscous"),
     (["freq", "--from", "1Hz", "--to", "10Hz", "--voltage", "0.5V"], "circuit"),
@@ -113,9 +114,10 @@ def test_drive_and_step_with_a_sheet_resistance(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("args, word", [
-    (["drive", "--waveform", "step:1V", "--duration", "1s", "--points", "11", "--sheet-resistance", "2.5"], "--points"),
-    (["step", "--sheet-resistance", "2.5", "--fidelity", "pnp"], "--fidelity pnp"),
-    (["step", "--sheet-resistance", "2.5", "--tol", "1e-3"], "--tol"),
+    (["drive", "--waveform", "step:1V", "--duration", "1s", "--points", "11", "--sheet-resistance", "2.5", "--beam",
+      "dynamic"], "--points"),
+    (["step", "--sheet-resistance", "2.5", "--fidelity", "pnp"], "fidelity pnp"),
+    (["step", "--sheet-resistance", "2.5", "--tol", "1e-3"], "tol"),
     (["step", "--sheet-resistance", "-2ohm/sq"], "--sheet-resistance"),
     (["step", "--line-segments", "1000"], "--line-segments"),
 ])
@@ -154,7 +156,7 @@ def test_freq_and_drive_support_and_electrode(tmp_path, capsys):
     # drive: the CSV's header keeps the default columns and appends the new ones; rows = the library's
     f = tmp_path / "d.csv"
     assert main(["drive", "--waveform", "step:0.5V", "--duration", "50ms", "--points", "201", "--support",
-                 "clamped-clamped", "--electrode", "2mm:12mm", "--out", str(f)]) == 0
+                 "clamped-clamped", "--electrode", "2mm:12mm", "--beam", "dynamic", "--out", str(f)]) == 0
     capsys.readouterr()
     rows = list(csv.reader(f.read_text().splitlines()))
     default = ["drive", "--waveform", "step:0.5V", "--duration", "50ms", "--points", "201", "--json"]

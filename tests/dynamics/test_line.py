@@ -325,7 +325,7 @@ def test_cli_sheet_resistance(capsys):
 def test_cli_sheet_resistance_with_the_dynamic_beam_a_bias_and_an_export(capsys, tmp_path):
     f = np.geomspace(0.1, 1e3, 6)
     base = ["freq", "--from", "0.1Hz", "--to", "1kHz", "--points", "6", "--sheet-resistance", "2.5ohm/sq", "--json"]
-    assert main(base + ["--viscous-modulus", "2e3"]) == 0  # --beam dynamic is freq's default
+    assert main(base + ["--viscous-modulus", "2e3", "--beam", "dynamic"]) == 0
     out = json.loads(capsys.readouterr().out)
     r = line_response(f, sheet_resistance=2.5, beam="dynamic", viscous_modulus=2e3)
     assert out["beam"] == "dynamic" and out["resonances"]["clamped-free"] == r.resonances["clamped-free"]
@@ -338,7 +338,7 @@ def test_cli_sheet_resistance_with_the_dynamic_beam_a_bias_and_an_export(capsys,
     assert np.allclose(out["Z_re"], r.Z.real, rtol=1e-15) and out["voltage"] == 0.4 and "error" not in out
     # the reduced-order model of the line, its stated error measured here against the full line
     path = tmp_path / "tf.json"
-    assert main(base + ["--viscous-modulus", "2e3", "--export", str(path), "--export-tol", "1e-3"]) == 0
+    assert main(base + ["--viscous-modulus", "2e3", "--beam", "dynamic", "--export", str(path), "--export-tol", "1e-3"]) == 0
     out = json.loads(capsys.readouterr().out)
     doc = json.loads(path.read_text())
     m = doc["models"]["w"]
@@ -349,7 +349,8 @@ def test_cli_sheet_resistance_with_the_dynamic_beam_a_bias_and_an_export(capsys,
     assert np.max(rel(fit, full)) <= 1.5 * m["max_rel_error"] and m["max_rel_error"] <= 1e-3
     assert "order" in out["export"]["w"]
     # 0 Ohm/sq is the uniform strip's response, value for value, with the modal beam too
-    plain = ["freq", "--from", "0.1Hz", "--to", "1kHz", "--points", "6", "--viscous-modulus", "2e3", "--json"]
+    plain = ["freq", "--from", "0.1Hz", "--to", "1kHz", "--points", "6", "--viscous-modulus", "2e3", "--beam", "dynamic",
+             "--json"]
     assert main(plain) == 0
     a = json.loads(capsys.readouterr().out)
     assert main(plain + ["--sheet-resistance", "0"]) == 0

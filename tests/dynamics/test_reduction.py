@@ -86,13 +86,14 @@ def test_fit_across_damped_resonances():
 
 def test_freq_export(tmp_path, capsys):
     out = tmp_path / "tf.json"
-    assert main(["freq", "--from", "0.1Hz", "--to", "100Hz", "--points", "5", "--export", str(out)]) == 0
+    assert main(["freq", "--from", "0.1Hz", "--to", "100Hz", "--points", "5", "--beam", "dynamic", "--export",
+                 str(out)]) == 0
     doc = json.loads(out.read_text())
     w = doc["models"]["w"]
     assert w["unit"] == "m/V" and w["max_rel_error"] <= 1e-4 and w["state_space"]["A"]
     A, B, C, D = (np.array(w["state_space"][k]) for k in "ABCD")
     f = np.array([0.3, 3.0, 30.0])
-    r = frequency_response(f, beam="dynamic")  # freq's default beam
+    r = frequency_response(f, beam="dynamic")
     assert np.max(np.abs(_ss_eval(A, B, C, D, f) / r.H_w - 1)) <= 2e-4
     assert "wrote" in capsys.readouterr().out
 

@@ -1,0 +1,282 @@
+"""One entry for time and frequency responses: the choice of solver a command or a Python user makes.
+
+:func:`time_response` chooses between the in-memory transient (:func:`~ipmc_asym.dynamics.circuit.step_response`:
+the reduced circuit or the PNP solver, with a tolerance and a refined grid for the dynamic beam), the
+uniform strip stepped on the output grid chunk by chunk (:func:`~ipmc_asym.dynamics.drive.drive_chunks`)
+and the electrode line (the same stepper with a sheet resistance, :mod:`ipmc_asym.dynamics.line_time`).
+:func:`spectrum` chooses between the uniform strip (:func:`~ipmc_asym.dynamics.circuit.frequency_response`)
+and the electrode line (:func:`~ipmc_asym.dynamics.line.line_response`).  ``ipmc-asym step``, ``drive``
+and ``freq`` parse their options, call these and print.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ipmc_asym.base.registry import check_choice
+from ipmc_asym.dynamics.circuit import (
+    BEAM_CHOICES,
+    FREQ_METHODS,
+    STEP_FIDELITIES,
+    TIME_MODES,
+    StepResult,
+    frequency_response,
+    step_response,
+    waveform,
+)
+from ipmc_asym.dynamics.drive import drive_chunks, drive_info, drive_response
+from ipmc_asym.dynamics.line import line_response
+from ipmc_asym.dynamics.line_time import DEFAULT_SEGMENTS
+from ipmc_asym.dynamics.waveforms import Waveform, parse_waveform
+from ipmc_asym.model.params import NAFION_LI, Material, Strip, check_finite
+
+__all__ = ["DEFAULT_BEAM", "TIME_PATHS", "Drive", "TimeResponse", "time_path", "time_response", "spectrum"]
+
+#: the beam of every command and entry unless asked otherwise: the paper's quasi-static beam (the moment
+#: of the static problem bends the strip at once).  The dynamic beam adds inertia and a Kelvin-Voigt
+#: damping whose viscous modulus no source gives (default 0: undamped modes that ring for ever and put
+#: the poles of an exported model on the imaginary axis), so it is asked for, not assumed.
+DEFAULT_BEAM = "quasi-static"
+
+#: solvers of a time response: ``memory`` (step_response: circuit or PNP, optional tolerance, the dynamic
+#: beam on a refined grid), ``stream`` (the circuit stepped on the output grid, chunk by chunk, memory
+#: independent of the number of points; supports and partial electrodes), ``line`` (the electrode line:
+#: the same stepper with resistive electrodes, its discretisation error stated)
+TIME_PATHS = ("memory", "stream", "line")
+
+#: how the dynamic beam meets the output grid: ``refined`` (the transient is solved on a grid of >= 40
+#: points per period of the first mode and sampled at the output times) or ``output`` (the modes are
+#: stepped on the output grid itself, which must resolve the first mode; it streams)
+BEAM_GRIDS = ("refined", "output")
+
+
+class Drive:
+    """The applied voltage ``phi0(t)`` (V) between the electrodes, checked when built.
+
+    Build it from a number (a step of that many volts at ``t = 0``), a waveform SPEC
+    (:func:`ipmc_asym.dynamics.waveforms.parse_waveform`: ``'sine:1V@10Hz'``, ``'step:1V+square:0.1V@5Hz'``,
+    ``'csv:V.csv'``), a parsed :class:`~ipmc_asym.dynamics.waveforms.Waveform` or a callable
+    ``phi0(t)`` (volts, vectorised or not), or with :meth:`step` / :meth:`parse`.
+
+    Attributes
+    ----------
+    kind : {"step", "waveform", "function"}
+    voltage : float
+        The step's height (V); ``nan`` for a waveform or a function.
+    spec : str
+        ``"step"`` for a step (as the outputs' ``waveform`` key), the SPEC of a waveform, ``"function"``.
+    function : callable
+        ``phi0(t)``: array of times (s) -> array of volts.
+    """
+
+    __slots__ = ("kind", "voltage", "spec", "function", "source")
+
+    def __init__(self, drive):
+        if isinstance(drive, Drive):
+            self.kind, self.voltage, self.spec = drive.kind, drive.voltage, drive.spec
+            self.function, self.source = drive.function, drive.source
+            return
+        if isinstance(drive, bool) or drive is None:
+            raise ValueError(f"drive must be a voltage (V), a waveform SPEC such as 'sine:1V@10Hz' or a callable "
+                             f"phi0(t) in volts; got {drive!r}")
+        if isinstance(drive, (int, float, np.floating, np.integer)):
+            self.kind, self.voltage, self.spec = "step", check_finite("drive", drive, "a finite number of volts"), "step"
+            self.function = self.source = waveform("step", self.voltage)
+        elif isinstance(drive, str):
+            wave = parse_waveform(drive)
+            self.kind, self.voltage, self.spec, self.function, self.source = "waveform", float("nan"), wave.spec, wave, wave
+        elif isinstance(drive, Waveform):
+            self.kind, self.voltage, self.spec, self.function, self.source = "waveform", float("nan"), drive.spec, drive, drive
+        elif callable(drive):
+            self.kind, self.voltage, self.spec = "function", float("nan"), "function"
+            self.function, self.source = waveform(drive, 0.0), drive
+        else:
+            raise ValueError(f"drive must be a voltage (V), a waveform SPEC such as 'sine:1V@10Hz' or a callable "
+                             f"phi0(t) in volts; got {type(drive).__name__}")
+
+    @classmethod
+    def step(cls, voltage) -> Drive:
+        """A step of ``voltage`` (V) at ``t = 0``."""
+        if isinstance(voltage, str):
+            raise ValueError(f"voltage must be a finite number of volts; got {voltage!r}")
+        return cls(voltage)
+
+    @classmethod
+    def parse(cls, spec) -> Drive:
+        """A waveform SPEC (:func:`ipmc_asym.dynamics.waveforms.parse_waveform`)."""
+        return cls(parse_waveform(spec))
+
+    def __call__(self, t):
+        return self.function(t)
+
+    def __repr__(self):
+        return f"Drive.step({self.voltage!r})" if self.kind == "step" else f"Drive({self.spec!r})"
+
+
+@dataclass
+class TimeResponse:
+    """What :func:`time_response` ran and its rows.
+
+    Attributes
+    ----------
+    path : {"memory", "stream", "line"}   the solver (:data:`TIME_PATHS`)
+    drive : Drive
+    duration : float or None    end time, s (None: the in-memory solve's default, 5 tau)
+    info : dict or None         header of the stepped paths (:func:`ipmc_asym.dynamics.drive.drive_info`:
+                                tau, R, notes, resonances, line segments)
+    result : StepResult or None the in-memory solve (path ``memory``)
+    chunks : iterator of dict or None   the stepped paths with ``stream=True``: dicts of column arrays
+                                (:data:`ipmc_asym.dynamics.drive.DRIVE_COLUMNS`, checks, line columns)
+                                and ``warnings``, computed as iterated
+    columns : dict or None      the stepped paths with ``stream=False``: every row in memory
+    """
+
+    path: str
+    drive: Drive
+    duration: float | None
+    info: dict | None = None
+    result: StepResult | None = None
+    chunks: Iterator | None = None
+    columns: dict | None = field(default=None, repr=False)
+
+
+def time_path(*, fidelity="circuit", tol=None, beam=DEFAULT_BEAM, sheet_resistance=0.0, support=None,
+              electrode=None, stream=False, beam_grid="refined") -> str:
+    """The solver :func:`time_response` runs for these choices (one of :data:`TIME_PATHS`).
+
+    The electrode line when ``sheet_resistance > 0``; the stepped uniform strip for a support other
+    than the free/blocked tip pair or a partial electrode (only that stepper has them), or when the
+    rows are streamed at circuit fidelity without a tolerance (with the dynamic beam only on the
+    output grid, ``beam_grid="output"``); the in-memory solve otherwise (PNP, a tolerance, the dynamic
+    beam on its refined grid).  The stepped paths are the reduced circuit: ``fidelity="pnp"`` or a
+    ``tol`` with them is refused (``ValueError``).
+    """
+    check_choice("fidelity", fidelity, STEP_FIDELITIES)
+    check_choice("beam", beam, BEAM_CHOICES)
+    check_choice("beam_grid", beam_grid, BEAM_GRIDS)
+    Rs = check_finite("sheet_resistance", sheet_resistance, "a finite number >= 0 Ohm/sq")
+    if Rs < 0.0:
+        raise ValueError(f"sheet_resistance must be a finite number >= 0 Ohm/sq; got {sheet_resistance!r}")
+    stepped = ("line" if Rs > 0.0 else
+               "stream" if support == "clamped-clamped" or electrode is not None else None)
+    if stepped is not None:
+        what = "sheet_resistance" if stepped == "line" else "support clamped-clamped or a partial electrode"
+        for bad, why in ((fidelity != "circuit", f"fidelity {fidelity}"), (tol is not None, "tol")):
+            if bad:
+                raise ValueError(f"{what} with {why}: only the reduced circuit steps it (the electrode line's "
+                                 f"discretisation error is stated); drop {why}")
+        return stepped
+    if stream and fidelity == "circuit" and tol is None and (beam == "quasi-static" or beam_grid == "output"):
+        return "stream"
+    return "memory"
+
+
+def time_response(strip: Strip | None = None, drive=None, *, duration=None, points: int = 1000, model="constant",
+                  material: Material | None = None, fidelity="circuit", tol: float | None = None,
+                  beam=DEFAULT_BEAM, viscous_modulus=0.0, sheet_resistance=0.0, line_segments=DEFAULT_SEGMENTS,
+                  support=None, electrode=None, stream=False, beam_grid="refined", n_modes=TIME_MODES,
+                  pnp_options=None) -> TimeResponse:
+    """Response of the strip to an applied voltage ``phi0(t)``, starting uncharged at t = 0.
+
+    Parameters
+    ----------
+    strip : Strip, optional
+        Geometry (``thickness`` TOTAL 2e, ``width`` TOTAL 2l, ``length``, m); its ``voltage`` (V) is
+        the step when ``drive`` is not given.
+    drive : Drive, float, str or callable, optional
+        The voltage: a number (a step, V), a waveform SPEC, a callable ``phi0(t)`` (V) or a
+        :class:`Drive`; default a step of ``strip.voltage``.
+    duration : float, optional
+        End time, s; default ``5 tau`` (``tau = R C_d(0)``).
+    points : int
+        Output times, equally spaced in ``[0, duration]``.
+    model, material :
+        As in :func:`ipmc_asym.dynamics.circuit.step_response`.
+    fidelity : {"circuit", "pnp"} ; tol : float, optional
+        The in-memory solve's rung and tolerance on sigma (:func:`~ipmc_asym.dynamics.circuit.step_response`).
+    beam : {"quasi-static", "dynamic"}
+        Default :data:`DEFAULT_BEAM`; ``viscous_modulus`` (Pa s) and ``n_modes`` with ``dynamic``.
+    sheet_resistance : float
+        Of each electrode, Ohm/sq; > 0: the electrode line of ``2 line_segments`` segments (its error
+        from ``line_segments``).
+    support, electrode :
+        As in :func:`ipmc_asym.dynamics.drive.drive_chunks` (the stepped path).
+    stream : bool
+        The caller takes the rows chunk by chunk (``.chunks``, memory independent of ``points``)
+        where a stepped path serves; the in-memory solve is used otherwise (see :func:`time_path`).
+    beam_grid : {"refined", "output"}
+        How the dynamic beam meets the output grid (:data:`BEAM_GRIDS`).
+    pnp_options : dict, optional
+        The PNP solver's options (in-memory path).
+
+    Returns
+    -------
+    TimeResponse
+        ``path`` says which solver ran; ``result`` (a :class:`~ipmc_asym.dynamics.circuit.StepResult`),
+        ``chunks`` or ``columns`` hold the rows.
+    """
+    s = Strip() if strip is None else strip
+    m = NAFION_LI if material is None else material
+    d = Drive.step(s.voltage) if drive is None else Drive(drive)
+    path = time_path(fidelity=fidelity, tol=tol, beam=beam, sheet_resistance=sheet_resistance, support=support,
+                     electrode=electrode, stream=stream, beam_grid=beam_grid)
+    if path == "memory":
+        # step_response reads the step's height from its first argument, a waveform from waveform_kind
+        kind = "step" if d.kind == "step" else d.source
+        r = step_response(d.voltage if d.kind == "step" else s.voltage, duration, strip=s, model=model,
+                          fidelity=fidelity, material=m, points=points, waveform_kind=kind, beam=beam,
+                          viscous_modulus=viscous_modulus, n_modes=n_modes, tol=tol, pnp_options=pnp_options)
+        return TimeResponse(path, d, duration, result=r)
+    # the stepped paths: the uniform strip streams with the quasi-static beam unless the output grid
+    # carries the modes (time_path); the line and the supports with either beam
+    vm = viscous_modulus
+    line = dict(sheet_resistance=sheet_resistance, line_segments=line_segments)
+    where = {} if support is None and electrode is None else {"support": support, "electrode": electrode}
+    info = drive_info(s, model, m, beam, vm, **line, **where)
+    dur = float(duration) if duration is not None else 5.0 * info["tau"]
+    kw = dict(strip=s, model=model, material=m, beam=beam, viscous_modulus=vm, n_modes=n_modes, **line, **where)
+    if stream:
+        return TimeResponse(path, d, dur, info=info, chunks=drive_chunks(d.function, dur, points, **kw))
+    return TimeResponse(path, d, dur, info=info, columns=drive_response(d.function, dur, points, **kw))
+
+
+def spectrum(f, strip: Strip | None = None, *, model="constant", material: Material | None = None,
+             method="pnp-linear", beam=DEFAULT_BEAM, viscous_modulus=0.0, voltage=0.0, sheet_resistance=None,
+             support=None, electrode=None):
+    """Small-signal impedance and transfer functions of the strip at frequencies ``f`` (Hz).
+
+    The electrode line (:func:`ipmc_asym.dynamics.line.line_response`) when ``sheet_resistance`` is
+    given (Ohm/sq, >= 0; 0 is the uniform strip exactly), else the uniform strip
+    (:func:`ipmc_asym.dynamics.circuit.frequency_response`, with ``support``/``electrode``).
+
+    Parameters
+    ----------
+    f : array_like (n,)
+        Frequencies, Hz, > 0.
+    strip, model, material, method, beam, viscous_modulus, voltage :
+        As in :func:`~ipmc_asym.dynamics.circuit.frequency_response` (``voltage``: DC bias, V, with
+        ``method="circuit"``); ``beam`` default :data:`DEFAULT_BEAM`.
+    sheet_resistance : float, optional
+    support, electrode :
+        Supports of the uniform strip only (``ValueError`` with a sheet resistance).
+
+    Returns
+    -------
+    FrequencyResult or LineResult
+    """
+    check_choice("method", method, FREQ_METHODS)
+    check_choice("beam", beam, BEAM_CHOICES)
+    if sheet_resistance is not None:
+        if support == "clamped-clamped" or electrode is not None:
+            what = "support clamped-clamped" if support == "clamped-clamped" else "a partial electrode"
+            raise ValueError(f"sheet_resistance: {what} is not supported with the electrode line (its moment is "
+                             "distributed over the full strip, clamped-free and clamped-pinned)")
+        return line_response(f, strip=strip, model=model, material=material, method=method,
+                             sheet_resistance=sheet_resistance, beam=beam, viscous_modulus=viscous_modulus,
+                             voltage=voltage)
+    where = {} if support is None and electrode is None else {"support": support, "electrode": electrode}
+    return frequency_response(f, strip=strip, model=model, material=material, method=method, beam=beam,
+                              viscous_modulus=viscous_modulus, voltage=voltage, **where)

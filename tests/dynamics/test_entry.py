@@ -1,0 +1,130 @@
+"""The one dynamic entry (dynamics/entry.py): the solver it picks and its numbers, against the
+functions it dispatches to called directly, and against the commands that call it."""
+
+import json
+
+import numpy as np
+import pytest
+
+from ipmc_asym.cli import main
+from ipmc_asym.dynamics.circuit import frequency_response, step_response, waveform
+from ipmc_asym.dynamics.drive import drive_response
+from ipmc_asym.dynamics.entry import DEFAULT_BEAM, Drive, spectrum, time_path, time_response
+from ipmc_asym.dynamics.line import line_response
+from ipmc_asym.dynamics.waveforms import parse_waveform
+from ipmc_asym.model.params import Strip
+
+
+def test_drive_is_a_step_or_a_waveform_checked_when_built():
+    d = Drive(1.5)
+    assert d.kind == "step" and d.voltage == 1.5 and d.spec == "step"
+    assert np.array_equal(d(np.array([0.0, 1.0])), [1.5, 1.5])
+    w = Drive("sine:2V@5Hz")
+    t = np.linspace(0.0, 0.3, 7)
+    assert w.kind == "waveform" and w.spec == "sine:2V@5Hz"
+    assert np.allclose(w(t), 2.0 * np.sin(2 * np.pi * 5.0 * t), rtol=0, atol=1e-12)
+    assert Drive(w).spec == w.spec and Drive.parse("step:1V").kind == "waveform"
+    for bad in (True, None, float("nan"), "sine:1V", object()):
+        with pytest.raises(ValueError) as e:
+            Drive(bad)
+        assert len(str(e.value).splitlines()) == 1
+    with pytest.raises(ValueError, match="voltage"):
+        Drive.step("1V")
+
+
+@pytest.mark.parametrize("kw, path", [
+    ({}, "memory"),
+    ({"stream": True}, "stream"),
+    ({"stream": True, "beam": "dynamic"}, "memory"),  # the dynamic beam on its refined grid
+    ({"stream": True, "beam": "dynamic", "beam_grid": "output"}, "stream"),
+    ({"stream": True, "fidelity": "pnp"}, "memory"),
+    ({"stream": True, "tol": 1e-3}, "memory"),
+    ({"sheet_resistance": 2.5}, "line"),
+    ({"sheet_resistance": 2.5, "stream": True}, "line"),
+    ({"support": "clamped-clamped"}, "stream"),
+    ({"electrode": (0.0, 0.01)}, "stream"),
+    ({"support": "clamped-free", "stream": False}, "memory"),
+])
+def test_time_path_table(kw, path):
+    assert time_path(**kw) == path
+
+
+@pytest.mark.parametrize("kw, word", [
+    ({"sheet_resistance": 2.5, "fidelity": "pnp"}, "fidelity pnp"),
+    ({"sheet_resistance": 2.5, "tol": 1e-3}, "tol"),
+    ({"support": "clamped-clamped", "tol": 1e-3}, "tol"),
+    ({"sheet_resistance": -1.0}, "sheet_resistance"),
+    ({"beam": "elastic"}, "beam"),
+    ({"beam_grid": "fine"}, "beam_grid"),
+])
+def test_time_path_refusals_are_one_line(kw, word):
+    with pytest.raises(ValueError) as e:
+        time_path(**kw)
+    assert word in str(e.value) and len(str(e.value).splitlines()) == 1
+
+
+def test_memory_path_is_step_response_with_the_voltage_once():
+    s = Strip(voltage=0.7)
+    r = time_response(s, points=9)
+    assert r.path == "memory" and r.drive.voltage == 0.7
+    ref = step_response(0.7, None, strip=s, points=9)
+    for c in ("t", "sigma", "current_density", "M_A", "w", "F_block"):
+        assert np.array_equal(getattr(r.result, c), getattr(ref, c)), c
+    # an explicit drive wins over the strip's voltage
+    r2 = time_response(s, 1.2, points=9)
+    assert np.array_equal(r2.result.sigma, step_response(1.2, None, strip=s, points=9).sigma)
+
+
+def test_stream_and_line_paths_are_the_stepped_circuit():
+    s = Strip()
+    wave = "sine:1V@20Hz"
+    r = time_response(s, wave, duration=0.1, points=21, stream=True)
+    assert r.path == "stream" and r.info["beam"] == DEFAULT_BEAM
+    chunks = list(r.chunks)
+    rows = {k: np.concatenate([c[k] for c in chunks]) for k in ("t", "sigma", "w")}
+    ref = drive_response(parse_waveform(wave), 0.1, 21, strip=s, beam="quasi-static")
+    for k in rows:
+        assert np.array_equal(rows[k], ref[k]), k
+    ln = time_response(s, wave, duration=0.1, points=21, sheet_resistance=2.5, line_segments=16)
+    assert ln.path == "line" and ln.columns is not None and ln.info["line_segments"] == 32
+    lref = drive_response(parse_waveform(wave), 0.1, 21, strip=s, beam="quasi-static", sheet_resistance=2.5,
+                          line_segments=16)
+    for k in ("sigma", "sigma_error", "w", "w_error"):
+        assert np.array_equal(ln.columns[k], lref[k]), k
+
+
+def test_spectrum_picks_the_line_with_a_sheet_resistance():
+    f = np.geomspace(0.1, 100.0, 5)
+    r = spectrum(f, Strip())
+    ref = frequency_response(f, strip=Strip(), beam="quasi-static")
+    assert np.array_equal(r.Z, ref.Z) and np.array_equal(r.w_amp, ref.w_amp)
+    rl = spectrum(f, Strip(), sheet_resistance=2.5)
+    lref = line_response(f, strip=Strip(), sheet_resistance=2.5, beam="quasi-static")
+    assert np.array_equal(rl.Z, lref.Z) and np.array_equal(rl.w_amp, lref.w_amp)
+    with pytest.raises(ValueError, match="circuit"):
+        spectrum(f, Strip(), voltage=0.5)
+    with pytest.raises(ValueError, match="sheet_resistance"):
+        spectrum(f, Strip(), sheet_resistance=1.0, support="clamped-clamped")
+
+
+def test_the_commands_make_the_entry_s_choice(tmp_path, capsys):
+    """step/drive/freq print what the entry (and the functions it calls) return for the same options."""
+    assert main(["step", "--points", "9", "--voltage", "0.7V", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    ref = step_response(0.7, None, strip=Strip(voltage=0.7), points=9)
+    assert out["beam"] == DEFAULT_BEAM and np.allclose(out["sigma"], ref.sigma, rtol=1e-15, atol=0)
+    # step --out streams (the circuit on the output grid): the rows of drive_chunks
+    f = tmp_path / "s.csv"
+    assert main(["step", "--points", "9", "--voltage", "0.7V", "--duration", "0.2s", "--out", str(f)]) == 0
+    assert "streamed" in capsys.readouterr().err
+    rows = [ln.split(",") for ln in f.read_text().splitlines()]
+    sig = np.array([float(x[rows[0].index("sigma")]) for x in rows[1:]])
+    dref = drive_response(waveform("step", 0.7), 0.2, 9, strip=Strip(voltage=0.7), beam="quasi-static")
+    assert np.allclose(sig, dref["sigma"], rtol=1e-15, atol=0)
+    assert main(["drive", "--waveform", "step:0.7V", "--duration", "0.2s", "--points", "9", "--json"]) == 0
+    dout = json.loads(capsys.readouterr().out)
+    assert dout["beam"] == DEFAULT_BEAM and np.allclose(dout["sigma"], dref["sigma"], rtol=1e-15, atol=0)
+    assert main(["freq", "--from", "0.1Hz", "--to", "100Hz", "--points", "5", "--json"]) == 0
+    fout = json.loads(capsys.readouterr().out)
+    fref = frequency_response(np.geomspace(0.1, 100.0, 5), strip=Strip(), beam="quasi-static")
+    assert fout["beam"] == DEFAULT_BEAM and np.allclose(fout["Z_re"], fref.Z.real, rtol=1e-15, atol=0)
