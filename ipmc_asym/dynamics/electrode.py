@@ -37,6 +37,7 @@ import numpy as np
 
 from ipmc_asym.base.registry import MODELS as _MODEL_SPECS
 from ipmc_asym.base.registry import check_choice, fidelity_names
+from ipmc_asym.base.results import Panel, ResultMixin, ResultSpec
 from ipmc_asym.base.settings import BVP_STATED_ERROR, EXACT_STATED_ERROR, VALIDITY_LIMIT
 from ipmc_asym.integral.api import check_min_thickness
 from ipmc_asym.kernels import _generated as G
@@ -65,8 +66,8 @@ _GL_X = np.ascontiguousarray(_GL_X)
 _GL_W = np.ascontiguousarray(_GL_W)
 
 
-@dataclass
-class ChargeResult:
+@dataclass(repr=False)
+class ChargeResult(ResultMixin):
     """Static electrode charge and capacitance; arrays broadcast from the inputs (SI).
 
     Attributes
@@ -82,6 +83,9 @@ class ChargeResult:
     valid : ndarray of bool  both error estimates below ``VALIDITY_LIMIT``
     fidelity, model : str
     """
+
+    _result = ResultSpec("point", None, ("sigma", "Q", "C_diff", "eps_app", "error", "error_C_diff", "core", "valid"),
+                         (Panel("point", ("sigma",)), Panel("point", ("C_diff",))), names={"error": "error_sigma"})
 
     sigma: np.ndarray
     Q: np.ndarray
