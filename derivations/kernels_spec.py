@@ -1,4 +1,4 @@
-"""Which derived expressions become kernels (collected by ``codegen.build_source``)."""
+"""Which derived expressions become kernels (collected by ``codegen.TARGETS``)."""
 
 from __future__ import annotations
 

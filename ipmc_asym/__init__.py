@@ -3,62 +3,26 @@
 Matched-asymptotic closed forms (generated from SymPy derivations into Numba kernels), a
 layer quadrature, and a full-BVP cross-check of the Tixier & Pouget model.
 
-One subpackage per concern; each imports only the ones before it in this list (the layer
-rule, ``docs/design.md``, checked by ``tests/test_layers.py``)::
+The public API is the names of :data:`__all__`, importable from here (``import ipmc_asym as
+ia``; lazy: importing the package loads no Numba, SciPy or SymPy): the strip and material,
+the functions behind the commands and their result types.  The subpackages are internal:
+their modules, names and signatures may change without notice.  One subpackage per concern;
+each imports only the ones before it in this list (the layer rule, ``docs/design.md``,
+checked by ``tests/test_layers.py``)::
 
     base -> model -> kernels -> bvp -> integral -> beam -> io -> forward -> dynamics
          -> parallel -> studies -> validation -> plotting -> cli
-
-Public API (lazy: importing the package loads no Numba, SciPy or SymPy).  The module paths
-of the flat layout (``ipmc_asym.params``, ``ipmc_asym.sweeps``, ...) still import: they are
-names of the modules in their subpackages (:data:`MOVED`).
 """
 
 from __future__ import annotations
 
 import importlib
-import importlib.abc
-import importlib.util
-import sys
-import types
 
 __version__ = "0.1.0"
 
-__all__ = [
-    "Strip",
-    "Material",
-    "NAFION_LI",
-    "NOMINAL_STRIP",
-    "Permittivity",
-    "MODELS",
-    "FIDELITIES",
-    "moment_integral",
-    "moment",
-    "evaluate",
-    "solve_bvp_profile",
-    "solve_beam",
-    "run_scene",
-    "sweep",
-    "charge",
-    "step_response",
-    "frequency_response",
-    "drive_response",
-    "parse_waveform",
-    "line_response",
-    "fit",
-    "read_fit_data",
-    "uq",
-    "profiles",
-    "validate",
-    "laws",
-    "scene",
-    "figures",
-    "transfer_function",
-    "materials",
-    "design",
-]
-
+#: public name -> (module, attribute), loaded on first use
 _LAZY = {
+    # strips, materials, models
     "Strip": ("ipmc_asym.model.params", "Strip"),
     "Material": ("ipmc_asym.model.params", "Material"),
     "NAFION_LI": ("ipmc_asym.model.params", "NAFION_LI"),
@@ -66,85 +30,53 @@ _LAZY = {
     "Permittivity": ("ipmc_asym.model.permittivity", "Permittivity"),
     "MODELS": ("ipmc_asym.model.permittivity", "MODELS"),
     "FIDELITIES": ("ipmc_asym.integral.api", "FIDELITIES"),
+    "materials": ("ipmc_asym.model.materials", "MATERIAL_SETS"),
+    # static forward model (estimate, sweep, scene, profiles)
     "moment_integral": ("ipmc_asym.integral.api", "moment_integral"),
     "moment": ("ipmc_asym.integral.api", "moment"),
     "evaluate": ("ipmc_asym.forward.estimate", "evaluate"),
     "solve_bvp_profile": ("ipmc_asym.bvp.solver", "solve"),
     "solve_beam": ("ipmc_asym.beam.statics", "solve_beam"),
     "run_scene": ("ipmc_asym.studies.scenes", "run_scene"),
+    "scene": ("ipmc_asym.studies.scenes", "run_scene"),
     "sweep": ("ipmc_asym.studies.sweeps", "sweep"),
+    # charge and dynamics (charge, step, drive, freq); the dynamic entry's Drive and time
+    # response join this group
     "charge": ("ipmc_asym.dynamics.electrode", "charge"),
     "step_response": ("ipmc_asym.dynamics.circuit", "step_response"),
     "frequency_response": ("ipmc_asym.dynamics.circuit", "frequency_response"),
     "drive_response": ("ipmc_asym.dynamics.drive", "drive_response"),
     "parse_waveform": ("ipmc_asym.dynamics.waveforms", "parse_waveform"),
     "line_response": ("ipmc_asym.dynamics.line", "line_response"),
+    "transfer_function": ("ipmc_asym.dynamics.reduction", "transfer_function"),
+    # studies (fit, uq, design, profiles, validate, laws, figures)
     "fit": ("ipmc_asym.studies.calibrate", "fit"),
     "read_fit_data": ("ipmc_asym.studies.calibrate", "read_data"),
     "uq": ("ipmc_asym.studies.uq", "run_uq"),
+    "design": ("ipmc_asym.studies.design", "design"),
     "profiles": ("ipmc_asym.studies.profiles", "profile_summary"),
     "validate": ("ipmc_asym.validation.validate", "claims"),
     "laws": ("ipmc_asym.studies.laws", "law_table"),
-    "scene": ("ipmc_asym.studies.scenes", "run_scene"),
     "figures": ("ipmc_asym.plotting.figures", "make_all"),
-    "transfer_function": ("ipmc_asym.dynamics.reduction", "transfer_function"),
-    "materials": ("ipmc_asym.model.materials", "MATERIAL_SETS"),
-    "design": ("ipmc_asym.studies.design", "design"),
+    # result types (each with a summary repr, .plot() and .to_xarray())
+    "MomentResult": ("ipmc_asym.integral.api", "MomentResult"),
+    "BVPResult": ("ipmc_asym.bvp.solver", "BVPResult"),
+    "BeamResult": ("ipmc_asym.beam.statics", "BeamResult"),
+    "ForwardResult": ("ipmc_asym.forward.model", "ForwardResult"),
+    "ChargeResult": ("ipmc_asym.dynamics.electrode", "ChargeResult"),
+    "StepResult": ("ipmc_asym.dynamics.circuit", "StepResult"),
+    "FrequencyResult": ("ipmc_asym.dynamics.circuit", "FrequencyResult"),
+    "LineResult": ("ipmc_asym.dynamics.line", "LineResult"),
+    "RationalModel": ("ipmc_asym.dynamics.reduction", "RationalModel"),
+    "CalibrationResult": ("ipmc_asym.studies.calibrate", "CalibrationResult"),
+    "UQResult": ("ipmc_asym.studies.uq", "UQResult"),
+    "DesignResult": ("ipmc_asym.studies.design", "DesignResult"),
+    # the output vocabulary (names, units, long names of every output)
+    "QUANTITIES": ("ipmc_asym.base.quantities", "QUANTITIES"),
 }
 
-
-#: module paths of the flat layout -> where the module lives now (same module object)
-MOVED = {
-    "registry": "base.registry", "settings": "base.settings", "units": "base.units",
-    "progress": "base.progress", "params": "model.params", "permittivity": "model.permittivity",
-    "_jit": "kernels.jit", "bvp_mesh": "bvp.mesh", "bvp_problems": "bvp.problems",
-    "integral_samples": "integral.samples", "fileio": "io.fileio", "jsonio": "io.jsonio",
-    "textfmt": "io.textfmt", "datasets": "io.datasets", "estimate": "forward.estimate",
-    "electrode": "dynamics.electrode", "transient": "dynamics.transient",
-    "circuit": "dynamics.circuit", "executors": "parallel.executors", "sweeps": "studies.sweeps",
-    "fits": "studies.fits", "profiles": "studies.profiles", "scene_schema": "studies.scene_schema",
-    "scenes": "studies.scenes", "laws": "studies.laws", "charge_studies": "studies.charge_studies",
-    "calibrate": "studies.calibrate", "uq": "studies.uq", "validate": "validation.validate",
-}
-
-
-class _MovedLoader(importlib.abc.Loader):
-    """Loads ``ipmc_asym.<old>`` as the module ``ipmc_asym.<new>`` (one module, two names)."""
-
-    def __init__(self, target):
-        self.target = target
-
-    def create_module(self, spec):
-        return importlib.import_module(self.target)
-
-    def exec_module(self, module):
-        pass
-
-
-class _MovedFinder(importlib.abc.MetaPathFinder):
-    """Answers only for the names in :data:`MOVED`; every other import is left to Python."""
-
-    def find_spec(self, fullname, path=None, target=None):
-        old = fullname[len(__name__) + 1:] if fullname.startswith(__name__ + ".") else None
-        if old not in MOVED:
-            return None
-        return importlib.util.spec_from_loader(fullname, _MovedLoader(f"{__name__}.{MOVED[old]}"))
-
-
-class _Package(types.ModuleType):
-    """The package module: a flat module path imported (``import ipmc_asym.uq``) does not shadow
-    the public function of the same name (``ipmc_asym.uq`` stays :func:`run_uq`)."""
-
-    def __setattr__(self, name, value):
-        if name in _LAZY and isinstance(value, types.ModuleType):
-            return
-        super().__setattr__(name, value)
-
-
-sys.modules[__name__].__class__ = _Package
-
-if not any(isinstance(f, _MovedFinder) for f in sys.meta_path):
-    sys.meta_path.append(_MovedFinder())
+#: the public API (at most 60 names, ``tests/test_public_face.py``)
+__all__ = list(_LAZY)
 
 
 def __getattr__(name):
@@ -156,9 +88,7 @@ def __getattr__(name):
 
 
 def __dir__():
-    # the public names and the package's own attributes; not the modules this file imports
-    # for its machinery (importlib, sys, types, annotations of ``from __future__``)
-    hidden = {"annotations", "importlib", "sys", "types"}
-    own = {k for k in globals() if k not in hidden and not (k.startswith("_") and not k.startswith("__"))}
-    own -= {k for k, v in globals().items() if isinstance(v, type) and k.startswith("_")}
-    return sorted(own | set(__all__) | set(_LAZY))
+    # the public names and the package's dunder attributes; not the machinery of this file
+    # (importlib, the annotations of ``from __future__``, the table _LAZY)
+    own = {k for k in globals() if k.startswith("__")}
+    return sorted(own | set(__all__))

@@ -72,6 +72,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ipmc_asym.base.results import Panel, ResultMixin, ResultSpec
 from ipmc_asym.kernels.jit import CACHE_DIR
 from ipmc_asym.kernels.quadrature_nodes import leggauss01
 
@@ -679,8 +680,8 @@ def regime_code(M, L, EI, tol=None, _err=None):
     return np.where(th > 2.0 * np.pi, 3, np.where(th > 0.5 * np.pi, 2, np.where(err <= tol, 0, 1)))
 
 
-@dataclass
-class BeamResult:
+@dataclass(repr=False)
+class BeamResult(ResultMixin):
     """Mechanics of the strip for given end moment(s); arrays broadcast over the inputs.
 
     Attributes
@@ -710,6 +711,10 @@ class BeamResult:
     regime_code : int or ndarray of int or None
         ``regime`` as indices into :data:`REGIMES`.
     """
+
+    _result = ResultSpec("point", None, ("theta", "w", "w_small", "x_tip", "y_tip", "F_block", "F_block_small",
+                                         "small_error", "block_error", "max_strain", "regime"),
+                         (Panel("point", ("w", "w_small")), Panel("point", ("F_block", "F_block_small"))))
 
     theta: object
     w: object

@@ -52,6 +52,7 @@ from types import SimpleNamespace
 import numpy as np
 from scipy.integrate import solve_bvp
 
+from ipmc_asym.base.results import Panel, ResultMixin, ResultSpec
 from ipmc_asym.base.settings import BVP_MAX_NODES, BVP_MAX_NODES_FIRST, BVP_TOL, BVP_TOL_FALLBACK
 from ipmc_asym.bvp.mesh import first_spacings, initial_guess, make_mesh
 from ipmc_asym.bvp.problems import (
@@ -78,8 +79,8 @@ _SUGGEST = (
 # ---------------------------------------------------------------------------------------
 # result container
 # ---------------------------------------------------------------------------------------
-@dataclass
-class BVPResult:
+@dataclass(repr=False)
+class BVPResult(ResultMixin):
     """Solution of the full BVP on its final mesh (all quantities dimensionless).
 
     Attributes
@@ -131,6 +132,9 @@ class BVPResult:
         positive-voltage frame (for a negative voltage evaluate at ``-z``); ``None`` at zero
         volts or after an internal failure.
     """
+
+    _result = ResultSpec("z", "z", ("C", "phi", "E", "D", "rhoZ", "p"),
+                         (Panel("z", ("C",), ylog=True), Panel("z", ("phi",)), Panel("z", ("p",))), ("B1", "I"))
 
     z: np.ndarray
     C: np.ndarray

@@ -42,6 +42,7 @@ import numpy as np
 
 from ipmc_asym.base.ladder import climb, escalation_note, rungs_from
 from ipmc_asym.base.registry import check_choice
+from ipmc_asym.base.results import Panel, ResultMixin, ResultSpec
 from ipmc_asym.beam.dynamics import (
     CLAMPED_OUTPUTS,
     DEFAULT_MODES,
@@ -228,8 +229,8 @@ def waveform(kind, voltage, *, ramp_time=None, frequency=None):
     return lambda t: V * np.sin(2.0 * math.pi * f * np.asarray(t, dtype=float))
 
 
-@dataclass
-class StepResult:
+@dataclass(repr=False)
+class StepResult(ResultMixin):
     """Time series of a charging transient (SI, per unit electrode area unless stated).
 
     Attributes
@@ -258,6 +259,11 @@ class StepResult:
     sigma_error : ndarray         error estimate of sigma (C/m^2) at each time; NaN for the circuit
                                   without ``tol``
     """
+
+    _result = ResultSpec("t", "t", ("phi0", "sigma", "current_density", "layer_voltage", "M_A", "theta", "w",
+                                    "F_block", "sigma_error"),
+                         (Panel("t", ("voltage", "layer_voltage")), Panel("t", ("sigma",)), Panel("t", ("w",))),
+                         ("tau", "R", "C_d0"), {"phi0": "voltage"})
 
     t: np.ndarray
     phi0: np.ndarray
@@ -611,8 +617,8 @@ def _circuit_error(sigma_c, t, fun, strip, perm, material, opts):
     return r, np.abs(sigma_c - r.sigma) + r.sigma_error
 
 
-@dataclass
-class FrequencyResult:
+@dataclass(repr=False)
+class FrequencyResult(ResultMixin):
     """Small-signal response about ``phi0 = 0`` (SI).
 
     Attributes
@@ -639,6 +645,10 @@ class FrequencyResult:
     H_clamped : dict          clamped-clamped only: output (:data:`CLAMPED_OUTPUTS`) -> complex array per
                               volt: ``M_root``, ``M_tip`` (N m/V), ``F_root``, ``F_tip`` (N/V), ``w_mid`` (m/V)
     """
+
+    _result = ResultSpec("f", "f", ("Z", "Z_area", "H_w", "w_amp", "w_phase", "H_theta", "H_F", "error"),
+                         (Panel("f", ("Z",), True, True), Panel("f", ("w_amp",), True, True),
+                          Panel("f", ("w_phase",), True)), ("tau", "f_d", "voltage"), {"error": "error_Z"})
 
     f: np.ndarray
     Z: np.ndarray

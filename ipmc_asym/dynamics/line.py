@@ -42,6 +42,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ipmc_asym.base.registry import check_choice
+from ipmc_asym.base.results import Panel, ResultMixin, ResultSpec
 from ipmc_asym.beam.dynamics import DEFAULT_MODES, distributed_transfer
 from ipmc_asym.dynamics.circuit import BEAM_CHOICES, FrequencyResult, dynamic_notes, frequency_response, strip_beam
 from ipmc_asym.model import groups
@@ -195,8 +196,8 @@ class ProfileQuadrature:
         return val, np.abs(val - self._rule(curvature, *self.rules[1]))
 
 
-@dataclass
-class LineResult:
+@dataclass(repr=False)
+class LineResult(ResultMixin):
     """Small-signal response of a strip whose electrodes have a sheet resistance (SI).
 
     Attributes
@@ -226,6 +227,12 @@ class LineResult:
                                 the modal integrals (a quadrature of half the order) and the modal
                                 truncation (the last kept mode's term); 0 for the quasi-static beam
     """
+
+    _result = ResultSpec("f", "f", ("Z", "Z_area", "H_w", "w_amp", "w_phase", "H_theta", "H_M", "H_F", "gamma_L",
+                                    "Z0", "error", "beam_error"),
+                         (Panel("f", ("Z",), True, True), Panel("f", ("w_amp",), True, True),
+                          Panel("f", ("w_phase",), True)),
+                         ("sheet_resistance", "length", "tau", "f_d", "voltage"), {"error": "error_Z"})
 
     f: np.ndarray
     Z: np.ndarray

@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ipmc_asym.base.results import Panel, ResultMixin, ResultSpec
 from ipmc_asym.dynamics.circuit import frequency_response
 from ipmc_asym.dynamics.line import line_response
 from ipmc_asym.model.params import NAFION_LI, Material, Strip
@@ -34,8 +35,8 @@ MAX_ORDER = 60
 ORDERS = (2, 4, 6, 8, 12, 16, 20, 24, 32, 40, 48, 60)
 
 
-@dataclass
-class RationalModel:
+@dataclass(repr=False)
+class RationalModel(ResultMixin):
     """``H(s) = d1 s + d + sum_k residues[k]/(s - poles[k])``, ``s = 2 pi i f`` (rad/s).
 
     Attributes
@@ -51,6 +52,17 @@ class RationalModel:
     success : bool   the fit met ``tol`` on the check grid
     message : str
     """
+
+    _result = ResultSpec("f", None, ())
+    #: vocabulary name of each exported output's transfer function
+    _H_NAMES = {"w": "H_w", "charge": "H_charge", "current": "H_current", "impedance": "Z"}
+
+    def _arrays(self):
+        f = np.geomspace(*self.band, 200) if self.band[0] > 0 else np.linspace(*self.band, 200)
+        return "f", f, {self._H_NAMES[self.output]: self(f)}
+
+    def _panels(self, arrays):
+        return (Panel("f", tuple(arrays), True, True),)
 
     poles: np.ndarray
     residues: np.ndarray

@@ -33,6 +33,7 @@ import numpy as np
 from ipmc_asym.base.ladder import climb, rungs_from
 from ipmc_asym.base.registry import FIDELITIES as _FIDELITY_SPECS
 from ipmc_asym.base.registry import compiled_fidelities
+from ipmc_asym.base.results import Panel, ResultMixin, ResultSpec
 from ipmc_asym.base.settings import OUTSIDE_REGIMES, STRAIN_LIMIT, STRAIN_LIMIT_SOURCE, VALIDATED_VOLTAGE, VALIDITY_LIMIT
 from ipmc_asym.beam.statics import REGIMES, blocking_force_ratio, solve_beam
 from ipmc_asym.forward.escalation import (
@@ -168,8 +169,8 @@ def flag_mask(check_of, key: str) -> np.ndarray:
     return np.zeros(np.shape(check_of("beam_regime")), bool) if bad is None else bad
 
 
-@dataclass
-class ForwardResult:
+@dataclass(repr=False)
+class ForwardResult(ResultMixin):
     """Outputs of :func:`forward`; arrays of the broadcast input shape (0-d for scalars), SI.
 
     The values are computed wherever a rung is valid; where no rung is valid the moment and
@@ -206,6 +207,13 @@ class ForwardResult:
     beam_warnings : list of str   :func:`ipmc_asym.beam.statics.solve_beam` warnings
     fidelity : str   the rung requested
     """
+
+    _result = ResultSpec("point", None, ("inputs.length", "inputs.width", "inputs.thickness", "inputs.voltage",
+                                         "I", "M_A", "theta", "w", "w_small", "F_block", "F_block_small", "x_tip",
+                                         "y_tip", "max_strain", "B1", "error", "fidelity_used", "escalated",
+                                         "regime", "valid"),
+                         (Panel("point", ("w", "w_small")), Panel("point", ("F_block", "F_block_small"))),
+                         names={f"inputs.{k}": k for k in ("length", "width", "thickness", "voltage")})
 
     I: np.ndarray
     M_A: np.ndarray

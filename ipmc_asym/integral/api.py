@@ -50,6 +50,7 @@ from ipmc_asym.base.progress import progress as _progress_bar
 from ipmc_asym.base.registry import FIDELITIES as _FIDELITY_SPECS
 from ipmc_asym.base.registry import MODELS as _MODEL_SPECS
 from ipmc_asym.base.registry import any_thickness_fidelities, check_choice, fidelity_names, is_compiled
+from ipmc_asym.base.results import Panel, ResultMixin, ResultSpec
 from ipmc_asym.base.settings import (
     BVP_STATED_ERROR,
     EXACT_STATED_ERROR,
@@ -81,8 +82,8 @@ ANY_THICKNESS = any_thickness_fidelities()
 _ORDER = {k: f.kernel_code for k, f in _FIDELITY_SPECS.items() if f.compiled}
 
 
-@dataclass
-class MomentResult:
+@dataclass(repr=False)
+class MomentResult(ResultMixin):
     """Moment integral and its bookkeeping; arrays broadcast from the inputs.
 
     Attributes
@@ -102,6 +103,9 @@ class MomentResult:
     success : ndarray of bool   ``bvp``: solve_bvp converged at that point (True otherwise)
     message : str   ``bvp``: the first failure's message ("" if none)
     """
+
+    _result = ResultSpec("point", None, ("I", "error", "B1", "core", "lam", "A2", "valid"),
+                         (Panel("point", ("I",)), Panel("point", ("error",), ylog=True)))
 
     I: np.ndarray
     error: np.ndarray

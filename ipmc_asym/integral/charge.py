@@ -36,6 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ipmc_asym.base.registry import FIDELITIES as _FIDELITY_SPECS
+from ipmc_asym.base.results import Panel, ResultMixin, ResultSpec
 from ipmc_asym.base.settings import BVP_STATED_ERROR, VALIDITY_LIMIT
 from ipmc_asym.integral.api import check_fidelity, check_min_thickness, paper_model_id
 from ipmc_asym.kernels.charge import GL_W, GL_X, charge_sweep
@@ -49,8 +50,8 @@ __all__ = ["ChargeResult", "charge", "charge_scale", "capacitance_scale", "SUBNO
 SUBNORMAL = 2.2250738585072014e-308
 
 
-@dataclass
-class ChargeResult:
+@dataclass(repr=False)
+class ChargeResult(ResultMixin):
     """Static electrode charge and capacitance; arrays broadcast from the inputs (SI).
 
     Attributes
@@ -66,6 +67,9 @@ class ChargeResult:
     valid : ndarray of bool  both error estimates below ``VALIDITY_LIMIT``
     fidelity, model : str
     """
+
+    _result = ResultSpec("point", None, ("sigma", "Q", "C_diff", "eps_app", "error", "error_C_diff", "core", "valid"),
+                         (Panel("point", ("sigma",)), Panel("point", ("C_diff",))), names={"error": "error_sigma"})
 
     sigma: np.ndarray
     Q: np.ndarray

@@ -114,7 +114,9 @@ def plot_fit_dynamic(result, path) -> str:
         for k in d.measured:
             panels.append((d, k, pr[k]))
     n = len(panels)
-    fig, axes = plt.subplots(2, n, figsize=(4.2 * n, 5.4), squeeze=False, gridspec_kw={"height_ratios": [3, 1.3]})
+    # sharex: the residuals below share (and label) the data's abscissa
+    fig, axes = plt.subplots(2, n, figsize=(4.2 * n, 5.4), squeeze=False, sharex="col",
+                             gridspec_kw={"height_ratios": [3, 1.3]})
     for j, (d, k, pred) in enumerate(panels):
         ax, axr = axes[0, j], axes[1, j]
         y = d.measured[k]

@@ -49,7 +49,8 @@ def plot_uq(result, path) -> str:
         ax.set_xlabel(axis_label(o, u or "1"))
         # at most four ticks: values such as 0.002345 overlap at matplotlib's default count
         ax.xaxis.set_major_locator(MaxNLocator(4))
-        ax.set_ylabel("density")
+        # density=True: counts per unit of the (scaled) output
+        ax.set_ylabel(f"probability density [1/{u}]" if u not in ("", "1") else "probability density [1]")
         sob = result.sobol.get(o)
         if sob:
             top = sorted(sob.items(), key=lambda kv: -kv[1]["ST"])[:2]

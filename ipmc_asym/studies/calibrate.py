@@ -56,8 +56,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ipmc_asym.base.quantities import BY_NAME
 from ipmc_asym.base.registry import closed_form_fidelities, fidelity_names
-from ipmc_asym.base.units import parse_force, parse_length, parse_voltage
+from ipmc_asym.base.results import Panel, ResultMixin, ResultSpec
+from ipmc_asym.base.units import (
+    parse_force,
+    parse_length,
+    parse_voltage,
+)
 from ipmc_asym.beam.statics import blocking_force_ratio
 from ipmc_asym.model.parameters import ALIASES, PARAMETERS, parse_value, with_values
 from ipmc_asym.model.params import NAFION_LI, Material, Strip
@@ -391,8 +397,8 @@ def predict(values: dict, geometry: dict, model="constant", fidelity="leading",
 
 
 # ---- the fit ---------------------------------------------------------------------------------
-@dataclass
-class CalibrationResult:
+@dataclass(repr=False)
+class CalibrationResult(ResultMixin):
     """Outcome of :func:`fit`.
 
     Attributes
@@ -429,6 +435,22 @@ class CalibrationResult:
     flagged_rows : dict   model assumption -> indices of the data rows whose fitted state fails
         it (the forward model's checks, as ``evaluate`` flags them); empty if none
     """
+
+    _result = ResultSpec("row", None, ())
+
+    def _arrays(self):
+        """Fitted parameters (0-d), and per data row the geometry, the measured and fitted values."""
+        out = {k: np.asarray(v["value"], float) for k, v in self.parameters.items() if k in BY_NAME}
+        if isinstance(self.data, CalibrationData):
+            out.update({k: np.asarray(v) for k, v in self.data.geometry.items()})
+            for m in MEASURED:
+                if m in self.data.measured and m in self.predictions:
+                    out[f"measured_{m}"] = np.asarray(self.data.measured[m], float)
+                    out[f"fitted_{m}"] = np.asarray(self.predictions[m], float)
+        return "row", None, out
+
+    def _panels(self, arrays):
+        return tuple(Panel("row", (f"measured_{m}", f"fitted_{m}")) for m in MEASURED if f"fitted_{m}" in arrays)
 
     parameters: dict
     correlation: list

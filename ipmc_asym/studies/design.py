@@ -64,6 +64,7 @@ else:  # pragma: no cover - Python 3.10
 import numpy as np
 
 from ipmc_asym.base.registry import fidelity_names, model_names
+from ipmc_asym.base.results import Panel, ResultMixin, ResultSpec
 from ipmc_asym.base.units import parse_force, parse_length, parse_quantity, parse_voltage
 from ipmc_asym.beam.dynamics import first_resonance
 from ipmc_asym.forward.model import CHECKS, forward
@@ -458,8 +459,8 @@ def _search(problem: _Problem, u0, c0, s0, step0, score=None, step_min=STEP_MIN)
     return u, s
 
 
-@dataclass
-class DesignResult:
+@dataclass(repr=False)
+class DesignResult(ResultMixin):
     """The answer of :func:`design` (``as_dict()`` is the ``--json`` object).
 
     Attributes
@@ -470,6 +471,19 @@ class DesignResult:
     pareto : list of dict   {"inputs", "outputs"} along the front (empty without [pareto])
     objective : dict, material : str, sources : list, evaluations : int, seconds : float
     """
+
+    _result = ResultSpec("point", None, ())
+
+    def _arrays(self):
+        """Inputs and outputs along the Pareto front (the optimum alone without one)."""
+        pts = self.pareto or [self.optimum]
+        keys = [*pts[0]["inputs"], *pts[0]["outputs"]]
+        vals = {k: [{**p["inputs"], **p["outputs"]}.get(k) for p in pts] for k in keys}
+        return "point", None, {k: np.array([np.nan if x is None else x for x in v], float) for k, v in vals.items()}
+
+    def _panels(self, arrays):
+        outs = list(self.pareto[0]["outputs"] if self.pareto else self.optimum["outputs"])
+        return (Panel(outs[0], tuple(outs[1:2])),) if len(outs) > 1 else (Panel("point", tuple(outs)),)
 
     optimum: dict
     active_constraints: list

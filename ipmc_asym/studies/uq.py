@@ -84,6 +84,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ipmc_asym.base.results import Panel, ResultMixin, ResultSpec
 from ipmc_asym.base.settings import CHUNK_ROWS
 from ipmc_asym.base.streamstats import SKETCH_K, Moments, QuantileSketch
 from ipmc_asym.base.units import parse_length, parse_voltage
@@ -260,8 +261,8 @@ def uq_chunk(task):
 
 
 # ---- driver ----------------------------------------------------------------------------------
-@dataclass
-class UQResult:
+@dataclass(repr=False)
+class UQResult(ResultMixin):
     """Outcome of :func:`run_uq`.
 
     Attributes
@@ -292,6 +293,18 @@ class UQResult:
     n_sobol : int  Saltelli base points (groups of D + 2 rows) in the Sobol' indices
     warnings : list of str   one line per failed model assumption (with its count)
     """
+
+    _result = ResultSpec("sample", None, ())
+
+    def _arrays(self):
+        """The stored runs: inputs and outputs (scene names) per sample, and the checks' verdict."""
+        out = {k: np.asarray(v) for k, v in {**self.samples, **self.outputs}.items()}
+        if self.valid is not None:
+            out["valid"] = np.asarray(self.valid)
+        return "sample", None, out
+
+    def _panels(self, arrays):
+        return tuple(Panel("sample", (o,), kind="hist") for o in self.outputs)
 
     summary: dict
     sobol: dict
