@@ -2,9 +2,14 @@
 
 from __future__ import annotations
 
+import time
 import tracemalloc
 
-from ipmc_asym.studies.uq import OUTPUT_UNITS, run_uq
+from ipmc_asym import uq as run_uq
+from ipmc_asym_bench.timing import load
+
+#: every output of a uq scene (ipmc_asym.studies.uq's output table)
+OUTPUTS = ["I", "moment", "tip_deflection", "rotation", "blocking_force"]
 
 __all__ = ["section"]
 
@@ -20,7 +25,7 @@ def section(quick: bool = False) -> dict:
     near 1.
     """
     scene = {"name": "bench_uq", "model": "constant", "voltage": "1V", "tolerance": 1e-2,
-             "outputs": list(OUTPUT_UNITS), "strip": {"width": "5mm"},
+             "outputs": list(OUTPUTS), "strip": {"width": "5mm"},
              "uncertain": {"thickness": {"dist": "normal", "mean": "200um", "sd": "8um"},
                            "length": {"dist": "uniform", "low": "1.95cm", "high": "2.05cm"},
                            "voltage": {"dist": "triangular", "low": "0.95V", "mode": "1V", "high": "1.05V"},
@@ -28,11 +33,14 @@ def section(quick: bool = False) -> dict:
                            "c_moy": {"dist": "normal", "mean": 3082, "sd": 60}}}
     n = 10**5 if quick else 10**6
     run_uq(scene, 1000, fidelity="leading")  # warm: kernels, the beam's branch table
-    best = None
+    best, cpu = None, float("inf")
     for _ in range(1 if quick else 2):
+        t0 = time.process_time()
         r = run_uq(scene, n, fidelity="leading")
+        cpu = min(cpu, time.process_time() - t0)
         if best is None or r.seconds < best.seconds:
             best = r
+    ld = load()
     peaks = []
     for e in (15, 17 if quick else 18):
         tracemalloc.start()
@@ -46,7 +54,10 @@ def section(quick: bool = False) -> dict:
     ev = best.n_samples / best.timings["evaluation"]
     return {"figures": [
         {"what": "uq end to end at leading (sampling + 5 outputs + Sobol')", "value": rate, "unit": "samples/s",
-         "target": 1e6, "pass": bool(rate >= 1e6), "note": f"{best.n_samples} runs in {best.seconds:.3g} s"},
+         "target": 1e6, "pass": bool(rate >= 1e6), "note": f"{best.n_samples} runs in {best.seconds:.3g} s wall clock (all threads), "
+                                                  f"load {ld:.2f}"},
+        {"what": "uq end to end at leading, CPU time of the process", "value": best.n_samples / cpu,
+         "unit": "samples/s", "target": None, "pass": None, "note": f"{cpu:.3g} s CPU (every thread's)"},
         {"what": "uq model evaluation only at leading", "value": ev, "unit": "samples/s", "target": None,
          "pass": None, "note": f"{best.timings['evaluation']:.3g} s"},
         {"what": "uq wall time for the 10^6-run request", "value": best.seconds, "unit": "s",

@@ -1,5 +1,7 @@
 """The benchmark sits outside the library: ipmc_asym never imports ipmc_asym_bench, and
-ipmc_asym_bench uses only public names of ipmc_asym (AST of every module)."""
+ipmc_asym_bench uses only the public face of ipmc_asym -- the names of ``ipmc_asym.__all__`` --
+plus the few helpers a plugin command of the CLI needs (:data:`PLUGIN_INTERFACE`); AST of every
+module."""
 
 from __future__ import annotations
 
@@ -10,6 +12,15 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 BENCH = "ipmc_asym_bench"
+
+#: what a plugin command of ``ipmc-asym`` may import besides ``ipmc_asym.__all__``: the CLI's
+#: option helpers, the output-path check, the JSON writer and the bench's own figure
+PLUGIN_INTERFACE = {
+    "ipmc_asym.cli.common": {"add_size_option", "count_type"},
+    "ipmc_asym.io.fileio": {"FIGURE_FORMATS", "check_output_path"},
+    "ipmc_asym.io.jsonio": {"dumps"},
+    "ipmc_asym.plotting.speed": {"plot_speed_accuracy"},
+}
 
 
 def modules(top: str) -> list[Path]:
@@ -67,6 +78,49 @@ def private_uses(tree: ast.AST) -> list[str]:
                     and node.args[0].id in library_names:
                 out.append(ast.unparse(node))
     return out
+
+
+def face_violations(tree: ast.AST, public: set) -> list[str]:
+    """Imports of ipmc_asym that are neither a name of ``public`` (``from ipmc_asym import X``,
+    ``ia.X`` with ``import ipmc_asym as ia``) nor in :data:`PLUGIN_INTERFACE`."""
+    out, aliases = [], set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom) and node.module and node.module.split(".")[0] == "ipmc_asym":
+            allowed = public if node.module == "ipmc_asym" else PLUGIN_INTERFACE.get(node.module, set())
+            out += [f"from {node.module} import {a.name}" for a in node.names if a.name not in allowed]
+        elif isinstance(node, ast.Import):
+            for a in node.names:
+                if a.name == "ipmc_asym":
+                    aliases.add(a.asname or a.name)
+                elif a.name.startswith("ipmc_asym."):
+                    out.append(f"import {a.name}")
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name) and node.value.id in aliases \
+                and node.attr not in public:
+            out.append(ast.unparse(node))
+    return out
+
+
+def test_the_bench_uses_only_the_public_face():
+    import ipmc_asym
+
+    public = set(ipmc_asym.__all__)
+    bad = [f"{p.relative_to(ROOT)}: {u}" for p in modules(BENCH)
+           for u in face_violations(ast.parse(p.read_text(encoding="utf-8")), public)]
+    assert not bad, bad
+
+
+@pytest.mark.parametrize("source, found", [
+    ("from ipmc_asym.integral.api import moment\n", True),
+    ("from ipmc_asym import moment_integral\n", False),
+    ("from ipmc_asym import groups_arrays\n", True),
+    ("import ipmc_asym as ia\nia.moment(1, 2)\n", False),
+    ("import ipmc_asym as ia\nia.closed_model_id\n", True),
+    ("import ipmc_asym.bvp.solver\n", True),
+    ("from ipmc_asym.io.jsonio import dumps\n", False),
+])
+def test_the_face_check_can_fail(source, found):
+    assert bool(face_violations(ast.parse(source), {"moment", "moment_integral"})) is found
 
 
 def test_the_library_does_not_import_the_bench():

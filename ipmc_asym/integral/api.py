@@ -44,6 +44,7 @@ import math
 import warnings
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 
 from ipmc_asym.base.progress import progress as _progress_bar
@@ -500,8 +501,19 @@ def interpret_small(enabled: bool = True) -> _Switch:
     return _Switch(_INTERPRET.set(bool(enabled)))
 
 
+#: compiled seconds per point of each rung's fused driver, one thread (``ipmc-asym bench``,
+#: order of magnitude): with :data:`PARALLEL_MIN_S`, the work below which one thread runs
+COMPILED_S = {"leading": 4e-8, "corrected": 5e-8, "quadrature": 2.5e-6, "exact": 1e-5}
+#: below this much single-thread work a parallel launch costs more than it saves: on this
+#: 2-core machine 1000 ``leading`` points (~50 us) ran 1.2x slower on 2 threads than on 1,
+#: 10 ``exact`` points (~100 us) 0.7x (``ipmc-asym bench``'s notes; wall clock, min of 15)
+PARALLEL_MIN_S = 1e-4
+
+
 def _run_driver(driver, n: int, fidelity: str, args):
-    """``driver(*args)``, or its interpreted twin where :func:`interpret_small` says so."""
+    """``driver(*args)``, or its interpreted twin where :func:`interpret_small` says so; on one
+    Numba thread where the work is below :data:`PARALLEL_MIN_S` (the thread count changes no
+    bit: blocks and points are independent, the counts are integers)."""
     cost = _FIDELITY_SPECS[fidelity].interpreted_s
     if _INTERPRET.get() and not driver.signatures and 0.0 < n * cost <= INTERPRET_BUDGET_S:
         try:
@@ -509,6 +521,14 @@ def _run_driver(driver, n: int, fidelity: str, args):
                 return interpreted(driver)(*args)
         except (ArithmeticError, ValueError):  # the compiled code returns inf/NaN there
             pass
+    if n * COMPILED_S.get(fidelity, 0.0) < PARALLEL_MIN_S:
+        old = numba.get_num_threads()
+        if old > 1:
+            numba.set_num_threads(1)
+            try:
+                return driver(*args)
+            finally:
+                numba.set_num_threads(old)
     return driver(*args)
 
 

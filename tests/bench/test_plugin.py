@@ -1,9 +1,9 @@
 """``ipmc-asym bench`` through the entry point group ``ipmc_asym.commands``: discovery (with a
-monkeypatched ``entry_points``), ``--help``, a tiny run, and ``figures`` finding the measurement."""
+monkeypatched ``entry_points``), ``--help`` and options, and ``figures`` finding the measurement
+(a run through ``main``: tests/bench/test_suite.py)."""
 
 from __future__ import annotations
 
-import json
 from importlib.metadata import EntryPoint
 
 import pytest
@@ -69,15 +69,6 @@ def test_bench_options(with_bench):
     assert (args.points, args.bvp_points, args.no_compile, args.layout, args.section, args.quick, args.figure) == \
         (1000, 2, True, "random", ["uq", "charge"], True, "")
     assert handlers["bench"].__module__ == "ipmc_asym_bench.cli"
-
-
-def test_bench_runs_through_main(with_bench, capsys, tmp_path):
-    fig = tmp_path / "sa.png"
-    assert cli.main(["bench", "--json", "--points", "300", "--bvp-points", "1", "--no-compile", "--quick",
-                     "--section", "charge", "--figure", str(fig)]) == 0
-    res = json.loads(capsys.readouterr().out)
-    assert res["points"] == 300 and set(res["sections"]) == {"charge"} and res["figure"] == str(fig)
-    assert fig.stat().st_size > 1000
 
 
 @pytest.mark.parametrize("plugin", [True, False])
