@@ -9,6 +9,7 @@ from ipmc_asym.base.units import fmt_length, parse_quantity, parse_sheet_resista
 from ipmc_asym.beam.dynamics import CLAMPED_OUTPUTS
 from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import (
+    add_output_option,
     add_size_option,
     add_strip_options,
     arg_type,
@@ -70,7 +71,7 @@ def register(sub):
                         "Z and w of the RC line along the strip, driven at the clamp")
     add_support_options(p)
     p.add_argument("--json", action="store_true", help="print one JSON object")
-    p.add_argument("--export", metavar="F.json", default=None,
+    add_output_option(p, "--export", formats=(".json",), metavar="F.json", default=None,
                    help="write reduced-order models of V -> w and V -> charge over [--from, --to] (poles, residues, "
                         "state space, stated error; see ipmc_asym.transfer_function)")
     p.add_argument("--export-tol", type=_tol_type, default=1e-4,

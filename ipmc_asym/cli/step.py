@@ -13,6 +13,7 @@ from ipmc_asym.base.registry import model_names
 from ipmc_asym.base.units import fmt_length, parse_time
 from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import (
+    add_output_option,
     add_size_option,
     add_strip_options,
     arg_type,
@@ -189,7 +190,7 @@ def register(sub):
                         "(see ipmc-asym drive --help)")
     add_beam_options(p, "quasi-static")
     add_line_options(p)
-    p.add_argument("--out", default=None, metavar="F.csv",
+    add_output_option(p, "--out", formats=(".csv",), default=None, metavar="F.csv",
                    help="CSV file (header row t, phi0, sigma, current_density, M_A, theta, w, check_* and valid per "
                         "time point; SI; a first column model with --model all), with the metadata (tau, total "
                         "thickness, model, units) in the sidecar F.csv.json")

@@ -16,6 +16,7 @@ from ipmc_asym.base.settings import MAX_ROWS
 from ipmc_asym.base.units import parse_vary_spec, vary_values
 from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import (
+    add_output_option,
     add_strip_options,
     count_type,
     first_run_notice,
@@ -58,7 +59,7 @@ def register(sub):
                         "(e.g. 1e-3 or 0.1%%; default 1%%)")
     p.add_argument("--max-rows", type=count_type("--max-rows"), default=MAX_ROWS,
                    help=f"refuse a sweep of more rows than this (default {MAX_ROWS:.0e}, settings.MAX_ROWS)")
-    p.add_argument("--out", default=None,
+    add_output_option(p, "--out", formats=OUT_FORMATS, default=None,
                    help="output file, written in chunks and atomically; the format follows the extension: .csv "
                         "(SI columns), .json, or .nc for a labelled NetCDF dataset (xarray; held in memory); "
                         "default: CSV on stdout")

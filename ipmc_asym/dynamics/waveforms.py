@@ -19,12 +19,14 @@ functions as well.
 from __future__ import annotations
 
 import csv
+import io
 import math
 import os
 import re
 
 import numpy as np
 
+from ipmc_asym.base.inputs import read_input_text
 from ipmc_asym.base.units import parse_quantity, parse_time, parse_voltage
 
 __all__ = ["Waveform", "parse_waveform", "WAVEFORM_KINDS", "MAX_CSV_ROWS"]
@@ -90,7 +92,11 @@ def _read_csv(path):
     if not os.path.isfile(path):
         raise ValueError(f"waveform csv: no such file {path!r}")
     ts, vs = [], []
-    with open(path, newline="") as fh:
+    try:
+        text = read_input_text(path, "waveform csv")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ValueError(f"waveform csv {path!r}: cannot read ({exc.__class__.__name__}: {exc})") from None
+    with io.StringIO(text, newline="") as fh:
         for i, row in enumerate(csv.reader(fh)):
             if not row or row[0].lstrip().startswith("#"):
                 continue

@@ -31,6 +31,7 @@ from concurrent.futures import ThreadPoolExecutor
 import numba
 import numpy as np
 
+from ipmc_asym.base import interrupt
 from ipmc_asym.base.progress import progress as progress_bar
 from ipmc_asym.base.registry import model_names
 from ipmc_asym.base.settings import CHUNK_ROWS, MAX_ROWS
@@ -400,6 +401,7 @@ def _texts(chunks, kind: str, workers: int):
     if workers <= 1:
         for c in chunks:
             for piece in _pieces(c):
+                interrupt.check()  # between pieces: a signal swallowed in compiled code stops the writer
                 yield _format_chunk_bytes(piece, kind), piece.size
         return
 
@@ -409,6 +411,7 @@ def _texts(chunks, kind: str, workers: int):
             for piece in _pieces(c):
                 pending.append((pool.submit(_format_chunk_bytes, piece, kind), piece.size))
                 while len(pending) > 2 * workers:
+                    interrupt.check()
                     f, k = pending.popleft()
                     yield f.result(), k
         while pending:
