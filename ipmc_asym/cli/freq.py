@@ -74,7 +74,7 @@ def register(sub):
     add_output_option(p, "--export", formats=(".json",), metavar="F.json", default=None,
                    help="write reduced-order models of V -> w and V -> charge over [--from, --to] (poles, residues, "
                         "state space, stated error; see ipmc_asym.transfer_function)")
-    p.add_argument("--export-tol", type=_tol_type, default=1e-4,
+    p.add_argument("--export-tol", type=arg_type(_tol_type, "--export-tol"), default=1e-4,
                    help="relative error the exported models aim at over the band, in (0, 1) (default 1e-4)")
 
 

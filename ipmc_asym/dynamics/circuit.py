@@ -454,9 +454,11 @@ def substep_grid(t, tau, h_max, substeps, too_long):
     time in the grid.  ``too_long`` is the message refused when the grid would pass 5e6 steps.
     """
     dt = np.diff(t) / tau
-    k = np.maximum(np.ceil(dt / h_max), np.where(dt <= 0.5 * h_max, 1, substeps)).astype(np.int64)
-    if k.sum() > 5_000_000:
+    # counted in floating point first: a duration of 1e30 s would overflow the integer count
+    kf = np.maximum(np.ceil(dt / h_max), np.where(dt <= 0.5 * h_max, 1, substeps))
+    if not np.all(np.isfinite(kf)) or kf.sum() > 5_000_000:
         raise ValueError(too_long)
+    k = kf.astype(np.int64)
     idx = np.concatenate(([0], np.cumsum(k)))
     frac = np.arange(idx[-1]) - np.repeat(idx[:-1], k)
     return np.concatenate((np.repeat(t[:-1] / tau, k) + np.repeat(dt / k, k) * frac, [t[-1] / tau])), idx

@@ -37,7 +37,7 @@ import numpy as np
 
 from ipmc_asym.base.registry import MODELS as _MODEL_SPECS
 from ipmc_asym.base.registry import check_choice, fidelity_names
-from ipmc_asym.base.settings import BVP_STATED_ERROR, EXACT_STATED_ERROR, VALIDITY_LIMIT
+from ipmc_asym.base.settings import BVP_STATED_ERROR, EXACT_STATED_ERROR, VALIDATED_VOLTAGE, VALIDITY_LIMIT
 from ipmc_asym.integral.api import check_min_thickness
 from ipmc_asym.kernels import _generated as G
 from ipmc_asym.kernels import _generated_charge as GC
@@ -79,8 +79,11 @@ class ChargeResult:
                       subnormal result: 1 where ``Q`` underflows to 0 at ``|phi0|`` ~ 1e-323 V)
     error_C_diff : ndarray  relative error estimate of ``C_diff`` (and of ``eps_app``)
     core : ndarray    neutral core left between the layers (units of e)
-    valid : ndarray of bool  both error estimates below ``VALIDITY_LIMIT``
+    valid : ndarray of bool  both error estimates below ``VALIDITY_LIMIT`` and ``check_voltage`` (the
+                      forward model's convention: valid = accurate and within every assumption)
     fidelity, model : str
+    check_voltage : ndarray of bool  ``|phi0| <= settings.VALIDATED_VOLTAGE`` (the range validated against
+                      the BVP; beyond it the numbers are kept and flagged, as the forward model's)
     """
 
     sigma: np.ndarray
@@ -93,6 +96,7 @@ class ChargeResult:
     valid: np.ndarray
     fidelity: str
     model: str
+    check_voltage: np.ndarray | None = None
 
 
 def charge_scale(perm: Permittivity, material: Material) -> float:
@@ -284,29 +288,40 @@ def charge(thickness, voltage, model="constant", fidelity="corrected", *, width=
         sig = capacitance_scale(perm, mat) * g * v
         cdv = capacitance_scale(perm, mat) * cdh
         err = err + _subnormal_rounding(sig) + _subnormal_rounding(sig * w * L, sig)
-    valid = (err < VALIDITY_LIMIT) & (errc < VALIDITY_LIMIT)
+    # beyond the validated voltage the numbers are kept and flagged (forward model's check_voltage)
+    volt_ok = np.abs(v) <= VALIDATED_VOLTAGE
+    valid = _accurate(err, errc) & volt_ok
     return ChargeResult(sigma=sig, Q=sig * w * L, C_diff=cdv, eps_app=cdv * th, error=err,
-                        error_C_diff=errc, core=core, valid=valid, fidelity=fidelity, model=perm.name)
+                        error_C_diff=errc, core=core, valid=valid, fidelity=fidelity, model=perm.name,
+                        check_voltage=volt_ok)
+
+
+def _accurate(err, errc):
+    """Both error estimates below ``VALIDITY_LIMIT`` (what a higher rung can improve)."""
+    return (np.asarray(err) < VALIDITY_LIMIT) & (np.asarray(errc) < VALIDITY_LIMIT)
 
 
 def charge_escalated(thickness: float, voltage: float, model="constant", fidelity="corrected", **kw) -> ChargeResult:
     """:func:`charge` of one point at the cheapest VALID rung from ``fidelity`` up the registry's ladder.
 
     Same arguments as :func:`charge` (scalars); the result's ``fidelity`` names the rung used.
-    Raises ``ValueError`` (one line) where no rung from ``fidelity`` up is valid.
+    A rung is climbed for accuracy only: beyond the validated voltage the result is kept with
+    ``check_voltage = valid = False``; where ``sigma`` or ``Q`` is subnormal (``|phi0|`` below
+    ~1e-300 V) no rung helps, and the first rung's result is returned with its rounding in
+    ``error`` (``valid = False`` once that passes ``VALIDITY_LIMIT``).  Raises ``ValueError``
+    (one line) where no rung from ``fidelity`` up is accurate otherwise.
     """
     check_choice("fidelity", fidelity, fidelity_names())
     ladder = fidelity_names()
     last = None
     for rung in ladder[ladder.index(fidelity):]:
         last = charge(thickness, voltage, model, rung, **kw)
-        if bool(last.valid):
+        if bool(_accurate(last.error, last.error_C_diff)):
             return last
         if float(voltage) != 0.0 and min(abs(float(last.sigma)), abs(float(last.Q))) < _SUBNORMAL:
-            # no rung helps: the value itself is below the normal range of a double
-            raise ValueError(f"voltage {float(voltage):g} V is too small: sigma or Q = sigma 2l L falls below "
-                             f"{_SUBNORMAL:.3g} (doubles lose relative precision there; relative rounding "
-                             f"{float(last.error):.2g})")
+            # no rung helps: the value itself is below the normal range of a double; its
+            # rounding is the stated error (sigma -> C_d(0) phi0 down to the subnormals)
+            return last
     raise ValueError(f"no fidelity from {fidelity!r} up is valid for model {get_model(model).name!r} (last rung "
                      f"{last.fidelity!r}: error estimates {float(last.error):.2g} / {float(last.error_C_diff):.2g})")
 
