@@ -170,7 +170,14 @@ def parse_waveform(spec) -> Waveform:
                 if ph:
                     if kind != "sine":
                         raise ValueError("a phase is only read for a sine")
-                    p["phase"] = float(ph)
+                    try:
+                        phase = float(ph)
+                    except ValueError:
+                        phase = math.nan
+                    if not math.isfinite(phase):
+                        raise ValueError(f"the phase must be a finite number of degrees (e.g. sine:1V@10Hz,90); "
+                                         f"got {ph.strip()!r}")
+                    p["phase"] = phase
                 terms.append((kind, p))
         except ValueError as exc:
             msg = str(exc)

@@ -23,7 +23,7 @@ from ipmc_asym.forward.escalation import Escalated, check_tol, moment_escalating
 from ipmc_asym.forward.model import CHECKS, FREE_STRIP_KEYS, MECHANICAL_KEYS, assumption_warnings, forward
 from ipmc_asym.integral.api import check_fidelity, check_min_thickness
 from ipmc_asym.model.groups import pressure_beta
-from ipmc_asym.model.params import NAFION_LI, Material, Strip, debye_length
+from ipmc_asym.model.params import NAFION_LI, Material, Strip, as_material, as_strip, debye_length
 from ipmc_asym.model.permittivity import MODELS, get_model
 
 __all__ = ["evaluate", "estimate_rows", "RESULT_KEYS", "CHECKS", "moment_escalating", "Escalated",
@@ -51,7 +51,8 @@ def evaluate(strip: Strip, model="constant", fidelity="quadrature", material: Ma
     fidelity : str
         The cheapest rung tried; with ``escalate`` (default) the first rung from there that
         is valid at this point is used (``fidelity_used``, ``escalated``).
-    material : Material
+    material : Material, str or dict
+        A material, a set name (``"nafion-li"``) or a ``[material]`` table.
     tol : float, optional
         Relative accuracy the caller needs, in (0, 1): the rung's error bound must meet it
         (default ``settings.VALIDITY_LIMIT``), and it decides whether a displacement counts
@@ -80,6 +81,8 @@ def evaluate(strip: Strip, model="constant", fidelity="quadrature", material: Ma
     check_fidelity(fidelity)
     tol = check_tol(tol)
     check_choice("on_invalid", on_invalid, ("raise", "nan"))
+    strip = as_strip(strip)
+    material = as_material(material)
     perm = get_model(model)
     check_min_thickness(strip.thickness)  # before the groups, which overflow for a 1e-300 m strip
     t0 = time.perf_counter()
