@@ -89,7 +89,7 @@ def _term(kind, p, t):
 
 
 def _read_csv(path):
-    if not os.path.isfile(path):
+    if not os.path.exists(path):
         raise ValueError(f"waveform csv: no such file {path!r}")
     ts, vs = [], []
     try:

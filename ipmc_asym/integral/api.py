@@ -50,7 +50,6 @@ from ipmc_asym.base.progress import progress as _progress_bar
 from ipmc_asym.base.registry import FIDELITIES as _FIDELITY_SPECS
 from ipmc_asym.base.registry import MODELS as _MODEL_SPECS
 from ipmc_asym.base.registry import any_thickness_fidelities, check_choice, fidelity_names, is_compiled
-from ipmc_asym.base.units import parse_length, parse_voltage
 from ipmc_asym.base.settings import (
     BVP_STATED_ERROR,
     EXACT_STATED_ERROR,
@@ -59,6 +58,7 @@ from ipmc_asym.base.settings import (
     ROUNDING_ERROR,
     VALIDITY_LIMIT,
 )
+from ipmc_asym.base.units import parse_length, parse_voltage
 from ipmc_asym.kernels.closed import closed_b1, closed_finish, layer_closed, moment_closed
 from ipmc_asym.kernels.debye import DH_A2, dh_exact, dh_layer
 from ipmc_asym.kernels.exact import moment_exact
