@@ -263,7 +263,10 @@ def sweep(vary: dict, model="constant", fidelity="quadrature", base: Strip | Non
     -------
     numpy structured array (dtype :data:`DTYPE`), one row per grid point and model.
     Rows where a check failed keep their inputs and say which check (``check_*``,
-    ``valid``); where no rung is valid, ``I`` and the mechanics are NaN.
+    ``valid``); an output :func:`ipmc_asym.evaluate` gives as None is NaN here (:func:`withhold`:
+    ``I`` and the mechanics where no rung is valid, the tip position ``w``, ``w_small``,
+    ``x_tip``, ``y_tip`` past a full turn, ``F_block`` where its large-displacement branch is not
+    tracked).
     """
     check_fidelity(fidelity)
     tol = check_tol(tol)
@@ -279,7 +282,8 @@ def sweep(vary: dict, model="constant", fidelity="quadrature", base: Strip | Non
         parts = list(iter_sweep(vary, model, fidelity, base, material, tol, escalate=escalate, progress=bar))
     finally:
         bar.close()
-    return np.concatenate(parts) if parts else np.empty(0, DTYPE)
+    # the outputs withheld where evaluate, scene and the CLI withhold them (NaN here, None there)
+    return withhold(np.concatenate(parts), copy=False) if parts else np.empty(0, DTYPE)
 
 
 def withhold(arr: np.ndarray, copy: bool = True) -> np.ndarray:
