@@ -18,7 +18,7 @@ import sys
 from importlib.metadata import entry_points
 
 from ipmc_asym import __version__
-from ipmc_asym.base.inputs import input_size_cap, max_input_bytes
+from ipmc_asym.base.inputs import MAX_INPUT_BYTES, input_size_cap, max_input_bytes, parse_size
 from ipmc_asym.base.interrupt import exit_status, handling_signals
 
 __all__ = ["main", "build_parser", "COMMANDS", "UsageError", "PLUGIN_GROUP", "plugin_commands", "load_plugin"]
@@ -74,7 +74,7 @@ def __getattr__(name):
     # ``UsageError`` lives in cli.common, imported by main only once the signal handlers are in
     # place (its imports load NumPy and Numba: a Ctrl-C there ends cleanly, no traceback)
     if name == "UsageError":
-        from ipmc_asym.cli.common import UsageError
+        from ipmc_asym.cli.common import UsageError  # deferred: cli.common loads NumPy and Numba (start-up)
 
         return UsageError
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
@@ -132,8 +132,7 @@ def build_parser(only: str | None = None, plugins: dict | None = None):
 
 def _add_input_cap(p):
     """``--max-input-size``, the one cap on every input file a command reads (base.inputs)."""
-    from ipmc_asym.base.inputs import MAX_INPUT_BYTES, parse_size
-    from ipmc_asym.cli.common import arg_type
+    from ipmc_asym.cli.common import arg_type  # deferred: cli.common loads NumPy and Numba (start-up)
 
     if "--max-input-size" in p._option_string_actions:
         return
@@ -168,7 +167,7 @@ def main(argv=None) -> int:
 
 
 def _run(argv, only, plugins, usage_error) -> int:
-    from ipmc_asym.cli.common import check_outputs, check_size_caps
+    from ipmc_asym.cli.common import check_outputs, check_size_caps  # deferred: as in main (start-up)
 
     command = only or "?"
     try:

@@ -97,7 +97,12 @@ def _read_csv(path):
     except (OSError, UnicodeDecodeError) as exc:
         raise ValueError(f"waveform csv {path!r}: cannot read ({exc.__class__.__name__}: {exc})") from None
     with io.StringIO(text, newline="") as fh:
-        for i, row in enumerate(csv.reader(fh)):
+        reader = csv.reader(fh)
+        try:
+            rows = list(reader)
+        except csv.Error as exc:  # e.g. a field above the csv module's limit (131072 characters)
+            raise ValueError(f"waveform csv {path!r} line {reader.line_num}: cannot read ({exc})") from None
+        for i, row in enumerate(rows):
             if not row or row[0].lstrip().startswith("#"):
                 continue
             if len(row) < 2:

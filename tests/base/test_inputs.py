@@ -75,3 +75,12 @@ def test_fit_csv_huge_field_names_the_line(tmp_path, capsys):
     rc = main(["fit", str(f), "--free", "modulus"])
     err = capsys.readouterr().err
     assert rc == 2 and "line 3" in err and "field larger than field limit" in err, err
+
+
+def test_waveform_csv_huge_field_names_the_line(tmp_path):
+    from ipmc_asym.dynamics.waveforms import parse_waveform
+
+    f = tmp_path / "w.csv"
+    f.write_text("t,V\n0,0\n1," + '"' + "1" * (5 * 2**20) + '"\n')
+    with pytest.raises(ValueError, match="line 3: cannot read .field larger than field limit"):
+        parse_waveform(f"csv:{f}")
