@@ -694,8 +694,9 @@ class BeamResult(ResultMixin):
         Small-displacement tip deflection (m).
     x_tip, y_tip : float or ndarray
         Tip coordinates of the free strip along / across the clamp axis (m); ``y_tip = w``.
-    F_block : float or ndarray
-        Large-displacement blocking force (N); NaN where not available (see ``warnings``).
+    F_block : float or ndarray or None
+        Large-displacement blocking force (N); where not available (see ``warnings``) NaN in an
+        array, None for scalar inputs (the convention of ``evaluate``: no number, no answer).
     F_block_small : float or ndarray
         Small-displacement blocking force ``3M/(2L)`` (N).
     regime : str or ndarray of str
@@ -764,7 +765,11 @@ def solve_beam(M, L, EI, *, tol=None, e=None, strain_limit=0.01) -> BeamResult:
         Scalars for scalar inputs, broadcast arrays otherwise.  ``warnings`` lists, one line
         each: points past a quarter turn or a full turn, large strain (> 1 %), and points
         where the large-displacement blocking force is NaN (``|kappa L| > KL_BLOCK_MAX``).
+        For scalar inputs the outputs without an answer are None, as in ``evaluate``:
+        ``F_block`` beyond ``KL_BLOCK_MAX``, and ``w``, ``w_small``, ``x_tip``, ``y_tip`` past a
+        full turn (the arc passes through itself); arrays keep NaN / the numbers with the warning.
     """
+    scalar = not any(isinstance(a, np.ndarray) or np.ndim(a) for a in (M, L, EI))
     tol_v = DEFAULT_SMALL_TOL if tol is None else float(tol)
     M, L, EI = _mLEI(M, L, EI)
     M, L, EI = np.broadcast_arrays(M, L, EI)
@@ -810,13 +815,13 @@ def solve_beam(M, L, EI, *, tol=None, e=None, strain_limit=0.01) -> BeamResult:
                 "small-strain assumption questionable"
             )
         eps = _out(eps)
+    tip = {"w": _out(y), "w_small": _out(-0.5 * M * L * L / EI), "x_tip": _out(x), "y_tip": _out(y)}
+    if scalar and bool(multi[0]):
+        tip = dict.fromkeys(tip)  # withheld past a full turn, as evaluate does
     return BeamResult(
         theta=_out(theta),
-        w=_out(y),
-        w_small=_out(-0.5 * M * L * L / EI),
-        x_tip=_out(x),
-        y_tip=_out(y),
-        F_block=_out(Fb),
+        **tip,
+        F_block=None if scalar and bool(beyond[0]) else _out(Fb),
         F_block_small=_out(Fs),
         regime=reg,
         regime_code=int(code) if np.ndim(code) == 0 else code,

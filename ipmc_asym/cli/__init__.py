@@ -18,7 +18,8 @@ import sys
 from importlib.metadata import entry_points
 
 from ipmc_asym import __version__
-from ipmc_asym.cli.common import Parser, UsageError, check_size_caps, join_negative_values
+from ipmc_asym.base.inputs import MAX_INPUT_BYTES, input_size_cap, max_input_bytes, parse_size
+from ipmc_asym.base.interrupt import exit_status, handling_signals
 
 __all__ = ["main", "build_parser", "COMMANDS", "UsageError", "PLUGIN_GROUP", "plugin_commands", "load_plugin"]
 
@@ -69,6 +70,16 @@ SUMMARIES = {
 }
 
 
+def __getattr__(name):
+    # ``UsageError`` lives in cli.common, imported by main only once the signal handlers are in
+    # place (its imports load NumPy and Numba: a Ctrl-C there ends cleanly, no traceback)
+    if name == "UsageError":
+        from ipmc_asym.cli.common import UsageError  # deferred: cli.common loads NumPy and Numba (start-up)
+
+        return UsageError
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
 def plugin_commands() -> dict:
     """``{name: entry point}`` of the commands installed packages declare in :data:`PLUGIN_GROUP`
     (a name of this package's own commands is not taken over)."""
@@ -87,6 +98,7 @@ def build_parser(only: str | None = None, plugins: dict | None = None):
     Installed commands (``plugins``, default :func:`plugin_commands`) are imported for their
     summary, listed after this package's own.
     """
+    from ipmc_asym.cli.common import Parser, UsageError  # deferred: see __getattr__
 
     ap = Parser(prog="ipmc-asym", description="Electromechanics of IPMC strips (Tixier & Pouget model).")
     ap.add_argument("--version", action="version", version=f"ipmc-asym {__version__}")
@@ -99,6 +111,7 @@ def build_parser(only: str | None = None, plugins: dict | None = None):
             continue
         mod = importlib.import_module(f"{__name__}.{modname}")
         mod.register(sub)
+        _add_input_cap(sub.choices[name])
         handlers[name] = mod.run
     for name, ep in (plugin_commands() if plugins is None else plugins).items():
         try:
@@ -112,25 +125,60 @@ def build_parser(only: str | None = None, plugins: dict | None = None):
             sub.add_parser(name, help=getattr(mod, "SUMMARY", ""), add_help=False)
             continue
         mod.register(sub)
+        _add_input_cap(sub.choices[name])
         handlers[name] = mod.run
     return ap, handlers
 
 
+def _add_input_cap(p):
+    """``--max-input-size``, the one cap on every input file a command reads (base.inputs)."""
+    from ipmc_asym.cli.common import arg_type  # deferred: cli.common loads NumPy and Numba (start-up)
+
+    if "--max-input-size" in p._option_string_actions:
+        return
+    p.add_argument("--max-input-size", type=arg_type(parse_size, "--max-input-size"), default=MAX_INPUT_BYTES,
+                   metavar="SIZE", help=f"refuse an input file larger than this (e.g. 64MB, 1GiB; default "
+                                        f"{MAX_INPUT_BYTES // 2**20} MiB): memory stays bounded")
+
+
 def main(argv=None) -> int:
-    """Run one command; exit status 0, 2 (bad input or no valid result: one line), 130 (Ctrl-C)."""
-    argv = sys.argv[1:] if argv is None else list(argv)
-    argv = join_negative_values(argv)
-    only = next((a for a in argv if not a.startswith("-")), None)
-    plugins = plugin_commands()
-    known = only in COMMANDS or only in plugins
-    command = only if known else "?"
+    """Run one command; exit status 0, 2 (bad input or no valid result: one line), 130 (Ctrl-C),
+    143 (SIGTERM), 129 (SIGHUP).
+
+    The three signals end the command alike (``base.interrupt``): the temporary files of the
+    atomic writers are removed, no traceback; the previous handlers are restored on return.
+    """
+    command = "?"
+    with handling_signals():
+        try:
+            from ipmc_asym.cli.common import UsageError, join_negative_values  # deferred: under the handlers
+
+            argv = join_negative_values(sys.argv[1:] if argv is None else list(argv))
+            only = next((a for a in argv if not a.startswith("-")), None)
+            plugins = plugin_commands()
+            known = only in COMMANDS or only in plugins
+            command = only if known else "?"
+            return _run(argv, only if known else None, plugins, UsageError)
+        except KeyboardInterrupt as exc:
+            # every file is written through fileio.atomic_write/atomic_path: nothing partial is left
+            how = "Ctrl-C" if exit_status(exc) == 130 else getattr(exc, "name", "signal")
+            sys.stderr.write(f"ipmc-asym {command}: interrupted ({how}); no partial output file left\n")
+            return exit_status(exc)
+
+
+def _run(argv, only, plugins, usage_error) -> int:
+    from ipmc_asym.cli.common import check_outputs, check_size_caps  # deferred: as in main (start-up)
+
+    command = only or "?"
     try:
-        ap, handlers = build_parser(only if known else None, plugins)
+        ap, handlers = build_parser(only, plugins)
         args = ap.parse_args(argv)
         command = args.command
         check_size_caps(args)  # every size-like option against its cap, before any work
-        rc = handlers[args.command](args)
-    except (ValueError, UsageError, OverflowError, ArithmeticError) as exc:
+        check_outputs(args)  # every output option: format from its extension, writable, before any work
+        with input_size_cap(getattr(args, "max_input_size", None) or max_input_bytes()):
+            rc = handlers[args.command](args)
+    except (ValueError, usage_error, OverflowError, ArithmeticError) as exc:
         msg = str(exc).splitlines()[0] if str(exc) else exc.__class__.__name__
         sys.stderr.write(f"ipmc-asym {command}: error: {msg}\n")
         return 2
@@ -142,10 +190,6 @@ def main(argv=None) -> int:
             return 0
         sys.stderr.write(f"ipmc-asym {command}: error: {exc.strerror or exc} ({exc.filename or ''})\n")
         return 2
-    except KeyboardInterrupt:
-        # every file is written through fileio.atomic_write/atomic_path: nothing partial is left
-        sys.stderr.write(f"ipmc-asym {command}: interrupted (Ctrl-C); no partial output file left\n")
-        return 130
     return int(rc or 0)
 
 

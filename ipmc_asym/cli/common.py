@@ -23,6 +23,7 @@ from ipmc_asym.base.units import (
     parse_voltage,
 )
 from ipmc_asym.integral.api import check_min_thickness
+from ipmc_asym.io.fileio import check_output_path
 from ipmc_asym.model.limits import bare_number_warning, material_warnings, range_warning
 from ipmc_asym.model.params import Strip, material_from_spec
 
@@ -31,6 +32,7 @@ __all__ = ["UsageError", "Parser", "add_strip_options", "add_material_options", 
            "material_from_args", "strip_from_args",
            "arg_type", "count_type", "join_negative_values", "fmt_num", "c_moy_label", "length_type", "pressure_type",
            "voltage_type", "tol_type", "first_run_notice", "diffusion_type", "sidecar_path", "add_size_option", "check_size_caps",
+           "add_output_option", "check_outputs",
            "seed_type", "model_help", "viscous_modulus_type", "duration_type", "waveform_type", "sheet_resistance_type",
            "frequency_type", "add_beam_options", "SOLVER_ALIASES", "add_solver_option", "add_line_options",
            "add_support_options", "support_from_args", "CLAMPED_UNITS", "print_clamped"]
@@ -172,6 +174,28 @@ def check_size_caps(args):
         if v is not None and m is not None and v > m:
             raise ValueError(f"{flag} {v:.6g} is above {cap} {m:.6g} (the cap bounding memory and time); "
                              f"lower {flag} or raise {cap}")
+
+
+def add_output_option(p, flag="--out", *, formats=None, kind="file", **kw):
+    """An output option ``flag`` (a file whose format follows its extension, one of ``formats``, or
+    a directory, ``kind="dir"``), checked by :func:`check_outputs` before any work.
+
+    ``main`` calls :func:`check_outputs` right after parsing: a format the command cannot write
+    (``--out d.xlsx`` of a CSV writer, ``--plot x.xlsx``), an empty path (``--out ''``), a
+    missing or read-only directory is refused in one line before anything is computed, the same
+    way for every command (``io.fileio.check_output_path``).
+    """
+    p.add_argument(flag, **kw)
+    outs = p.get_default("_outputs") or ()
+    p.set_defaults(_outputs=tuple(outs) + ((flag, kind, tuple(formats) if formats else None),))
+
+
+def check_outputs(args):
+    """Check every output option of ``args`` given (even empty) with :func:`io.fileio.check_output_path`."""
+    for flag, kind, formats in getattr(args, "_outputs", ()) or ():
+        v = getattr(args, _dest(flag), None)
+        if v is not None:
+            check_output_path(v, kind, flag, formats=formats)
 
 
 def _seed(text):

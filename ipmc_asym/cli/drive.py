@@ -14,6 +14,7 @@ from ipmc_asym.cli.common import (  # noqa: F401  (CLAMPED_UNITS, viscous_modulu
     CLAMPED_UNITS,
     add_beam_options,
     add_line_options,
+    add_output_option,
     add_strip_options,
     add_support_options,
     count_type,
@@ -36,7 +37,7 @@ from ipmc_asym.dynamics.drive import (
     MAX_DRIVE_POINTS,
 )
 from ipmc_asym.dynamics.entry import time_response
-from ipmc_asym.io.fileio import atomic_write, check_output_path
+from ipmc_asym.io.fileio import atomic_path, atomic_write, check_output_path
 from ipmc_asym.io.jsonio import dumps
 from ipmc_asym.io.textfmt import format_table
 
@@ -59,7 +60,7 @@ def register(sub):
     add_beam_options(p)
     add_line_options(p)
     add_support_options(p)
-    p.add_argument("--out", default=None, help="CSV file, written as computed (columns " + ", ".join(DRIVE_COLUMNS)
+    add_output_option(p, "--out", formats=(".csv",), default=None, help="CSV file, written as computed (columns " + ", ".join(DRIVE_COLUMNS)
                    + ", then the forward model's check_* and valid per time point, 1 or 0)")
     p.add_argument("--json", action="store_true", help=f"print one JSON object (at most {MAX_JSON_POINTS:g} points)")
 
@@ -91,7 +92,7 @@ def run(args):
     if args.json and args.points > MAX_JSON_POINTS:
         raise ValueError(f"--json holds every row in memory: --points at most {MAX_JSON_POINTS:g} (use --out F.csv)")
     if args.out:
-        check_output_path(args.out, "file")
+        check_output_path(args.out, "file", formats=(".csv",))
         check_output_path(sidecar_path(args.out), "file")
     material = material_from_args(args)
     if args.diffusion is not None:
@@ -121,17 +122,20 @@ def run(args):
     seen, counts = {}, {}
     i0 = 0
     if args.out:
-        # one header row (pandas.read_csv reads it as is); the metadata in the sidecar F.csv.json
-        with atomic_write(sidecar_path(args.out)) as fh:
-            fh.write(dumps({"csv": os.path.basename(args.out), **head}, indent=1) + "\n")
-        with atomic_write(args.out) as fh:
-            fh.write(",".join(columns) + "\n")
-            for ch in gen:
-                _note_warnings(ch, seen, counts)
-                fh.write(_csv_rows(ch, columns))
-                n = ch["t"].size
-                shown += [{c: float(ch[c][i - i0]) for c in shown_cols} for i in range(i0, i0 + n) if i in show]
-                i0 += n
+        # one header row (pandas.read_csv reads it as is); the metadata in the sidecar F.csv.json,
+        # written last: its temporary file is renamed after the CSV's, and both are removed on
+        # any failure or interruption before (no sidecar without its CSV)
+        with atomic_path(sidecar_path(args.out)) as side_tmp:
+            with atomic_write(args.out) as fh:
+                fh.write(",".join(columns) + "\n")
+                for ch in gen:
+                    _note_warnings(ch, seen, counts)
+                    fh.write(_csv_rows(ch, columns))
+                    n = ch["t"].size
+                    shown += [{c: float(ch[c][i - i0]) for c in shown_cols} for i in range(i0, i0 + n) if i in show]
+                    i0 += n
+                with open(side_tmp, "w", encoding="utf-8") as sh:
+                    sh.write(dumps({"csv": os.path.basename(args.out), **head}, indent=1) + "\n")
         sys.stderr.write(f"drive: {args.points} rows -> {args.out}\n")
     else:
         for ch in gen:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import sys
 
 from ipmc_asym.cli import SUMMARIES, load_plugin
-from ipmc_asym.cli.common import add_size_option, new_dir_removed_on_failure
+from ipmc_asym.cli.common import add_output_option, add_size_option, new_dir_removed_on_failure
 from ipmc_asym.io.fileio import check_output_path, make_output_dir
 from ipmc_asym.plotting.speed import load_bench
 
@@ -16,7 +16,7 @@ MAX_DPI = 600
 
 def register(sub):
     p = sub.add_parser("figures", help=SUMMARIES["figures"])
-    p.add_argument("--out", required=True, metavar="DIR",
+    add_output_option(p, "--out", kind="dir", required=True, metavar="DIR",
                    help="output directory (required: no default that would depend on the working directory; "
                         "only its last level is created)")
     add_size_option(p, "--dpi", default=110, maximum=MAX_DPI, minimum=10, help="resolution in dots per inch (>= 10)")

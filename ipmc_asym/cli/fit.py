@@ -8,6 +8,7 @@ import sys
 from ipmc_asym.base.registry import fidelity_names, model_names
 from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import (
+    add_output_option,
     add_size_option,
     add_solver_option,
     add_strip_options,
@@ -85,7 +86,7 @@ def register(sub):
     p.add_argument("--seed", type=seed_type, default=0, help="seed of the multistart starts (integer >= 0, default 0)")
     p.add_argument("--scheduler", default=None, metavar="local|tcp://HOST:PORT",
                    help="run the multistart on dask.distributed (default: serial)")
-    p.add_argument("--plot", default=None, metavar="F.png",
+    add_output_option(p, "--plot", formats=FIGURE_FORMATS, default=None, metavar="F.png",
                    help=f"data vs fitted model with residuals ({', '.join(FIGURE_FORMATS)})")
     p.add_argument("--no-progress", action="store_true", help="no progress bar (model evaluations) on stderr")
     p.add_argument("--json", action="store_true", help="print one JSON object")

@@ -11,10 +11,12 @@ from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import (
     CLAMPED_UNITS,
     add_beam_options,
+    add_output_option,
     add_size_option,
     add_solver_option,
     add_strip_options,
     add_support_options,
+    arg_type,
     diffusion_type,
     fmt_num,
     frequency_type,
@@ -56,10 +58,10 @@ def register(sub):
                         "Z and w of the RC line along the strip, driven at the clamp")
     add_support_options(p)
     p.add_argument("--json", action="store_true", help="print one JSON object")
-    p.add_argument("--export", metavar="F.json", default=None,
+    add_output_option(p, "--export", formats=(".json",), metavar="F.json", default=None,
                    help="write reduced-order models of V -> w and V -> charge over [--from, --to] (poles, residues, "
                         "state space, stated error; see ipmc_asym.transfer_function)")
-    p.add_argument("--export-tol", type=_tol_type, default=1e-4,
+    p.add_argument("--export-tol", type=arg_type(_tol_type, "--export-tol"), default=1e-4,
                    help="relative error the exported models aim at over the band, in (0, 1) (default 1e-4)")
 
 

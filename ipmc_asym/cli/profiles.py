@@ -4,7 +4,14 @@ from __future__ import annotations
 
 from ipmc_asym.base.registry import model_choices, model_names
 from ipmc_asym.cli import SUMMARIES
-from ipmc_asym.cli.common import add_strip_options, fmt_num, material_from_args, new_dir_removed_on_failure, strip_from_args
+from ipmc_asym.cli.common import (
+    add_output_option,
+    add_strip_options,
+    fmt_num,
+    material_from_args,
+    new_dir_removed_on_failure,
+    strip_from_args,
+)
 from ipmc_asym.io.fileio import check_output_path, make_output_dir
 from ipmc_asym.io.jsonio import dumps
 from ipmc_asym.studies.profiles import PAPER_LAYERS, compute_all, profile_summary
@@ -14,7 +21,7 @@ def register(sub):
     p = sub.add_parser("profiles", help=SUMMARIES["profiles"])
     add_strip_options(p, mechanics=False)
     p.add_argument("--model", default="all", choices=model_choices(), help="permittivity model (default all)")
-    p.add_argument("--out", default=None, metavar="DIR",
+    add_output_option(p, "--out", kind="dir", default=None, metavar="DIR",
                    help="output directory for the CSV and PNG files (only its last level is created); without it "
                         "the layer summary is printed and no file is written")
     p.add_argument("--json", action="store_true", help="print the layer summary as JSON")

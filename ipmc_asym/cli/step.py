@@ -15,6 +15,7 @@ from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import (
     add_beam_options,
     add_line_options,
+    add_output_option,
     add_size_option,
     add_solver_option,
     add_strip_options,
@@ -168,7 +169,7 @@ def register(sub):
                         "(see ipmc-asym drive --help)")
     add_beam_options(p)
     add_line_options(p)
-    p.add_argument("--out", default=None, metavar="F.csv",
+    add_output_option(p, "--out", formats=(".csv",), default=None, metavar="F.csv",
                    help="CSV file (header row t, phi0, sigma, current_density, M_A, theta, w, check_* and valid per "
                         "time point; SI; a first column model with --model all), with the metadata (tau, total "
                         "thickness, model, units) in the sidecar F.csv.json")

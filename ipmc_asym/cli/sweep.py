@@ -16,6 +16,7 @@ from ipmc_asym.base.settings import MAX_ROWS
 from ipmc_asym.base.units import parse_vary_spec, vary_values
 from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import (
+    add_output_option,
     add_strip_options,
     count_type,
     first_run_notice,
@@ -36,6 +37,11 @@ from ipmc_asym.studies.sweeps import iter_sweep, prefetched, sweep, warm_writer,
 
 #: extensions of --out (the format follows the extension)
 OUT_FORMATS = (".csv", ".json", ".nc")
+#: most rows of a sweep held in memory (--out F.nc, a NetCDF dataset written at once, and
+#: --scheduler, whose chunks come back as arrays): ~630 bytes a row at the peak (tracemalloc,
+#: tests/cli/test_sweep_memory.py), so under 1 GB; a CSV or JSON --out is streamed (no cap but
+#: --max-rows)
+MAX_MEMORY_ROWS = 10**6
 #: points per axis used for the fits (a subsample of a longer axis fits the same law)
 FIT_POINTS = 2000
 
@@ -58,9 +64,10 @@ def register(sub):
                         "(e.g. 1e-3 or 0.1%%; default 1%%)")
     p.add_argument("--max-rows", type=count_type("--max-rows"), default=MAX_ROWS,
                    help=f"refuse a sweep of more rows than this (default {MAX_ROWS:.0e}, settings.MAX_ROWS)")
-    p.add_argument("--out", default=None,
+    add_output_option(p, "--out", formats=OUT_FORMATS, default=None,
                    help="output file, written in chunks and atomically; the format follows the extension: .csv "
-                        "(SI columns), .json, or .nc for a labelled NetCDF dataset (xarray; held in memory); "
+                        "(SI columns), .json, or .nc for a labelled NetCDF dataset (xarray; held in memory: at most "
+                        f"{MAX_MEMORY_ROWS:g} rows); "
                         "default: CSV on stdout")
     p.add_argument("--scheduler", default=None, metavar="local|tcp://HOST:PORT",
                    help="run the sweep's chunks on dask.distributed (results identical to the serial run; "
@@ -127,6 +134,11 @@ def run(args) -> int:
     if n > args.max_rows:
         raise ValueError(f"the sweep has {n:.3g} rows, more than --max-rows {args.max_rows:g}; "
                          "narrow it or raise --max-rows")
+    to_nc = bool(args.out) and args.out.lower().endswith(".nc")
+    if (to_nc or args.scheduler is not None) and n > MAX_MEMORY_ROWS:
+        what = "--out F.nc writes its dataset at once" if to_nc else "--scheduler returns its chunks as arrays"
+        raise ValueError(f"the sweep has {n:.3g} rows; {what}, held in memory: at most {MAX_MEMORY_ROWS:g} rows "
+                         "(< 1 GB); narrow it, or write --out F.csv / F.json (streamed)")
     vary = {k: vary_values(*sp[1:]) for k, sp in specs.items()}
     if args.out:
         check_output_path(args.out, "file", formats=OUT_FORMATS)
@@ -149,7 +161,6 @@ def run(args) -> int:
     with warnings.catch_warnings(), np.errstate(all="ignore"):
         # no NumPy RuntimeWarning with internal paths: non-finite results are columns/notes
         warnings.simplefilter("ignore", RuntimeWarning)
-        to_nc = bool(args.out) and args.out.lower().endswith(".nc")
         if args.scheduler is not None or to_nc:
             # the whole grid in memory: a NetCDF dataset is written at once, and distributed
             # chunks come back as arrays (refused above --max-rows like every sweep)

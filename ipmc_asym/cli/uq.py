@@ -8,6 +8,7 @@ from ipmc_asym.base.registry import compiled_fidelities
 from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import (
     add_material_options,
+    add_output_option,
     add_size_option,
     first_run_notice,
     fmt_num,
@@ -48,9 +49,9 @@ def register(sub):
                    help="seed of the scrambled Sobol' sequence (integer >= 0, default 0; stored in the NetCDF)")
     p.add_argument("--scheduler", default=None, metavar="local|tcp://HOST:PORT",
                    help="run the chunks on dask.distributed (default: in this process)")
-    p.add_argument("--out", default=None, metavar="F.nc",
+    add_output_option(p, "--out", formats=(".nc",), default=None, metavar="F.nc",
                    help="NetCDF file (.nc) of the statistics, the indices and the first --store-samples runs")
-    p.add_argument("--plot", default=None, metavar="F.png",
+    add_output_option(p, "--plot", formats=FIGURE_FORMATS, default=None, metavar="F.png",
                    help=f"histograms of the outputs ({', '.join(FIGURE_FORMATS)})")
     p.add_argument("--keep-invalid", action="store_true",
                    help="keep the samples outside a model assumption (past a quarter turn, above the strain limit, "

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from ipmc_asym.cli import SUMMARIES
+from ipmc_asym.cli.common import add_output_option
 from ipmc_asym.io.fileio import atomic_write, check_output_path
 from ipmc_asym.io.jsonio import dumps
 from ipmc_asym.validation.validate import VERDICTS, claims, to_markdown
@@ -12,7 +13,7 @@ def register(sub):
     """Add the ``validate`` subcommand."""
     p = sub.add_parser("validate", help=SUMMARIES["validate"])
     p.add_argument("--json", action="store_true", help='print {"claims": [...]}')
-    p.add_argument("--out", default=None, metavar="F.md", help="write a Markdown report to this file (.md)")
+    add_output_option(p, "--out", formats=(".md",), default=None, metavar="F.md", help="write a Markdown report to this file (.md)")
 
 
 def run(args) -> int:

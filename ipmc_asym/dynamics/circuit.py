@@ -321,17 +321,28 @@ def quasi_static_mechanics(u, strip: Strip, perm: Permittivity, material: Materi
             np.asarray(r.F_block, dtype=float))
 
 
+#: most output times of one in-memory step response (~1 kB per time point over the integrator's
+#: and the forward model's arrays: ~1 GB here; the command line's --max-points stays below)
+MAX_STEP_POINTS = 10**6
+
+
 def _time_grid(duration, t, points):
     if t is not None:
         t = np.asarray(t, dtype=float).reshape(-1)
+        if t.size > MAX_STEP_POINTS:
+            raise ValueError(f"t has {t.size} times, more than {MAX_STEP_POINTS:g} (the cap bounding memory, "
+                             "circuit.MAX_STEP_POINTS); stream longer runs with drive_chunks")
         if t.size < 2 or not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0) or t[0] < 0:
             raise ValueError("t must be a finite, strictly increasing array of >= 2 times >= 0 s")
         return t
     d = check_positive("duration", duration, "s")
-    n = int(points)
-    if n < 2:
-        raise ValueError(f"points must be an integer >= 2; got {points!r}")
-    return np.linspace(0.0, d, n)
+    if isinstance(points, bool) or not isinstance(points, (int, np.integer)):
+        if not (isinstance(points, (float, np.floating)) and float(points).is_integer()):
+            raise ValueError(f"points must be an integer in [2, {MAX_STEP_POINTS:g}]; got {points!r}")
+    if not 2 <= points <= MAX_STEP_POINTS:
+        raise ValueError(f"points must be an integer in [2, {MAX_STEP_POINTS:g}] (the cap bounding memory, "
+                         f"circuit.MAX_STEP_POINTS; stream longer runs with drive_chunks); got {points!r}")
+    return np.linspace(0.0, d, int(points))
 
 
 class CircuitStepper:
@@ -387,9 +398,11 @@ def substep_grid(t, tau, h_max, substeps, too_long):
     time in the grid.  ``too_long`` is the message refused when the grid would pass 5e6 steps.
     """
     dt = np.diff(t) / tau
-    k = np.maximum(np.ceil(dt / h_max), np.where(dt <= 0.5 * h_max, 1, substeps)).astype(np.int64)
-    if k.sum() > 5_000_000:
+    # counted in floating point first: a duration of 1e30 s would overflow the integer count
+    kf = np.maximum(np.ceil(dt / h_max), np.where(dt <= 0.5 * h_max, 1, substeps))
+    if not np.all(np.isfinite(kf)) or kf.sum() > 5_000_000:
         raise ValueError(too_long)
+    k = kf.astype(np.int64)
     idx = np.concatenate(([0], np.cumsum(k)))
     frac = np.arange(idx[-1]) - np.repeat(idx[:-1], k)
     return np.concatenate((np.repeat(t[:-1] / tau, k) + np.repeat(dt / k, k) * frac, [t[-1] / tau])), idx

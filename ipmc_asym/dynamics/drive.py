@@ -16,6 +16,7 @@ import math
 
 import numpy as np
 
+from ipmc_asym.base import interrupt
 from ipmc_asym.base.registry import check_choice
 from ipmc_asym.base.settings import VALIDATED_VOLTAGE
 from ipmc_asym.beam.dynamics import CLAMPED_OUTPUTS, natural_frequencies
@@ -285,6 +286,7 @@ def drive_chunks(wave, duration, points, *, strip: Strip | None = None, model="c
             prev = (tt[-2], uu[-2])
         else:
             held = {}
+        interrupt.check()  # a Ctrl-C/SIGTERM swallowed inside the chunk's compiled code stops here
         yield {**{k: out[k] for k in DRIVE_COLUMNS + CHECK_COLUMNS + lcols + ccols}, "warnings": warns}
         start = stop
         if last:

@@ -15,7 +15,7 @@ import numpy as np
 from ipmc_asym.base.ladder import climb, rungs_from
 from ipmc_asym.base.registry import fidelity_names
 from ipmc_asym.integral.api import check_fidelity
-from ipmc_asym.integral.charge import SUBNORMAL, ChargeResult, capacitance_scale, charge, charge_scale
+from ipmc_asym.integral.charge import SUBNORMAL, ChargeResult, accurate, capacitance_scale, charge, charge_scale
 from ipmc_asym.kernels.charge import CLOSED_TRUNCATION, charge_hat_point
 from ipmc_asym.model import groups
 from ipmc_asym.model.params import NAFION_LI, Material
@@ -30,18 +30,21 @@ def charge_escalated(thickness: float, voltage: float, model="constant", fidelit
     """:func:`charge` of one point at the cheapest VALID rung from ``fidelity`` up the registry's ladder.
 
     Same arguments as :func:`charge` (scalars); the result's ``fidelity`` names the rung used.
-    Raises ``ValueError`` (one line) where no rung from ``fidelity`` up is valid.
+    A rung is climbed for accuracy only: beyond the validated voltage the result is kept with
+    ``check_voltage = valid = False``; where ``sigma`` or ``Q`` is subnormal (``|phi0|`` below
+    ~1e-300 V) no rung helps, and the first rung's result is returned with its rounding in
+    ``error`` (``valid = False`` once that passes ``VALIDITY_LIMIT``).  Raises ``ValueError``
+    (one line) where no rung from ``fidelity`` up is accurate otherwise.
     """
     check_fidelity(fidelity)
 
     def checks(f, r, idx):
-        if bool(r.valid):
+        if bool(accurate(r.error, r.error_C_diff)):
             return True, ""
         if float(voltage) != 0.0 and min(abs(float(r.sigma)), abs(float(r.Q))) < SUBNORMAL:
-            # no rung helps: the value itself is below the normal range of a double
-            raise ValueError(f"voltage {float(voltage):g} V is too small: sigma or Q = sigma 2l L falls below "
-                             f"{SUBNORMAL:.3g} (doubles lose relative precision there; relative rounding "
-                             f"{float(r.error):.2g})")
+            # no rung helps: the value itself is below the normal range of a double; its
+            # rounding is the stated error (sigma -> C_d(0) phi0 down to the subnormals)
+            return True, ""
         return False, f"error estimates {float(r.error):.2g} / {float(r.error_C_diff):.2g}"
 
     lad = climb(rungs_from(fidelity_names(), fidelity), lambda f, idx: charge(thickness, voltage, model, f, **kw),

@@ -19,12 +19,14 @@ functions as well.
 from __future__ import annotations
 
 import csv
+import io
 import math
 import os
 import re
 
 import numpy as np
 
+from ipmc_asym.base.inputs import read_input_text
 from ipmc_asym.base.units import parse_quantity, parse_time, parse_voltage
 
 __all__ = ["Waveform", "parse_waveform", "WAVEFORM_KINDS", "MAX_CSV_ROWS"]
@@ -87,11 +89,20 @@ def _term(kind, p, t):
 
 
 def _read_csv(path):
-    if not os.path.isfile(path):
+    if not os.path.exists(path):
         raise ValueError(f"waveform csv: no such file {path!r}")
     ts, vs = [], []
-    with open(path, newline="") as fh:
-        for i, row in enumerate(csv.reader(fh)):
+    try:
+        text = read_input_text(path, "waveform csv")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ValueError(f"waveform csv {path!r}: cannot read ({exc.__class__.__name__}: {exc})") from None
+    with io.StringIO(text, newline="") as fh:
+        reader = csv.reader(fh)
+        try:
+            rows = list(reader)
+        except csv.Error as exc:  # e.g. a field above the csv module's limit (131072 characters)
+            raise ValueError(f"waveform csv {path!r} line {reader.line_num}: cannot read ({exc})") from None
+        for i, row in enumerate(rows):
             if not row or row[0].lstrip().startswith("#"):
                 continue
             if len(row) < 2:
@@ -164,7 +175,14 @@ def parse_waveform(spec) -> Waveform:
                 if ph:
                     if kind != "sine":
                         raise ValueError("a phase is only read for a sine")
-                    p["phase"] = float(ph)
+                    try:
+                        phase = float(ph)
+                    except ValueError:
+                        phase = math.nan
+                    if not math.isfinite(phase):
+                        raise ValueError(f"the phase must be a finite number of degrees (e.g. sine:1V@10Hz,90); "
+                                         f"got {ph.strip()!r}")
+                    p["phase"] = phase
                 terms.append((kind, p))
         except ValueError as exc:
             msg = str(exc)

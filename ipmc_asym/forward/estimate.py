@@ -22,7 +22,7 @@ from ipmc_asym.base.registry import check_choice
 from ipmc_asym.forward.escalation import Escalated, check_tol, moment_escalating
 from ipmc_asym.forward.model import CHECKS, FREE_STRIP_KEYS, MECHANICAL_KEYS, _forward, assumption_warnings
 from ipmc_asym.model.groups import pressure_beta
-from ipmc_asym.model.params import NAFION_LI, Material, Strip, debye_length
+from ipmc_asym.model.params import NAFION_LI, Material, Strip, as_material, as_strip, debye_length
 from ipmc_asym.model.permittivity import MODELS
 from ipmc_asym.model.request import Request
 
@@ -51,7 +51,8 @@ def evaluate(strip: Strip, model="constant", fidelity="quadrature", material: Ma
     fidelity : str
         The cheapest rung tried; with ``escalate`` (default) the first rung from there that
         is valid at this point is used (``fidelity_used``, ``escalated``).
-    material : Material
+    material : Material, str or dict
+        A material, a set name (``"nafion-li"``) or a ``[material]`` table.
     tol : float, optional
         Relative accuracy the caller needs, in (0, 1): the rung's error bound must meet it
         (default ``settings.VALIDITY_LIMIT``), and it decides whether a displacement counts
@@ -79,6 +80,8 @@ def evaluate(strip: Strip, model="constant", fidelity="quadrature", material: Ma
     """
     req = Request(model, fidelity, tol, escalate, pressure_term)
     check_choice("on_invalid", on_invalid, ("raise", "nan"))
+    strip = as_strip(strip)
+    material = as_material(material)
     perm = req.model
     t0 = time.perf_counter()
     # the Strip holds its checks (the thickness floor: no 1e-300 m strip reaches the groups)

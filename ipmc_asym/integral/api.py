@@ -60,6 +60,7 @@ from ipmc_asym.base.settings import (
     ROUNDING_ERROR,
     VALIDITY_LIMIT,
 )
+from ipmc_asym.base.units import parse_length, parse_voltage
 from ipmc_asym.kernels.closed import closed_b1, closed_finish, layer_closed, moment_closed
 from ipmc_asym.kernels.debye import DH_A2, dh_exact, dh_layer
 from ipmc_asym.kernels.exact import moment_exact
@@ -537,6 +538,20 @@ _SCALAR_CACHE: dict = {}
 _SCALAR_TYPES = (float, int, np.float64)
 
 
+def as_numbers(name: str, value, parse):
+    """``value`` as numbers: a string with units (``"200um"``, ``"1V"``) through ``parse``; an
+    array or number unchanged; anything else refused in one line naming ``name``."""
+    if type(value) in _SCALAR_TYPES or isinstance(value, np.ndarray) and value.dtype.kind in "fiu":
+        return value
+    if isinstance(value, str):
+        return parse(name, value)
+    try:
+        return np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a number, an array of numbers or a string with units; got "
+                         f"{type(value).__name__} {str(value)[:40]!r}") from None
+
+
 def _flat_input(a: np.ndarray, shape: tuple) -> np.ndarray:
     """A flat float64 view of ``a`` for the fused driver: size-1 inputs stay size 1, same-shape
     C-contiguous inputs are viewed; only a true broadcast of two arrays is materialised."""
@@ -712,6 +727,8 @@ def moment_integral(thickness, voltage, model="constant", fidelity="quadrature",
         ``M_A = A5 I`` with ``A5 = 6 l e^2 F |phi0| C_moy``.
     """
     check_choice("on_invalid", on_invalid, ("raise", "nan", "warn"))
+    thickness = as_numbers("thickness (total, 2e)", thickness, parse_length)
+    voltage = as_numbers("voltage", voltage, parse_voltage)
     # scalar fast path: one compiled call, no arrays (falls through on anything unusual,
     # including an invalid point, which then gets the full treatment below)
     if (type(thickness) in _SCALAR_TYPES and type(voltage) in _SCALAR_TYPES and material is None

@@ -37,7 +37,7 @@ import numpy as np
 
 from ipmc_asym.base.registry import FIDELITIES as _FIDELITY_SPECS
 from ipmc_asym.base.results import Panel, ResultMixin, ResultSpec
-from ipmc_asym.base.settings import BVP_STATED_ERROR, VALIDITY_LIMIT
+from ipmc_asym.base.settings import BVP_STATED_ERROR, VALIDATED_VOLTAGE, VALIDITY_LIMIT
 from ipmc_asym.integral.api import check_fidelity, check_min_thickness, paper_model_id
 from ipmc_asym.kernels.charge import GL_W, GL_X, charge_sweep
 from ipmc_asym.model import groups
@@ -64,8 +64,11 @@ class ChargeResult(ResultMixin):
                       subnormal result: 1 where ``Q`` underflows to 0 at ``|phi0|`` ~ 1e-323 V)
     error_C_diff : ndarray  relative error estimate of ``C_diff`` (and of ``eps_app``)
     core : ndarray    neutral core left between the layers (units of e)
-    valid : ndarray of bool  both error estimates below ``VALIDITY_LIMIT``
+    valid : ndarray of bool  both error estimates below ``VALIDITY_LIMIT`` and ``check_voltage`` (the
+                      forward model's convention: valid = accurate and within every assumption)
     fidelity, model : str
+    check_voltage : ndarray of bool  ``|phi0| <= settings.VALIDATED_VOLTAGE`` (the range validated against
+                      the BVP; beyond it the numbers are kept and flagged, as the forward model's)
     """
 
     _result = ResultSpec("point", None, ("sigma", "Q", "C_diff", "eps_app", "error", "error_C_diff", "core", "valid"),
@@ -81,6 +84,7 @@ class ChargeResult(ResultMixin):
     valid: np.ndarray
     fidelity: str
     model: str
+    check_voltage: np.ndarray | None = None
 
 
 def charge_scale(perm: Permittivity, material: Material) -> float:
@@ -145,9 +149,17 @@ def charge(thickness, voltage, model="constant", fidelity="corrected", *, width=
         sig = capacitance_scale(perm, mat) * g * v
         cdv = capacitance_scale(perm, mat) * cdh
         err = err + _subnormal_rounding(sig) + _subnormal_rounding(sig * w * L, sig)
-    valid = (err < VALIDITY_LIMIT) & (errc < VALIDITY_LIMIT)
+    # beyond the validated voltage the numbers are kept and flagged (forward model's check_voltage)
+    volt_ok = np.abs(v) <= VALIDATED_VOLTAGE
+    valid = accurate(err, errc) & volt_ok
     return ChargeResult(sigma=sig, Q=sig * w * L, C_diff=cdv, eps_app=cdv * th, error=err,
-                        error_C_diff=errc, core=core, valid=valid, fidelity=fidelity, model=perm.name)
+                        error_C_diff=errc, core=core, valid=valid, fidelity=fidelity, model=perm.name,
+                        check_voltage=volt_ok)
+
+
+def accurate(err, errc):
+    """Both error estimates below ``VALIDITY_LIMIT`` (what a higher rung can improve)."""
+    return (np.asarray(err) < VALIDITY_LIMIT) & (np.asarray(errc) < VALIDITY_LIMIT)
 
 
 

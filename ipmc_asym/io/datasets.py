@@ -15,6 +15,7 @@ Layer rule: stdlib + numpy at import; xarray deferred (heavy import, start-up).
 from __future__ import annotations
 
 import dataclasses
+import errno
 import importlib.util
 import json
 
@@ -205,5 +206,10 @@ def write_netcdf(ds, path, engine: str | None = None) -> str:
     p = check_output_path(path, what="--out", formats=(".nc",))
     eng = engine or netcdf_engine()
     with atomic_path(p) as tmp:
-        ds.to_netcdf(tmp, engine=eng)
+        try:
+            ds.to_netcdf(tmp, engine=eng)
+        except RuntimeError as exc:
+            # the NetCDF/HDF5 libraries report a full disk or a failed write as "NetCDF: HDF
+            # error", naming no file: say which file could not be written
+            raise OSError(errno.EIO, f"cannot write the NetCDF file ({exc}; disk full?)", p) from None
     return eng

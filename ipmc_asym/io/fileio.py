@@ -14,6 +14,10 @@
   temporary file in the same directory, renamed over the target on success, removed on any
   error or Ctrl-C), so no partial file is ever left; an ``OSError`` names the target, not
   the temporary file.
+* **Interruptible.**  Under the command line's signal handling (``base.interrupt``) every
+  write through :func:`atomic_write` and every rename checks the interruption flag, so a
+  Ctrl-C, SIGTERM or SIGHUP whose exception was swallowed inside compiled code still stops
+  a streaming writer at its next chunk and no file is committed after it.
 """
 
 from __future__ import annotations
@@ -22,6 +26,8 @@ import contextlib
 import errno
 import os
 import tempfile
+
+from ipmc_asym.base import interrupt
 
 __all__ = ["check_output_path", "atomic_write", "atomic_path", "make_output_dir", "output_format",
            "FIGURE_FORMATS"]
@@ -157,7 +163,8 @@ def atomic_write(path, mode: str = "w", **open_kw):
             open_kw.setdefault("encoding", "utf-8")
             open_kw.setdefault("newline", "")
         with os.fdopen(fd, mode, **open_kw) as fh:
-            yield fh
+            yield _Checked(fh)
+        interrupt.check()  # an interruption swallowed during the work: nothing committed
         os.chmod(tmp, _umask_mode())
         os.replace(tmp, p)
     except BaseException as exc:
@@ -166,6 +173,35 @@ def atomic_write(path, mode: str = "w", **open_kw):
         if isinstance(exc, OSError) and not isinstance(exc, BrokenPipeError) and exc.filename in (tmp, None):
             raise _named(exc, p) from None
         raise
+
+
+class _Checked:
+    """A file object whose ``write`` first checks the interruption flag (one check per chunk of a
+    streaming writer); every other attribute is the file's."""
+
+    __slots__ = ("_fh",)
+
+    def __init__(self, fh):
+        self._fh = fh
+
+    def write(self, data):
+        interrupt.check()
+        return self._fh.write(data)
+
+    def writelines(self, lines):
+        interrupt.check()
+        return self._fh.writelines(lines)
+
+    @property
+    def buffer(self):
+        """The binary layer of a text file, checked the same way."""
+        return _Checked(self._fh.buffer)
+
+    def __getattr__(self, name):
+        return getattr(self._fh, name)
+
+    def __iter__(self):
+        return iter(self._fh)
 
 
 def atomic_path(path):
@@ -191,12 +227,15 @@ class _AtomicPath:
     def __exit__(self, et, ev, tb):
         if et is None:
             try:
+                interrupt.check()  # an interruption swallowed during the work: nothing committed
                 os.chmod(self.tmp, _umask_mode())
                 os.replace(self.tmp, self.path)
-            except OSError as exc:
+            except BaseException as exc:
                 with contextlib.suppress(OSError):
                     os.unlink(self.tmp)
-                raise _named(exc, self.path) from None
+                if isinstance(exc, OSError):
+                    raise _named(exc, self.path) from None
+                raise
             return False
         with contextlib.suppress(OSError):
             os.unlink(self.tmp)

@@ -39,6 +39,7 @@ if sys.version_info >= (3, 11):
 else:  # pragma: no cover - Python 3.10
     import tomli as tomllib
 
+from ipmc_asym.base.inputs import read_input_text
 from ipmc_asym.base.units import parse_quantity
 
 __all__ = ["Parameter", "MaterialSet", "PARAMETERS", "MATERIAL_FIELDS", "set_names", "load_set", "read_set",
@@ -353,8 +354,9 @@ def read_set(path, defaults: dict | None = None) -> MaterialSet:
     if os.path.getsize(path) > MAX_FILE_BYTES:
         raise ValueError(f"material file {path!r} is larger than {MAX_FILE_BYTES} bytes")
     try:
-        with open(path, "rb") as f:
-            data = tomllib.load(f)
+        data = tomllib.loads(read_input_text(path, "material file"))
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ValueError(f"material file {path!r}: cannot read ({exc.__class__.__name__}: {exc})") from None
     except tomllib.TOMLDecodeError as exc:
         raise ValueError(f"material file {path}: not valid TOML ({exc})") from None
     return parse_set(data, path, defaults)

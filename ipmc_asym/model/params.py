@@ -35,6 +35,8 @@ from ipmc_asym.model import material_data
 from ipmc_asym.model.groups import Groups, debye_length, make_groups, moment_scale
 
 __all__ = [
+    "as_material",
+    "as_strip",
     "C_MOY_PAPER",
     "V1_LI_DEFAULT",
     "V1_LI_SOURCE",
@@ -435,3 +437,27 @@ def second_moment(width, thickness):
     l = 0.5 * np.asarray(width, dtype=float)  # noqa: E741
     e = 0.5 * np.asarray(thickness, dtype=float)
     return 4.0 * l * e**3 / 3.0
+
+
+def as_material(material, what: str = "material") -> Material:
+    """The material of a public function's ``material`` argument: a :class:`Material`, a set name
+    or file (``"nafion-li"``, ``"FILE.toml"``, :func:`named_material`), a ``[material]`` table
+    (dict, :func:`material_from_spec`) or None (``nafion-li``); one-line ``ValueError`` otherwise."""
+    if material is None:
+        return NAFION_LI
+    if isinstance(material, Material):
+        return material
+    if isinstance(material, str):
+        return named_material(material)
+    if isinstance(material, dict):
+        return material_from_spec(material)
+    raise ValueError(f"{what} must be a Material, a set name (e.g. 'nafion-li', see ipmc_asym.materials()) or a "
+                     f"[material] table; got {type(material).__name__}")
+
+
+def as_strip(strip, what: str = "strip") -> Strip:
+    """``strip`` if it is a :class:`Strip`; one-line ``ValueError`` otherwise."""
+    if isinstance(strip, Strip):
+        return strip
+    raise ValueError(f"{what} must be an ipmc_asym.Strip, e.g. Strip(length=0.02, width=5e-3, thickness=200e-6, "
+                     f"voltage=1.0); got {type(strip).__name__}")

@@ -44,6 +44,8 @@ import contextlib
 import math
 import multiprocessing as mp
 import os
+import socket
+import struct
 import time
 from concurrent.futures import ProcessPoolExecutor
 
@@ -54,7 +56,7 @@ from ipmc_asym.integral.api import moment
 from ipmc_asym.integral.samples import moment_samples
 
 __all__ = ["run_chunks", "imap_chunks", "chunk_slices", "warm_kernels", "worker_setup", "BLAS_ENV", "MIN_CHUNK_SECONDS",
-           "check_scheduler", "worker_env"]
+           "check_scheduler", "worker_env", "probe_scheduler", "PROBE_TIMEOUT"]
 
 #: environment of every worker process: one BLAS/OpenMP thread (the parallelism is the workers)
 BLAS_ENV = {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1",
@@ -64,15 +66,73 @@ MIN_CHUNK_SECONDS = 0.1
 
 
 def check_scheduler(scheduler):
-    """``None``, ``"local"``, ``"tcp://HOST:PORT"`` or a Client; one-line ``ValueError`` otherwise."""
+    """``None``, ``"local"``, ``"tcp://HOST:PORT"`` (answering like a dask peer, :func:`probe_scheduler`)
+    or a Client; one-line ``ValueError`` otherwise."""
     if scheduler is None or scheduler == "local" or hasattr(scheduler, "submit"):
         return scheduler
     if isinstance(scheduler, str) and scheduler.startswith(("tcp://", "tls://")):
         hostport = scheduler.split("://", 1)[1]
         host, _, port = hostport.rpartition(":")
         if host and port.isdigit():
+            # a server that is not dask, or silent: one line now, not a hang or a huge allocation
+            # after the work has started
+            probe_scheduler(scheduler)
             return scheduler
     raise ValueError(f"--scheduler must be local or tcp://HOST:PORT; got {scheduler!r}")
+
+
+#: seconds to connect to a ``tcp://`` scheduler and to receive its first message (its handshake)
+PROBE_TIMEOUT = 5.0
+#: largest first message of a dask peer (its handshake is a few hundred bytes): a larger
+#: length prefix is not dask (e.g. an HTTP reply read as a length would ask for exabytes)
+MAX_HANDSHAKE_BYTES = 1 << 20
+
+
+def probe_scheduler(address: str, timeout: float | None = None) -> None:
+    """Check that ``tcp://HOST:PORT`` answers like a dask peer, within ``timeout`` seconds.
+
+    A dask comm (``distributed.comm.tcp``) starts by sending its handshake: one message whose
+    first 8 bytes are its length (little-endian unsigned 64-bit).  The probe connects, reads
+    those 8 bytes and checks the length is that of a handshake; a server that is not dask, or
+    accepts and stays silent, is refused in one line instead of a huge allocation or a hang.
+    ``tls://`` addresses are checked for a connection only (the handshake is encrypted).
+
+    Raises
+    ------
+    ValueError
+        One line naming ``--scheduler`` and what went wrong.
+    """
+    timeout = PROBE_TIMEOUT if timeout is None else float(timeout)
+    scheme, _, hostport = address.partition("://")
+    host, _, port = hostport.rpartition(":")
+    host = host.strip("[]")
+    try:
+        sock = socket.create_connection((host, int(port)), timeout=timeout)
+    except TimeoutError:
+        raise ValueError(f"--scheduler {address}: no connection within {timeout:g} s") from None
+    except OSError as exc:
+        raise ValueError(f"--scheduler {address}: cannot connect ({exc.strerror or exc.__class__.__name__})") from None
+    with sock:
+        if scheme != "tcp":
+            return
+        head = b""
+        try:
+            while len(head) < 8:
+                got = sock.recv(8 - len(head))
+                if not got:
+                    raise ValueError(f"--scheduler {address}: the server closed the connection without a dask "
+                                     "handshake (not a dask scheduler?)")
+                head += got
+        except TimeoutError:
+            raise ValueError(f"--scheduler {address}: no dask handshake within {timeout:g} s (not a dask "
+                             "scheduler?)") from None
+        except OSError as exc:
+            raise ValueError(f"--scheduler {address}: connection failed ({exc.strerror or exc.__class__.__name__})"
+                             ) from None
+    (n,) = struct.unpack("<Q", head)
+    if not 0 < n <= MAX_HANDSHAKE_BYTES:
+        raise ValueError(f"--scheduler {address}: the server does not speak the dask protocol (its first message "
+                         f"would be {n} bytes; not a dask scheduler)")
 
 
 #: the compiled rungs (``compiled`` in the registry): what workers may call

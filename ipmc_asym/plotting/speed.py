@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 
+from ipmc_asym.base.inputs import read_input_text
 from ipmc_asym.plotting import MODEL_COLOURS, pyplot, savefig
 
 __all__ = ["plot_speed_accuracy", "load_bench", "ERR_FLOOR"]
@@ -21,8 +22,7 @@ ERR_FLOOR = 1e-16
 def load_bench(path) -> dict:
     """A saved ``ipmc-asym bench --json`` result, checked; one-line ``ValueError`` otherwise."""
     try:
-        with open(path, encoding="utf-8") as fh:
-            res = json.load(fh)
+        res = json.loads(read_input_text(path, "--bench"))
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
         raise ValueError(f"--bench {path!r}: cannot read a bench JSON file ({exc.__class__.__name__}: {exc})") from None
     if not isinstance(res, dict) or not isinstance(res.get("results"), list) or "points" not in res:

@@ -50,12 +50,14 @@ Layer rule: stdlib + numpy at import; SciPy's optimiser and statistics deferred.
 from __future__ import annotations
 
 import csv
+import io
 import math
 import os
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from ipmc_asym.base.inputs import read_input_text
 from ipmc_asym.base.quantities import BY_NAME
 from ipmc_asym.base.registry import closed_form_fidelities, fidelity_names
 from ipmc_asym.base.results import Panel, ResultMixin, ResultSpec
@@ -176,10 +178,12 @@ def read_rows(path, max_rows: int | None = MAX_DATA_ROWS) -> list:
     if max_rows is not None and (isinstance(max_rows, bool) or int(max_rows) < 1):
         raise ValueError(f"max_rows must be an integer >= 1 or None; got {max_rows!r}")
     rows = []
+    reader = None
     try:
         # utf-8-sig: a byte-order mark (Excel's "CSV UTF-8") is not part of the first header name
-        with open(p, newline="", encoding="utf-8-sig") as fh:
-            for r in csv.reader(fh):
+        with io.StringIO(read_input_text(p, "data file", "utf-8-sig"), newline="") as fh:
+            reader = csv.reader(fh)
+            for r in reader:
                 if not any(c.strip() for c in r) or r[0].lstrip().startswith("#"):
                     continue
                 rows.append(r)
@@ -187,8 +191,10 @@ def read_rows(path, max_rows: int | None = MAX_DATA_ROWS) -> list:
                 if max_rows is not None and len(rows) > int(max_rows) + 1:
                     raise ValueError(f"{name}: more than {int(max_rows)} data rows (the cap; --max-rows "
                                      f"on the command line)")
-    except (OSError, UnicodeDecodeError, csv.Error) as exc:
-        raise ValueError(f"data file {p!r}: cannot read ({exc.__class__.__name__})") from None
+    except csv.Error as exc:  # e.g. a field above the csv module's limit (131072 characters)
+        raise ValueError(f"data file {p!r} line {reader.line_num if reader else 1}: cannot read ({exc})") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ValueError(f"data file {p!r}: cannot read ({exc.__class__.__name__}: {exc})") from None
     if not rows:
         raise ValueError(f"{name}: empty file (need a header row and data rows)")
     return rows

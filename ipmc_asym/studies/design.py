@@ -63,6 +63,7 @@ else:  # pragma: no cover - Python 3.10
 
 import numpy as np
 
+from ipmc_asym.base.inputs import read_input_text
 from ipmc_asym.base.registry import fidelity_names, model_names
 from ipmc_asym.base.results import Panel, ResultMixin, ResultSpec
 from ipmc_asym.base.units import parse_force, parse_length, parse_quantity, parse_voltage
@@ -282,10 +283,13 @@ def parse_spec(spec: dict, name: str = "design") -> DesignSpec:
 
 
 def load_spec(path) -> dict:
-    """Read a spec file (TOML) into a dict (``ValueError`` on unreadable TOML)."""
+    """Read a spec file (TOML) into a dict (``ValueError`` on an unreadable file or TOML)."""
     try:
-        with open(path, "rb") as f:
-            return tomllib.load(f)
+        text = read_input_text(path, "spec file")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ValueError(f"spec file {os.fspath(path)!r}: cannot read ({exc.__class__.__name__}: {exc})") from None
+    try:
+        return tomllib.loads(text.removeprefix("\ufeff"))
     except tomllib.TOMLDecodeError as exc:
         raise ValueError(f"{path}: not valid TOML ({exc})") from None
 

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ipmc_asym.base.registry import check_choice, model_names
 from ipmc_asym.base.settings import LAW_HOLD_TOL
 from ipmc_asym.integral.api import moment
 from ipmc_asym.studies.fits import local_exponent
@@ -51,6 +52,8 @@ def law_table(model=None):
     >>> {r["model"] for r in rows}, "I" in {r["quantity"] for r in rows}
     ({'constant'}, True)
     """
+    if model is not None:
+        check_choice("model", model, model_names())  # one line naming the choices, not an empty table
     import sympy as sp  # deferred: SymPy (start-up)
     from ipmc_asym_derivations import scaling  # deferred: SymPy (start-up)
 

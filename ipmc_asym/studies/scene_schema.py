@@ -49,6 +49,7 @@ from typing import Callable, Union
 
 import numpy as np
 
+from ipmc_asym.base.inputs import read_input_text
 from ipmc_asym.base.registry import model_names
 from ipmc_asym.base.settings import DEFAULT_SCENE_TOL, MAX_ROWS
 from ipmc_asym.base.units import parse_length, parse_voltage
@@ -129,8 +130,7 @@ def load_scene(path) -> dict:
     """Read a scene TOML file into a dict; ``ValueError`` naming the file if unreadable or not TOML."""
     p = os.fspath(path)
     try:
-        with open(p, "rb") as fh:
-            text = fh.read().decode("utf-8")
+        text = read_input_text(p, "scene file")
     except (OSError, UnicodeDecodeError) as exc:
         raise ValueError(f"scene file {p!r}: cannot read ({exc.__class__.__name__}: {exc})") from None
     try:

@@ -209,12 +209,16 @@ def run_scene(scene) -> dict:
             berr = np.atleast_1d(r.block_error)
             small = berr <= tol
             F = np.where(small, np.atleast_1d(r.F_block_small), np.atleast_1d(r.F_block))
-            if not np.all(np.isfinite(F)):
-                k = int(np.flatnonzero(~np.isfinite(F))[0])
-                raise ValueError(f"blocking_force: no large-displacement blocking force at point {k} "
-                                 f"({res['points'][k]}); the strip bends too far (|kappa L| too large)")
-            vals["blocking_force"] = _fit_vals(F, "F_block")
-            out["blocking_force"] = {"values": F.tolist(), "unit": "N", "fidelity": fl,
+            # no large-displacement root (|kappa L| past the tracked branch): that point's value is
+            # withheld (None), as evaluate and sweep do; the other points and outputs stand
+            F_ok = np.isfinite(F)
+            if not np.all(F_ok):
+                k = int(np.flatnonzero(~F_ok)[0])
+                res["warnings"].append(f"blocking_force withheld (None) at {int((~F_ok).sum())} point(s), first "
+                                       f"{k} ({res['points'][k]}): no large-displacement blocking force, the strip "
+                                       f"bends too far (|kappa L| too large)")
+            vals["blocking_force"] = np.where(F_ok, _fit_vals(F, "F_block"), np.nan)
+            out["blocking_force"] = {"values": _kept(F, F_ok), "unit": "N", "fidelity": fl,
                                      "error_estimate": (err + np.where(small, berr, 0.0)).tolist(),
                                      "beam": ["small" if s else "large" for s in small]}
     if "profiles" in outputs:

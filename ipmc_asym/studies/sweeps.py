@@ -31,6 +31,7 @@ from concurrent.futures import ThreadPoolExecutor
 import numba
 import numpy as np
 
+from ipmc_asym.base import interrupt
 from ipmc_asym.base.progress import progress as progress_bar
 from ipmc_asym.base.registry import model_names
 from ipmc_asym.base.settings import CHUNK_ROWS, MAX_ROWS
@@ -262,7 +263,10 @@ def sweep(vary: dict, model="constant", fidelity="quadrature", base: Strip | Non
     -------
     numpy structured array (dtype :data:`DTYPE`), one row per grid point and model.
     Rows where a check failed keep their inputs and say which check (``check_*``,
-    ``valid``); where no rung is valid, ``I`` and the mechanics are NaN.
+    ``valid``); an output :func:`ipmc_asym.evaluate` gives as None is NaN here (:func:`withhold`:
+    ``I`` and the mechanics where no rung is valid, the tip position ``w``, ``w_small``,
+    ``x_tip``, ``y_tip`` past a full turn, ``F_block`` where its large-displacement branch is not
+    tracked).
     """
     check_fidelity(fidelity)
     tol = check_tol(tol)
@@ -278,7 +282,8 @@ def sweep(vary: dict, model="constant", fidelity="quadrature", base: Strip | Non
         parts = list(iter_sweep(vary, model, fidelity, base, material, tol, escalate=escalate, progress=bar))
     finally:
         bar.close()
-    return np.concatenate(parts) if parts else np.empty(0, DTYPE)
+    # the outputs withheld where evaluate, scene and the CLI withhold them (NaN here, None there)
+    return withhold(np.concatenate(parts), copy=False) if parts else np.empty(0, DTYPE)
 
 
 def withhold(arr: np.ndarray, copy: bool = True) -> np.ndarray:
@@ -400,6 +405,7 @@ def _texts(chunks, kind: str, workers: int):
     if workers <= 1:
         for c in chunks:
             for piece in _pieces(c):
+                interrupt.check()  # between pieces: a signal swallowed in compiled code stops the writer
                 yield _format_chunk_bytes(piece, kind), piece.size
         return
 
@@ -409,6 +415,7 @@ def _texts(chunks, kind: str, workers: int):
             for piece in _pieces(c):
                 pending.append((pool.submit(_format_chunk_bytes, piece, kind), piece.size))
                 while len(pending) > 2 * workers:
+                    interrupt.check()
                     f, k = pending.popleft()
                     yield f.result(), k
         while pending:

@@ -159,6 +159,9 @@ def parse_uncertain(table) -> dict:
                              + (f"; missing {', '.join(missing)}" if missing else "")
                              + (f"; unknown {', '.join(sorted(extra))}" if extra else ""))
         vals = tuple(_quantity(name, k, spec[k]) for k in keys)
+        for k, v in zip(keys, vals):  # a NaN passes every comparison below: refused by name here
+            if not math.isfinite(v):
+                raise ValueError(f"uncertain.{name}.{k} must be a finite number; got {spec[k]!r}")
         positive = name != "voltage"
         if dist == "normal":
             mu, sd = vals

@@ -294,6 +294,21 @@ REFUSALS = [
     ["validate", "--out", "/proc/r.md"], ["validate", "--out", "r.html"], ["derive", "--nope"],
     ["bench", "--points", "0"], ["bench", "--figure", "x.txt"], ["bench", "--layout", "spiral"],
     ["uq", "/nonexistent.toml"], ["scene", "/nonexistent.toml"], ["fit", "/nonexistent.csv", "--free", "modulus"],
+    # unbounded reads: a device is refused before a byte is read (base.inputs)
+    ["scene", "/dev/zero"], ["uq", "/dev/zero"], ["design", "/dev/zero"], ["fit", "/dev/zero", "--free", "modulus"],
+    ["scene", os.path.join(ROOT, "examples", "uq_nominal.toml"), "--max-input-size", "10B"],
+    ["scene", os.path.join(ROOT, "examples", "uq_nominal.toml"), "--max-input-size", "0"],
+    # every output option: format from the extension, refused before the work; '' is no path
+    ["drive", "--waveform", "step:1V", "--duration", "1s", "--out", "d.xlsx"],
+    ["drive", "--waveform", "step:1V", "--duration", "1s", "--out", "d"],
+    ["design", os.path.join(ROOT, "examples", "design_blocking_force.toml"), "--plot", "x.xlsx"],
+    ["step", "--out", "s.nc"], ["freq", "--export", "e.csv"],
+    ["sweep", "--vary", "voltage=1V:2V:3", "--out", ""], ["validate", "--out", ""], ["figures", "--out", ""],
+    ["uq", os.path.join(ROOT, "examples", "uq_nominal.toml"), "--out", ""], ["profiles", "--out", ""],
+    ["sweep", "--vary", "voltage=1V:2V:2000000", "--out", "s.nc"],
+    # messages
+    ["step", "--duration", "1e30"], ["drive", "--waveform", "step:1V", "--duration", "1e30"],
+    ["freq", "--export-tol", "0"], ["drive", "--waveform", "sine:1V@10Hz,nan", "--duration", "1s"],
 ]
 
 
