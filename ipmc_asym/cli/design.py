@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from ipmc_asym.cli import SUMMARIES
-from ipmc_asym.cli.common import add_material_options, print_citations
+from ipmc_asym.cli.common import add_electrode_options, add_material_options, electrode_spec, print_citations
 from ipmc_asym.forward.model import CHECKS
 from ipmc_asym.io.fileio import check_output_path
 from ipmc_asym.io.jsonio import dumps
@@ -21,6 +21,7 @@ def register(sub):
     p.add_argument("--plot", default=None, metavar="F.png",
                    help="the Pareto front of [pareto] (default: tip_deflection vs blocking_force, 200 points)")
     add_material_options(p)
+    add_electrode_options(p)
     p.set_defaults(material=None)
 
 
@@ -41,6 +42,12 @@ def run(args) -> int:
     spec = load_spec(args.spec)
     if args.material is not None:
         spec["material"] = args.material
+    layer = electrode_spec(args)
+    if layer:  # the layers on the spec's (or --material's) set: one Material for the design
+        from ipmc_asym.model.params import material_from_spec
+
+        spec["material"] = material_from_spec({"preset": spec.get("material", "nafion-li"), **layer},
+                                              labels={k: "--" + k.replace("_", "-") for k in layer})
     if args.plot and "pareto" not in spec:  # the plot is the front: force vs deflection by default
         spec["pareto"] = {"x": "tip_deflection", "y": "blocking_force", "points": 200}
     name = args.spec.rsplit("/", 1)[-1].removesuffix(".toml")

@@ -138,6 +138,10 @@ def run(args) -> int:
                    f"columns, so no chi2 goodness of fit)")
         print(f"fit of {source}: {res.n_points} measured values, model {res.model}, fidelity {res.fidelity}, "
               f"{gof}")
+        if material.electrode.present:
+            from ipmc_asym.model.electrode import beam_label
+
+            print(f"beam: {beam_label(material.electrode)} (start values of a freed layer parameter)")
         print(f"{'parameter':16s} {'value':>12s} {'stderr':>10s} {'95% interval (profile)':>28s}  unit")
         for n, p in res.parameters.items():
             unit = FREE_PARAMETERS[n][0]

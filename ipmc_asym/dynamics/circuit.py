@@ -74,6 +74,7 @@ from ipmc_asym.model.params import (
     NAFION_LI,
     Material,
     Strip,
+    bending_stiffness,
     check_finite,
     check_positive,
 )
@@ -790,7 +791,7 @@ def frequency_response(f, *, strip: Strip | None = None, model="constant", mater
     tau = float(time_constant(s.thickness, perm, m))
     # tip deflection per volt, small displacements: w = -M L^2/(2 E I_p),
     # M per volt = A5(1 V) (1 + A3) * (moment transfer), A5(1 V) = 6 l e^2 C_moy F (N m/V)
-    w_per_M = -s.length**2 / (2.0 * m.E * s.I_p)
+    w_per_M = -s.length**2 / (2.0 * float(bending_stiffness(m, s.width, s.thickness)))
     k_w = w_per_M * float(groups.A5(s.width, s.thickness, 1.0, m)) * (1.0 + A3)
     R = float(core_resistance(s.thickness, m))
     C0 = 0.5 * capacitance_scale(perm, m)

@@ -45,7 +45,15 @@ from ipmc_asym.dynamics.line_time import (
 )
 from ipmc_asym.dynamics.waveforms import Waveform, parse_waveform
 from ipmc_asym.forward.model import CHECKS, assumption_warnings, voltage_reason
-from ipmc_asym.model.params import NAFION_LI, SHEET_RESISTANCE_SOURCE, Material, Strip, check_finite, check_positive
+from ipmc_asym.model.params import (
+    NAFION_LI,
+    SHEET_RESISTANCE_SOURCE,
+    Material,
+    Strip,
+    bending_stiffness,
+    check_finite,
+    check_positive,
+)
 from ipmc_asym.model.permittivity import get_model
 
 __all__ = ["DRIVE_COLUMNS", "CHECK_COLUMNS", "LINE_COLUMNS", "CLAMPED_COLUMNS", "MAX_DRIVE_POINTS", "drive_info", "drive_chunks",
@@ -311,7 +319,7 @@ def _line_mechanics(M, x, strip: Strip, material: Material):
     _, wt = line_weights(x.size - 1, L)
     Mt = M @ wt / L
     Mw = M @ (2.0 * (L - x) * wt / L**2)
-    EI = material.E * strip.I_p
+    EI = float(bending_stiffness(material, strip.width, strip.thickness))  # composite with electrode layers
     with np.errstate(all="ignore"):
         bt = solve_beam(Mt, L, EI, e=strip.e, strain_limit=material.strain_limit)
         bw = solve_beam(Mw, L, EI, e=strip.e, strain_limit=material.strain_limit)

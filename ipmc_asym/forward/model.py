@@ -39,8 +39,9 @@ from ipmc_asym.forward.pressure import moment_pressure_escalating
 from ipmc_asym.integral.api import check_fidelity, check_min_thickness, closed_model_id, validity_limit
 from ipmc_asym.integral.samples import moment_samples
 from ipmc_asym.model import groups
+from ipmc_asym.model.electrode import composite_stiffness
 from ipmc_asym.model.limits import slender_ok, slender_warnings
-from ipmc_asym.model.params import NAFION_LI, Material, moment_scale, second_moment
+from ipmc_asym.model.params import NAFION_LI, Material, moment_scale
 from ipmc_asym.model.permittivity import get_model
 
 __all__ = ["forward", "ForwardResult", "CHECKS", "NUMERICAL_CHECKS", "ASSUMPTION_CHECKS", "FLAGS", "MOMENT_KEYS",
@@ -429,7 +430,7 @@ def forward(length, width, thickness, voltage, *, modulus=None, c_moy=None, mate
     L, wd, th, v, E, C = (a.reshape(-1) for a in (L, wd, th, v, E, C))
     k = L.size
     A5 = moment_scale(wd, th, v, material.F, material.C_moy if c_moy is None else C)
-    EI = E * second_moment(wd, th)
+    EI = composite_stiffness(E, wd, th, material.electrode)  # E I_p, or the section with electrode layers
     # I depends on (thickness, voltage) (and C_moy) only: each distinct pair once
     first, inv = (None, None) if pair_code is None else distinct_pairs(np.broadcast_to(pair_code, shape))
 

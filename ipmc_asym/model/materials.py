@@ -69,6 +69,10 @@ def info(material) -> dict:
     d["used"] = {"Z3": m.Z3, "rho3": m.rho3, "phi4": m.phi4, "rho2": m.rho2, "E": m.E, "T": m.T, "F": m.F,
                  "R": m.R, "D": m.D, "C_moy": m.C_moy, "C_moy_formula": m.C_moy_formula,
                  "c_moy_source": m.c_moy if isinstance(m.c_moy, str) else "given"}
+    if m.electrode.present:
+        e = m.electrode
+        d["used"]["electrode"] = {"thickness": e.thickness, "modulus": e.modulus, "density": e.density,
+                                  "metal": e.metal, "source": e.source}
     d["sources"] = list(citations(m))
     return d
 

@@ -52,7 +52,7 @@ from __future__ import annotations
 import csv
 import math
 import os
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -92,9 +92,16 @@ FREE_PARAMETERS = {
     "diffusion": ("m^2/s", (1e-14, 1e-7), "cation diffusion coefficient D"),
     "viscous_modulus": ("Pa s", (1.0, 1e9), "viscous modulus eta_E = E tau_v of the Kelvin-Voigt law (eq. (3))"),
     "sheet_resistance": ("Ohm/sq", (1e-3, 1e4), "sheet resistance R_s of each electrode"),
+    # the metal layers of the composite beam (model.electrode): seen through the stiffness EI
+    "electrode_thickness": ("m", (1e-8, 1e-4), "thickness t_m of each metal electrode layer"),
+    "electrode_modulus": ("Pa", (1e9, 1e12), "Young's modulus E_m of the electrode metal"),
 }
 #: other names a --free item may take (the key) for a name of FREE_PARAMETERS (the value)
-FREE_ALIASES = {"D": "diffusion", "E": "modulus", "R_s": "sheet_resistance", "eta_E": "viscous_modulus"}
+FREE_ALIASES = {"D": "diffusion", "E": "modulus", "R_s": "sheet_resistance", "eta_E": "viscous_modulus",
+                "t_m": "electrode_thickness", "E_m": "electrode_modulus"}
+#: free parameters that deflection and force data see only through the bending stiffness EI
+#: (w = -M_A L^2/(2 EI), F from kappa L = M_A L/EI): at most one of them can be identified
+STIFFNESS_PARAMETERS = ("modulus", "electrode_thickness", "electrode_modulus")
 #: which kinds of data rows see each free parameter (static: deflection/blocking force at rest;
 #: time: a transient t -> current/charge/deflection/force; impedance: a spectrum f -> Z), and
 #: for a parameter no kind present sees, the data that would identify it
@@ -110,7 +117,29 @@ VISIBLE_TO = {
                                         "beam dynamic)"),
     "sheet_resistance": (("impedance",), "an impedance spectrum (f, Z_re, Z_im): the fit's time-domain model has "
                                          "ideal electrodes"),
+    "electrode_thickness": (("static", "time_mech"), "deflection or blocking-force data (static rows or a time "
+                                                     "series): the layers change the beam, not the electrochemistry"),
+    "electrode_modulus": (("static", "time_mech"), "deflection or blocking-force data (static rows or a time "
+                                                   "series): the layers change the beam, not the electrochemistry"),
 }
+
+
+def check_stiffness_free(names, material: Material) -> None:
+    """Refuse (one line) electrode parameters the data cannot identify.
+
+    Deflection and force see ``E_p``, ``t_m`` and ``E_m`` only through the composite ``EI``
+    (:data:`STIFFNESS_PARAMETERS`): at most one of them is free; a layer parameter needs a layer
+    to start from (``--electrode-thickness > 0`` with ``--electrode-metal`` or
+    ``--electrode-modulus``), its start value.
+    """
+    stiff = [k for k in names if k in STIFFNESS_PARAMETERS]
+    if len(stiff) > 1:
+        raise ValueError(f"--free {', '.join(stiff)}: deflection and force data see these only through the bending "
+                         "stiffness EI (one number): free one of them, fix the others")
+    for k in stiff:
+        if k != "modulus" and not material.electrode.present:
+            raise ValueError(f"--free {k}: the strip has no electrode layer to fit; give a starting layer "
+                             "(--electrode-thickness > 0 and --electrode-metal or --electrode-modulus)")
 
 
 def check_visible(names, kinds) -> None:
@@ -361,8 +390,10 @@ _BOUND_UNITS = {
 
 
 def _bound(k, x):
-    if k == "modulus":
+    if k in ("modulus", "electrode_modulus"):
         return parse_pressure(k, x)
+    if k == "electrode_thickness":
+        return parse_length(f"--free {k}", x)
     if k == "diffusion":
         return parse_diffusion(f"--free {k}", x)
     if k == "sheet_resistance":
@@ -394,6 +425,13 @@ def _material(material: Material, values) -> Material:
         kw["D"] = float(values["diffusion"])
     if "sheet_resistance" in values:
         kw["sheet_resistance"] = float(values["sheet_resistance"])
+    el = {}
+    if "electrode_thickness" in values:
+        el["thickness"] = float(values["electrode_thickness"])
+    if "electrode_modulus" in values:
+        el["modulus"] = float(values["electrode_modulus"])
+    if el:
+        kw["electrode"] = replace(material.electrode, **el)
     return material.with_(**kw) if kw else material
 
 
@@ -587,6 +625,10 @@ def _start_values(names, model, material):
             v = material.E
         elif n == "c_moy":
             v = material.C_moy
+        elif n == "electrode_thickness":
+            v = material.electrode.thickness
+        elif n == "electrode_modulus":
+            v = material.electrode.modulus
         else:
             v = getattr(p, n)
             if v <= 0:
@@ -680,6 +722,7 @@ def fit(data: CalibrationData, free, model="constant", material: Material = NAFI
     bounds = parse_free(free)
     names = list(bounds)
     check_visible(names, ("static",))
+    check_stiffness_free(names, material)
     p = len(names)
     n = data.n_points
     check_count(names, n, data.has_sigma)

@@ -492,6 +492,10 @@ class DesignResult:
              "units": {**CONSTRAINABLE}, "thickness_is": "TOTAL 2e", "width_is": "TOTAL 2l"}
         if self.robust is not None:
             d["robust"] = self.robust
+        if m.electrode.present:  # the composite beam (the bare membrane is the paper's)
+            from ipmc_asym.model.electrode import beam_label
+
+            d["beam"] = beam_label(m.electrode)
         return d
 
 
