@@ -57,7 +57,8 @@ def test_material_set_thickness_is_the_default(capsys):
     assert j["inputs"]["thickness_total"] == pytest.approx(183e-6, rel=1e-12)
     assert "nafion-117-h" in j["inputs"]["thickness_source"]
     j = _json(capsys, "--material", "nafion-117-h", "--model", "constant", "--thickness", "200um")
-    assert j["inputs"]["thickness_total"] == 200e-6 and "thickness_source" not in j["inputs"]
+    assert j["inputs"]["thickness_total"] == pytest.approx(200e-6, rel=1e-12)
+    assert "thickness_source" not in j["inputs"]
 
 
 def test_model_spread_spans_models_and_c_moy(capsys):
@@ -74,7 +75,8 @@ def test_model_spread_spans_models_and_c_moy(capsys):
         assert q["numerical_error"] >= max(r["error_estimate"] for r in out["results"])
     # the spread is far wider than the numerical error (issue: 2.32 / 0.77 / 2.00 mN at 2 V)
     q = sp["quantities"]["w_small"]
-    assert q["ratio"] > 1.5 and q["numerical_error"] < 1e-3
+    width = (q["max"] - q["min"]) / max(abs(q["max"]), abs(q["min"]))
+    assert q["ratio"] > 1.2 and width > 1e3 * q["numerical_error"]
     assert main(["estimate"]) == 0
     text = capsys.readouterr().out
     assert "model-form spread over 6 variants" in text and "numerical rel.err" in text
