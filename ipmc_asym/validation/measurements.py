@@ -68,9 +68,9 @@ class Measurement:
 
 
 MEASUREMENTS = (
-    Measurement("tip_deflection", "tip deflection |w|", "Nafion (Li+), L = 2 cm, 2l = 5 mm, 2e = 200 um, 1 V "
+    Measurement("tip_deflection", "tip deflection (magnitude)", "Nafion (Li+), L = 2 cm, 2l = 5 mm, 2e = 200 um, 1 V "
                 "(the paper's nominal strip)", (0.5e-3, 1.5e-3), "m", PAPER),
-    Measurement("blocking_force", "blocking force |F|", "Nafion (Li+), L = 2 cm, 2l = 5 mm, 2e = 200 um, 1 V "
+    Measurement("blocking_force", "blocking force (magnitude)", "Nafion (Li+), L = 2 cm, 2l = 5 mm, 2e = 200 um, 1 V "
                 "(the paper's nominal strip)", (0.6e-3, 1.3e-3), "N", PAPER),
     Measurement("time_constant", "step time constant", "Nafion IPMC, 2e = 200 um, a few cm, a few volts (stated "
                 "as 'about one second')", 1.0, "s", PAPER_INTRO),
