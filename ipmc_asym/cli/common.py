@@ -15,8 +15,9 @@ import sys
 from ipmc_asym.base.settings import MIN_THICKNESS
 from ipmc_asym.base.units import parse_diffusion, parse_length, parse_pressure, parse_quantity, parse_voltage
 from ipmc_asym.integral.api import check_min_thickness
+from ipmc_asym.model.electrode import METALS, beam_label
 from ipmc_asym.model.limits import bare_number_warning, material_warnings, range_warning
-from ipmc_asym.model.params import Strip, material_from_spec
+from ipmc_asym.model.params import Strip, material_from_spec, set_thickness
 
 __all__ = ["UsageError", "Parser", "add_strip_options", "add_material_options", "print_citations", "material_comments",
            "scene_with_material",
@@ -283,8 +284,6 @@ def _electrode_density(text):
 def add_electrode_options(p):
     """The metal electrode layers of the beam (``model.electrode``; default: the material set's,
     none for the paper's bare membrane)."""
-    from ipmc_asym.model.electrode import METALS
-
     p.add_argument("--electrode-thickness", type=arg_type(_electrode_thickness, "electrode-thickness"), default=None,
                    help="thickness t_m of EACH metal electrode layer on the faces (composite beam: stiffness, mass; "
                         "the electrochemistry keeps the membrane thickness), e.g. 5um; default the material set's "
@@ -366,8 +365,6 @@ def electrode_spec(args) -> dict:
 def material_comments(material) -> list:
     """Header comment lines of a result file: the material set, the beam when it carries electrode
     layers (the bare membrane is the paper's beam) and the numbered sources."""
-    from ipmc_asym.model.electrode import beam_label
-
     beam = [f"beam: {beam_label(material.electrode)}"] if material.electrode.present else []
     return [f"material set: {material.name}"] + beam + [f"source [{i}]: {c}"
                                                        for i, c in enumerate(material.sources, 1)]
@@ -392,8 +389,6 @@ DEFAULT_THICKNESS = 200e-6
 def default_thickness(material_name):
     """``(thickness m, note)``: the material set's typical thickness (:func:`params.set_thickness`),
     else :data:`DEFAULT_THICKNESS` with an empty note (the output stays as it was)."""
-    from ipmc_asym.model.params import set_thickness
-
     try:
         got = set_thickness(material_name or "nafion-li")
     except ValueError:  # an unknown set: material_from_args says so, in its own words

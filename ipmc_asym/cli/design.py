@@ -7,6 +7,7 @@ from ipmc_asym.cli.common import add_electrode_options, add_material_options, el
 from ipmc_asym.forward.model import CHECKS
 from ipmc_asym.io.fileio import check_output_path
 from ipmc_asym.io.jsonio import dumps
+from ipmc_asym.model.params import material_from_spec
 from ipmc_asym.studies.design import INPUTS, OUTPUTS, design, load_spec
 
 
@@ -44,8 +45,6 @@ def run(args) -> int:
         spec["material"] = args.material
     layer = electrode_spec(args)
     if layer:  # the layers on the spec's (or --material's) set: one Material for the design
-        from ipmc_asym.model.params import material_from_spec
-
         spec["material"] = material_from_spec({"preset": spec.get("material", "nafion-li"), **layer},
                                               labels={k: "--" + k.replace("_", "-") for k in layer})
     if args.plot and "pareto" not in spec:  # the plot is the front: force vs deflection by default

@@ -24,6 +24,7 @@ from ipmc_asym.cli.freq import _sheet
 from ipmc_asym.dynamics.circuit import BEAM_CHOICES
 from ipmc_asym.io.fileio import FIGURE_FORMATS, check_output_path
 from ipmc_asym.io.jsonio import dumps
+from ipmc_asym.model.electrode import beam_label
 from ipmc_asym.parallel.executors import check_scheduler
 from ipmc_asym.studies.calibrate import FREE_PARAMETERS, MAX_DATA_ROWS, CalibrationData, fit, parse_free
 from ipmc_asym.studies.calibrate_dynamic import TIME_FIDELITIES, fit_dynamic, read_file
@@ -139,8 +140,6 @@ def run(args) -> int:
         print(f"fit of {source}: {res.n_points} measured values, model {res.model}, fidelity {res.fidelity}, "
               f"{gof}")
         if material.electrode.present:
-            from ipmc_asym.model.electrode import beam_label
-
             print(f"beam: {beam_label(material.electrode)} (start values of a freed layer parameter)")
         print(f"{'parameter':16s} {'value':>12s} {'stderr':>10s} {'95% interval (profile)':>28s}  unit")
         for n, p in res.parameters.items():

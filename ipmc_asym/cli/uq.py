@@ -19,6 +19,7 @@ from ipmc_asym.cli.common import (
 from ipmc_asym.io.datasets import uq_dataset, write_netcdf
 from ipmc_asym.io.fileio import FIGURE_FORMATS, check_output_path
 from ipmc_asym.io.jsonio import dumps
+from ipmc_asym.model.electrode import beam_label
 from ipmc_asym.parallel.executors import check_scheduler
 from ipmc_asym.studies.uq import SOBOL_BATCHES, STORE_SAMPLES, run_uq
 
@@ -104,8 +105,6 @@ def run(args) -> int:
     print(f"uq of scene {res.scene!r} [{res.model}]: {res.n_samples} runs (N = {res.base_n}), {res.seconds:.3g} s; "
           f"fidelity per sample: {fid}; thickness is the TOTAL thickness 2e")
     if res.material is not None and res.material.electrode.present:
-        from ipmc_asym.model.electrode import beam_label
-
         print(f"beam: {beam_label(res.material.electrode)}")
     print(f"{'output':15s} {'unit':5s} {'mean':>11s} {'sd':>10s} {'2.5%':>11s} {'50%':>11s} {'97.5%':>11s}")
     for o, s in res.summary.items():

@@ -49,7 +49,11 @@ JSON_KEYS = ("claim", "section", "paper", "ours", "verdict", "key", "criterion",
 
 def _measurements(args) -> int:
     """``validate --measurements``: the comparison table (text, JSON or Markdown)."""
-    from ipmc_asym.validation.measurements import compare, cross_prediction, to_markdown
+    from ipmc_asym.validation.measurements import (  # deferred: only --measurements needs the forward model
+        compare,
+        cross_prediction,
+        to_markdown,
+    )
 
     rows, cross = compare(), cross_prediction()
     if args.out:

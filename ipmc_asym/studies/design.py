@@ -67,6 +67,7 @@ from ipmc_asym.base.registry import fidelity_names, model_names
 from ipmc_asym.base.units import parse_force, parse_length, parse_quantity, parse_voltage
 from ipmc_asym.beam.dynamics import first_resonance
 from ipmc_asym.forward.model import CHECKS, forward
+from ipmc_asym.model.electrode import beam_label
 from ipmc_asym.model.materials import citations
 from ipmc_asym.model.params import NOMINAL_STRIP, Material, check_positive, named_material
 from ipmc_asym.studies.uq import _transform, parse_uncertain
@@ -493,8 +494,6 @@ class DesignResult:
         if self.robust is not None:
             d["robust"] = self.robust
         if m.electrode.present:  # the composite beam (the bare membrane is the paper's)
-            from ipmc_asym.model.electrode import beam_label
-
             d["beam"] = beam_label(m.electrode)
         return d
 
