@@ -26,7 +26,8 @@ from ipmc_asym.model.groups import pressure_beta
 from ipmc_asym.model.params import _PAPER_SETS, NAFION_LI, Material, Strip, debye_length
 from ipmc_asym.model.permittivity import MODELS, get_model
 
-__all__ = ["evaluate", "estimate_rows", "model_spread", "SPREAD_KEYS", "RESULT_KEYS", "CHECKS", "moment_escalating", "Escalated",
+__all__ = ["evaluate", "estimate_rows", "model_spread", "spread_of", "spread_variants", "SPREAD_KEYS",
+           "RESULT_KEYS", "CHECKS", "moment_escalating", "Escalated",
            "check_tol", "FREE_STRIP_KEYS", "MECHANICAL_KEYS"]
 
 RESULT_KEYS = ("model", "fidelity", "fidelity_used", "escalated", "C_moy", "A0", "A1", "A2", "A3", "A5",
@@ -168,14 +169,27 @@ SPREAD_NOTE = (
     "the numerical error (docs/measurements.md compares the predictions with published measurements)")
 
 
-def _spread_variants(material: Material):
-    """``[(label, material)]``: the C_moy forms to span (paper and formula for the paper's sets)."""
+def spread_variants(material: Material):
+    """``[(label, material)]``: the C_moy forms to span (paper and formula for the paper's sets,
+    and a given value; ``label`` None for another set: its own C_moy only)."""
     if material.name in _PAPER_SETS:
         out = [("paper", material.with_(c_moy="paper")), ("formula", material.with_(c_moy="formula"))]
         if material.c_moy not in ("paper", "formula"):  # a given value: spanned too
             out.append((f"{material.C_moy:g}", material))
         return out
     return [(None, material)]
+
+
+def spread_of(values: dict, numerical_error=None) -> dict:
+    """``{"min", "max", "ratio", "values", "numerical_error"}`` of ``values`` (label -> number or
+    None); ``ratio`` = max|y|/min|y| (None when the sign changes or a value is 0)."""
+    got = [v for v in values.values() if v is not None]
+    lo, hi = (min(got), max(got)) if got else (None, None)
+    ratio = None
+    if got and (lo > 0 or hi < 0):
+        a = [abs(v) for v in got]
+        ratio = max(a) / min(a)
+    return {"min": lo, "max": hi, "ratio": ratio, "values": dict(values), "numerical_error": numerical_error}
 
 
 def model_spread(strip: Strip, material: Material = NAFION_LI, fidelity="quadrature", tol=None, rows=None, *,
@@ -201,7 +215,7 @@ def model_spread(strip: Strip, material: Material = NAFION_LI, fidelity="quadrat
         rung) are None and left out of min/max.
     """
     done = {r["model"]: r for r in rows or ()}
-    variants = _spread_variants(material)
+    variants = spread_variants(material)
     out_rows = {}
     for cm, mat in variants:
         for m in MODELS:
@@ -210,18 +224,9 @@ def model_spread(strip: Strip, material: Material = NAFION_LI, fidelity="quadrat
                 r = evaluate(strip, m, fidelity, mat, tol, escalate=escalate, on_invalid="nan",
                              pressure_term=pressure_term)
             out_rows[m if cm is None else f"{m}/{cm}"] = r
-    q = {}
     err = [r["error_estimate"] for r in out_rows.values() if r["error_estimate"] is not None]
-    for k in SPREAD_KEYS:
-        vals = {lab: r.get(k) for lab, r in out_rows.items()}
-        got = [v for v in vals.values() if v is not None]
-        lo, hi = (min(got), max(got)) if got else (None, None)
-        ratio = None
-        if got and (lo > 0 or hi < 0):
-            a = [abs(v) for v in got]
-            ratio = max(a) / min(a)
-        q[k] = {"min": lo, "max": hi, "ratio": ratio, "values": vals,
-                "numerical_error": max(err) if err else None}
+    q = {k: spread_of({lab: r.get(k) for lab, r in out_rows.items()}, max(err) if err else None)
+         for k in SPREAD_KEYS}
     over = ["permittivity model: " + ", ".join(MODELS)]
     if len(variants) > 1:
         over.append("C_moy: paper (the stated 3082 mol/m^3) and formula (eq. (17) from the set's data)")

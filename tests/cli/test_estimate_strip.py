@@ -86,3 +86,15 @@ def test_model_spread_other_set_spans_models_only(capsys):
     out = _json(capsys, "--material", "nafion-117-h", "--model", "linear")
     assert out["model_spread"]["variants"] == ["constant", "linear", "affine"]
     assert out["model_spread"]["quantities"]["w"]["values"]["linear"] == out["results"][0]["w"]
+
+
+def test_charge_spread_spans_the_rows(capsys):
+    assert main(["charge", "--json", "--model", "affine"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    sp = out["model_spread"]
+    assert len(sp["variants"]) == 6
+    row = out["results"][0]
+    for k in ("sigma", "Q", "C_diff", "eps_app"):
+        q = sp["quantities"][k]
+        assert q["values"]["affine/paper"] == row[k]
+        assert q["min"] <= row[k] <= q["max"]
