@@ -97,8 +97,8 @@ def _mechanics(material: Material):
 
 def diffusion_from_conductivity(kappa, material: Material) -> float:
     """``D = kappa R T/(phi4 F^2 C_moy)`` (m^2/s): the core conductivity of the model inverted."""
-    m = material
-    return float(kappa) * m.R * m.T / (m.phi4 * m.F**2 * m.C_moy)
+    # kappa is linear in D (groups.kappa, the one place the formula lives): scale the material's D
+    return float(kappa) * material.D / float(groups.kappa(material))
 
 
 def compare() -> list[dict]:
