@@ -59,7 +59,8 @@ import numpy as np
 from numpy.polynomial import Polynomial as P
 
 from ipmc_asym.kernels.jit import jit
-from ipmc_asym.model.params import Material, check_positive, second_moment
+from ipmc_asym.model.electrode import composite_mass, membrane_share
+from ipmc_asym.model.params import Material, bending_stiffness, check_positive
 
 __all__ = ["SUPPORTS", "DEFAULT_MODES", "VISCOUS_MODULUS_SOURCE", "Beam", "Modes", "hydrated_density",
            "characteristic", "eigenvalues", "first_resonance", "mode_shape", "modes", "natural_frequencies", "transfer",
@@ -92,8 +93,8 @@ class Beam:
     Attributes
     ----------
     length : float        L, m
-    EI : float            bending stiffness E I_p, N m^2
-    rhoA : float          mass per length rho 2l 2e, kg/m
+    EI : float            bending stiffness E I_p, N m^2 (the composite section with electrode layers)
+    rhoA : float          mass per length rho 2l 2e (+ 2 rho_m 2l t_m with layers), kg/m
     tau_v : float         Kelvin-Voigt time eta_E/E, s (>= 0)
     electrode : tuple     covered part [x1, x2] of the length, m (default the whole strip)
     """
@@ -121,9 +122,15 @@ class Beam:
         eta = float(viscous_modulus)
         if not (math.isfinite(eta) and eta >= 0.0):
             raise ValueError(f"viscous modulus must be a finite number >= 0 Pa s; got {viscous_modulus!r}")
-        EI = material.E * float(second_moment(width, thickness))
-        rhoA = hydrated_density(material) * float(width) * float(thickness)
-        return cls(float(length), EI, rhoA, eta / material.E, electrode)
+        # the composite section with metal layers (material.electrode): stiffness and mass of the
+        # three layers; the viscosity acts on the membrane's share E_p I_p of the stiffness only
+        el = material.electrode
+        EI = float(bending_stiffness(material, float(width), float(thickness)))
+        rhoA = float(composite_mass(hydrated_density(material), float(width), float(thickness), el))
+        tau_v = eta / material.E
+        if el.present:
+            tau_v = tau_v * float(membrane_share(material.E, float(width), float(thickness), el))
+        return cls(float(length), EI, rhoA, tau_v, electrode)
 
     @property
     def omega_scale(self) -> float:
@@ -291,8 +298,8 @@ def first_resonance(length, width, thickness, material: Material, support="clamp
     thickness, m): ``f1 = b1^2 sqrt(E I_p/(rho A L^4))/(2 pi)``, ``b1 = 1.8751`` for a free tip
     (:func:`eigenvalues`), the same as :func:`natural_frequencies` of :meth:`Beam.from_strip`."""
     L = np.asarray(length, dtype=float)
-    EI = material.E * second_moment(width, thickness)
-    rhoA = hydrated_density(material) * np.asarray(width, dtype=float) * np.asarray(thickness, dtype=float)
+    EI = bending_stiffness(material, width, thickness)
+    rhoA = composite_mass(hydrated_density(material), width, thickness, material.electrode)
     return float(eigenvalues(support, 1)[0]) ** 2 * np.sqrt(EI / (rhoA * L**4)) / (2.0 * math.pi)
 
 

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import math
 import os
 import re
 import sys
@@ -24,8 +25,9 @@ from ipmc_asym.base.units import (
 )
 from ipmc_asym.integral.api import check_min_thickness
 from ipmc_asym.io.fileio import check_output_path
+from ipmc_asym.model.electrode import METALS, beam_label
 from ipmc_asym.model.limits import bare_number_warning, material_warnings, range_warning
-from ipmc_asym.model.params import Strip, material_from_spec
+from ipmc_asym.model.params import Strip, material_from_spec, set_thickness
 
 __all__ = ["UsageError", "Parser", "add_strip_options", "add_material_options", "print_citations", "material_comments",
            "scene_with_material",
@@ -278,8 +280,9 @@ def add_strip_options(p, *, voltage=True, mechanics=True):
     the command reports beam outputs (``--strain-limit``)."""
     p.add_argument("--length", type=length_type("length"), default=0.02, help="strip length L (default 2cm)")
     p.add_argument("--width", type=length_type("width"), default=5e-3, help="TOTAL width 2l (default 5mm)")
-    p.add_argument("--thickness", type=length_type("thickness"), default=200e-6,
-                   help="TOTAL thickness 2e (default 200um)")
+    p.add_argument("--thickness", type=length_type("thickness"), default=None,
+                   help="TOTAL membrane thickness 2e (default: the material set's typical thickness, e.g. 183um for "
+                        "nafion-117-h, said in the output; 200um for nafion-li)")
     if voltage:
         p.add_argument("--voltage", type=voltage_type(), default=1.0,
                        help="voltage phi0 (default 1V; sign = direction)")
@@ -288,6 +291,7 @@ def add_strip_options(p, *, voltage=True, mechanics=True):
     p.add_argument("--c-moy", default=None,
                    help="mean cation concentration C_moy: paper (3082), formula (~3162) or a value in mol/m^3 "
                         "(default: the material set's, paper for nafion-li)")
+    add_electrode_options(p)
     add_material_options(p)
     if not mechanics:
         return
@@ -295,6 +299,37 @@ def add_strip_options(p, *, voltage=True, mechanics=True):
                    help="face strain e|kappa| up to which the small-strain beam model is assumed (a model assumption: "
                         "rows above it are kept and flagged), e.g. 0.02 or 2%%; default the material's (1%%, "
                         "settings.STRAIN_LIMIT)")
+
+
+def _electrode_thickness(text):
+    v = parse_length("--electrode-thickness", text)
+    if not (math.isfinite(v) and v >= 0.0):
+        raise ValueError(f"--electrode-thickness must be a length >= 0 (each layer), e.g. 5um or 0; got {text!r}")
+    return v
+
+
+def _electrode_density(text):
+    v = parse_quantity("--electrode-density", text, {"kg/m^3": 1.0, "kg/m3": 1.0, "g/cm^3": 1e3, "g/cm3": 1e3},
+                       "density")
+    if not (math.isfinite(v) and v >= 0.0):
+        raise ValueError(f"--electrode-density must be a density >= 0, e.g. 21450kg/m3 or 21.45g/cm3; got {text!r}")
+    return v
+
+
+def add_electrode_options(p):
+    """The metal electrode layers of the beam (``model.electrode``; default: the material set's,
+    none for the paper's bare membrane)."""
+    p.add_argument("--electrode-thickness", type=arg_type(_electrode_thickness, "electrode-thickness"), default=None,
+                   help="thickness t_m of EACH metal electrode layer on the faces (composite beam: stiffness, mass; "
+                        "the electrochemistry keeps the membrane thickness), e.g. 5um; default the material set's "
+                        "(none: the paper's bare membrane); 0 = no layer")
+    p.add_argument("--electrode-metal", default=None, choices=sorted(METALS),
+                   help="metal of the layers: its handbook modulus and density with their source (ipmc_asym/model/"
+                        "electrode.py METALS)")
+    p.add_argument("--electrode-modulus", type=pressure_type("electrode-modulus"), default=None,
+                   help="Young's modulus E_m of the layers (overrides the metal's), e.g. 171GPa")
+    p.add_argument("--electrode-density", type=arg_type(_electrode_density, "electrode-density"), default=None,
+                   help="density of the layers (overrides the metal's; dynamics only), e.g. 21450kg/m3")
 
 
 def add_material_options(p):
@@ -325,6 +360,9 @@ def material_from_args(args):
         spec["c_moy"] = args.c_moy
     if getattr(args, "strain_limit", None) is not None:
         spec["strain_limit"] = args.strain_limit
+    for k in ("electrode_thickness", "electrode_metal", "electrode_modulus", "electrode_density"):
+        if getattr(args, k, None) is not None:
+            spec[k] = getattr(args, k)
     material = material_from_spec(spec, labels=_MATERIAL_OPTIONS)
     for line in material_warnings(material):
         warn(line)
@@ -336,18 +374,35 @@ def material_from_args(args):
 def scene_with_material(path, args):
     """A scene file as a dict whose ``[material]`` table is ``--material`` alone when given (the
     scene's own material keys were written for its material); the path itself without it."""
-    if getattr(args, "material", None) is None:
+    layer = electrode_spec(args)
+    if getattr(args, "material", None) is None and not layer:
         return path
     from ipmc_asym.studies.scene_schema import load_scene  # deferred: only --material on a scene file needs it
 
     scene = load_scene(path)
-    scene["material"] = {"preset": args.material}
+    if getattr(args, "material", None) is not None:
+        scene["material"] = {"preset": args.material}
+    if layer:  # the layer options on top of the scene's (or --material's) material table
+        table = dict(scene.get("material") or {})
+        for k in ("electrode_thickness", "electrode_metal", "electrode_modulus", "electrode_density"):
+            table.pop(k, None)
+        table.update(layer)
+        scene["material"] = table
     return scene
 
 
+def electrode_spec(args) -> dict:
+    """The electrode options given (``electrode_thickness`` ... -> value), for a material table."""
+    return {k: getattr(args, k) for k in ("electrode_thickness", "electrode_metal", "electrode_modulus",
+                                          "electrode_density") if getattr(args, k, None) is not None}
+
+
 def material_comments(material) -> list:
-    """Header comment lines of a result file: the material set and its numbered sources."""
-    return [f"material set: {material.name}"] + [f"source [{i}]: {c}" for i, c in enumerate(material.sources, 1)]
+    """Header comment lines of a result file: the material set, the beam when it carries electrode
+    layers (the bare membrane is the paper's beam) and the numbered sources."""
+    beam = [f"beam: {beam_label(material.electrode)}"] if material.electrode.present else []
+    return [f"material set: {material.name}"] + beam + [f"source [{i}]: {c}"
+                                                       for i, c in enumerate(material.sources, 1)]
 
 
 def print_citations(material, json_mode=False):
@@ -357,12 +412,30 @@ def print_citations(material, json_mode=False):
     (sys.stderr if json_mode else sys.stdout).write(bibliography(material) + "\n")
 
 
-_MATERIAL_OPTIONS = {"preset": "--material", "E": "--modulus", "c_moy": "--c-moy", "strain_limit": "--strain-limit"}
+_MATERIAL_OPTIONS = {"preset": "--material", "E": "--modulus", "c_moy": "--c-moy", "strain_limit": "--strain-limit",
+                     "electrode_thickness": "--electrode-thickness", "electrode_metal": "--electrode-metal",
+                     "electrode_modulus": "--electrode-modulus", "electrode_density": "--electrode-density"}
+
+
+#: the strip's thickness when neither --thickness nor the material set gives one (m)
+DEFAULT_THICKNESS = 200e-6
+
+
+def default_thickness(material_name):
+    """``(thickness m, note)``: the material set's typical thickness (:func:`params.set_thickness`),
+    else :data:`DEFAULT_THICKNESS` with an empty note (the output stays as it was)."""
+    try:
+        got = set_thickness(material_name or "nafion-li")
+    except ValueError:  # an unknown set: material_from_args says so, in its own words
+        got = None
+    return got if got is not None else (DEFAULT_THICKNESS, "")
 
 
 def strip_from_args(args):
     """The strip of the options; a thickness below ``settings.MIN_THICKNESS`` is refused here, the
     one check every command with strip options shares (integral.api.check_min_thickness)."""
+    if getattr(args, "thickness", None) is None:
+        args.thickness, args.thickness_note = default_thickness(getattr(args, "material", None))
     check_min_thickness(args.thickness)
     return Strip(length=args.length, width=args.width, thickness=args.thickness,
                  voltage=getattr(args, "voltage", 1.0))

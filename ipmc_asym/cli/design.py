@@ -3,10 +3,11 @@
 from __future__ import annotations
 
 from ipmc_asym.cli import SUMMARIES
-from ipmc_asym.cli.common import add_material_options, add_output_option, print_citations
+from ipmc_asym.cli.common import add_electrode_options, add_material_options, add_output_option, electrode_spec, print_citations
 from ipmc_asym.forward.model import CHECKS
 from ipmc_asym.io.fileio import FIGURE_FORMATS, check_output_path
 from ipmc_asym.io.jsonio import dumps
+from ipmc_asym.model.params import material_from_spec
 from ipmc_asym.studies.design import INPUTS, OUTPUTS, design, load_spec
 
 
@@ -21,6 +22,7 @@ def register(sub):
     add_output_option(p, "--plot", formats=FIGURE_FORMATS, default=None, metavar="F.png",
                    help="the Pareto front of [pareto] (default: tip_deflection vs blocking_force, 200 points)")
     add_material_options(p)
+    add_electrode_options(p)
     p.set_defaults(material=None)
 
 
@@ -41,6 +43,10 @@ def run(args) -> int:
     spec = load_spec(args.spec)
     if args.material is not None:
         spec["material"] = args.material
+    layer = electrode_spec(args)
+    if layer:  # the layers on the spec's (or --material's) set: one Material for the design
+        spec["material"] = material_from_spec({"preset": spec.get("material", "nafion-li"), **layer},
+                                              labels={k: "--" + k.replace("_", "-") for k in layer})
     if args.plot and "pareto" not in spec:  # the plot is the front: force vs deflection by default
         spec["pareto"] = {"x": "tip_deflection", "y": "blocking_force", "points": 200}
     name = args.spec.rsplit("/", 1)[-1].removesuffix(".toml")

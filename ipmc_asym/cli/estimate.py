@@ -14,9 +14,11 @@ from ipmc_asym.cli.common import (
     strip_from_args,
     tol_type,
 )
-from ipmc_asym.forward.estimate import estimate_rows, model_list
+from ipmc_asym.forward.estimate import SPREAD_NOTE, estimate_rows, model_list, model_spread
 from ipmc_asym.integral.api import interpret_small
 from ipmc_asym.io.jsonio import dumps
+from ipmc_asym.model.electrode import beam_label
+from ipmc_asym.model.params import bending_stiffness
 
 
 def register(sub):
@@ -61,14 +63,27 @@ def run(args):
         "modulus": material.E, "c_moy": material.C_moy, "c_moy_source": str(material.c_moy),
         "I_p": strip.I_p, "material": material.name, "material_sources": list(material.sources),
         "pressure_term": bool(args.pressure_term),
+        "beam": beam_label(material.electrode),
+        "electrode_thickness": material.electrode.thickness,
+        "electrode_modulus": material.electrode.modulus if material.electrode.present else None,
+        "bending_stiffness": float(bending_stiffness(material, strip.width, strip.thickness)),
     }
+    note = getattr(args, "thickness_note", "")
+    if note:
+        inputs["thickness_source"] = note
+    spread = model_spread(strip, material, args.fidelity, args.tol, rows, escalate=not args.no_escalate,
+                          pressure_term=args.pressure_term)
     if args.json:
-        print(dumps({"inputs": inputs, "results": rows}, indent=2))
+        print(dumps({"inputs": inputs, "results": rows, "model_spread": spread}, indent=2))
         return 0
     print(f"IPMC strip: L = {fmt_length(strip.length)}, total width 2l = {fmt_length(strip.width)}, "
           f"total thickness 2e = {fmt_length(strip.thickness)} (half thickness e = {fmt_length(strip.e)}), "
           f"phi0 = {fmt_num(strip.voltage)} V, E = {material.E:.3g} Pa, C_moy = {c_moy_label(material)}")
     print(f"material set {material.name} ({len(material.sources)} sources: --cite, ipmc-asym materials)")
+    if note:
+        print(note)
+    print(f"beam: {beam_label(material.electrode)}, EI = "
+          f"{float(bending_stiffness(material, strip.width, strip.thickness)):.4g} N m^2")
     hdr = (f"{'model':9s} {'fidelity':10s} {'I':>11s} {'M_A [N m]':>11s} {'theta [rad]':>11s} "
            f"{'w [mm]':>9s} {'w_small[mm]':>11s} {'F_block[mN]':>11s} {'F_small[mN]':>11s} {'rel.err':>8s} regime")
     print(hdr)
@@ -85,6 +100,7 @@ def run(args):
               f"{r['regime']}")
     if any(r["escalated"] for r in rows):
         print("* escalated: the requested fidelity is not valid here; the first valid rung was used")
+    _print_spread(spread)
     for r in rows:
         for w in r["warnings"]:
             print(f"warning [{r['model']}]: {w}")
@@ -94,3 +110,20 @@ def run(args):
             print(f"not valid [{r['model']}]: failed check(s) {failed} (model assumptions: numbers kept, flagged); "
                   f"withheld (n/a): {held}")
     return 0
+
+
+def _print_spread(spread):
+    """The model-form spread beside the numerical error: one line per output."""
+    q = spread["quantities"]
+    print(f"model-form spread over {len(spread['variants'])} variants ({'; '.join(spread['over'])}):")
+    units = {"M_A": ("N m", 1.0), "theta": ("rad", 1.0), "w": ("mm", 1e3), "w_small": ("mm", 1e3),
+             "F_block": ("mN", 1e3), "F_block_small": ("mN", 1e3)}
+    for k, (u, f) in units.items():
+        d = q[k]
+        if d["min"] is None:
+            print(f"  {k:14s} n/a")
+            continue
+        ratio = "" if d["ratio"] is None else f" (x{d['ratio']:.3g})"
+        print(f"  {k + ' [' + u + ']':18s} {fmt_num(d['min'] * f, '.4g'):>10s} .. {fmt_num(d['max'] * f, '.4g'):<10s}"
+              f"{ratio}   numerical rel.err <= {fmt_num(d['numerical_error'], '.1e')}")
+    print("  note: " + SPREAD_NOTE)

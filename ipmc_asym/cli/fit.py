@@ -26,6 +26,7 @@ from ipmc_asym.cli.common import (
 from ipmc_asym.dynamics.circuit import BEAM_CHOICES
 from ipmc_asym.io.fileio import FIGURE_FORMATS, check_output_path
 from ipmc_asym.io.jsonio import dumps
+from ipmc_asym.model.electrode import beam_label
 from ipmc_asym.parallel.executors import check_scheduler
 from ipmc_asym.studies.calibrate import FREE_ALIASES, FREE_PARAMETERS, MAX_DATA_ROWS, CalibrationData, fit, parse_free
 from ipmc_asym.studies.calibrate_dynamic import TIME_FIDELITIES, fit_dynamic, read_file
@@ -141,6 +142,8 @@ def run(args) -> int:
                    f"columns, so no chi2 goodness of fit)")
         print(f"fit of {source}: {res.n_points} measured values, model {res.model}, fidelity {res.fidelity}, "
               f"{gof}")
+        if material.electrode.present:
+            print(f"beam: {beam_label(material.electrode)} (start values of a freed layer parameter)")
         print(f"{'parameter':16s} {'value':>12s} {'stderr':>10s} {'95% interval (profile)':>28s}  unit")
         for n, p in res.parameters.items():
             unit = FREE_PARAMETERS[n][0]

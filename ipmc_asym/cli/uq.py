@@ -7,6 +7,7 @@ import sys
 from ipmc_asym.base.registry import compiled_fidelities
 from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import (
+    add_electrode_options,
     add_material_options,
     add_output_option,
     add_size_option,
@@ -19,6 +20,7 @@ from ipmc_asym.cli.common import (
 from ipmc_asym.io.datasets import uq_dataset, write_netcdf
 from ipmc_asym.io.fileio import FIGURE_FORMATS, check_output_path
 from ipmc_asym.io.jsonio import dumps
+from ipmc_asym.model.electrode import beam_label
 from ipmc_asym.parallel.executors import check_scheduler
 from ipmc_asym.studies.uq import SOBOL_BATCHES, STORE_SAMPLES, run_uq
 
@@ -59,6 +61,7 @@ def register(sub):
                         "and left out (their check_* variables are in the NetCDF either way)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     add_material_options(p)
+    add_electrode_options(p)
     p.set_defaults(material=None)  # default: the scene's [material]
 
 
@@ -102,6 +105,8 @@ def run(args) -> int:
     fid = ", ".join(f"{k}: {v}" for k, v in res.fidelity.items() if v)
     print(f"uq of scene {res.scene!r} [{res.model}]: {res.n_samples} runs (N = {res.base_n}), {res.seconds:.3g} s; "
           f"fidelity per sample: {fid}; thickness is the TOTAL thickness 2e")
+    if res.material is not None and res.material.electrode.present:
+        print(f"beam: {beam_label(res.material.electrode)}")
     print(f"{'output':15s} {'unit':5s} {'mean':>11s} {'sd':>10s} {'2.5%':>11s} {'50%':>11s} {'97.5%':>11s}")
     for o, s in res.summary.items():
         print(f"{o:15s} {s['unit']:5s} {s['mean']:11.5g} {s['sd']:10.3g} {s['q2.5']:11.5g} {s['q50']:11.5g} "

@@ -14,12 +14,18 @@ def register(sub):
     p = sub.add_parser("validate", help=SUMMARIES["validate"])
     p.add_argument("--json", action="store_true", help='print {"claims": [...]}')
     add_output_option(p, "--out", formats=(".md",), default=None, metavar="F.md", help="write a Markdown report to this file (.md)")
+    p.add_argument("--measurements", action="store_true",
+                   help="instead of the paper's claims: the model against published measurements (deflection, "
+                        "blocking force, time constant, conductivity; bare membrane and platinum layers), with "
+                        "the source, the measured value, the model's and the ratio (docs/measurements.md)")
 
 
 def run(args) -> int:
     """Run ``ipmc-asym validate``."""
     if args.out:
         check_output_path(args.out, "file", formats=(".md",))
+    if args.measurements:
+        return _measurements(args)
     rows = claims()
     if args.out:
         with atomic_write(args.out) as fh:
@@ -40,3 +46,28 @@ def run(args) -> int:
 
 #: the keys of a JSON claim row
 JSON_KEYS = ("claim", "section", "paper", "ours", "verdict", "key", "criterion", "reason", "value", "alternatives")
+
+
+def _measurements(args) -> int:
+    """``validate --measurements``: the comparison table (text, JSON or Markdown)."""
+    from ipmc_asym.validation.measurements import (  # deferred: only --measurements needs the forward model
+        compare,
+        cross_prediction,
+        to_markdown,
+    )
+
+    rows, cross = compare(), cross_prediction()
+    if args.out:
+        with atomic_write(args.out) as fh:
+            fh.write(to_markdown(rows, cross))
+    if args.json:
+        print(dumps({"measurements": rows, "cross_prediction": cross}, indent=2))
+        return 0
+    for r in rows:
+        meas = r["measured"]
+        ms = f"{meas[0]:.3g} to {meas[1]:.3g}" if isinstance(meas, list) else f"{meas:.3g}"
+        print(f"{r['quantity']} [{r['strip']}]\n    measured: {ms} {r['unit']}  ({r['source']})\n    model, "
+              f"{r['beam']}: " + ", ".join(f"{m} {v:.3g} (ratio {r['ratio'][m]:.3g})" for m, v in r["model"].items()))
+    print(f"calibrated on the measured conductivity: D = {cross['D']:.3g} m^2/s -> time constant "
+          + ", ".join(f"{m} {v:.3g} s" for m, v in cross["model"].items()) + f" against ~1 s ({cross['note']})")
+    return 0

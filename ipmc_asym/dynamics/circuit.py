@@ -68,11 +68,13 @@ from ipmc_asym.kernels import _generated_charge as GC
 from ipmc_asym.kernels.charge import GL_W, GL_X
 from ipmc_asym.kernels.charge_time import integrate_circuit
 from ipmc_asym.model import groups
+from ipmc_asym.model.electrode import beam_label
 from ipmc_asym.model.params import (
     D_CATION_SOURCE,
     NAFION_LI,
     Material,
     Strip,
+    bending_stiffness,
     check_finite,
     check_positive,
 )
@@ -98,13 +100,16 @@ DYNAMIC_NOTES = (
 BEAM_CHOICES = ("quasi-static", "dynamic")
 
 
-def dynamic_notes(beam="quasi-static", viscous_modulus=0.0):
-    """The notes every dynamic output carries (water transport out of scope, beam model, D source)."""
+def dynamic_notes(beam="quasi-static", viscous_modulus=0.0, material: Material | None = None):
+    """The notes every dynamic output carries (water transport out of scope, beam model, D source;
+    the composite section when ``material`` carries electrode layers)."""
     check_choice("beam", beam, BEAM_CHOICES)
     notes = list(DYNAMIC_NOTES)
     if beam == "dynamic":
         notes[1] = INERTIA_NOTE + f"; viscous modulus {float(viscous_modulus):g} Pa s"
         notes.append(VISCOUS_MODULUS_SOURCE)
+    if material is not None and material.electrode.present:
+        notes.append("beam: " + beam_label(material.electrode))
     return notes
 
 
@@ -479,7 +484,7 @@ def step_response(voltage=1.0, duration=None, *, strip: Strip | None = None, mod
     tau = float(time_constant(s.thickness, perm, m))
     tgrid = _time_grid(5.0 * tau if duration is None and t is None else duration, t, points)
     R = float(core_resistance(s.thickness, m))
-    notes = dynamic_notes(beam, viscous_modulus)
+    notes = dynamic_notes(beam, viscous_modulus, m)
     extra = {}
     dyn = BeamDynamics(s, m, viscous_modulus, n_modes) if beam == "dynamic" else None
     tout = tgrid
@@ -752,7 +757,7 @@ def frequency_response(f, *, strip: Strip | None = None, model="constant", mater
     tau = float(time_constant(s.thickness, perm, m))
     # tip deflection per volt, small displacements: w = -M L^2/(2 E I_p),
     # M per volt = A5(1 V) (1 + A3) * (moment transfer), A5(1 V) = 6 l e^2 C_moy F (N m/V)
-    w_per_M = -s.length**2 / (2.0 * m.E * s.I_p)
+    w_per_M = -s.length**2 / (2.0 * float(bending_stiffness(m, s.width, s.thickness)))
     k_w = w_per_M * float(groups.A5(s.width, s.thickness, 1.0, m)) * (1.0 + A3)
     R = float(core_resistance(s.thickness, m))
     C0 = 0.5 * capacitance_scale(perm, m)
@@ -805,7 +810,7 @@ def frequency_response(f, *, strip: Strip | None = None, model="constant", mater
     sups = ("clamped-free", "clamped-pinned") + (("clamped-clamped",) if support == "clamped-clamped" else ())
     resonances = {sup: natural_frequencies(sup, b, 3).tolist() for sup in sups}
     area = s.width * s.length
-    notes = dynamic_notes(beam, viscous_modulus) + support_notes(support, el)
+    notes = dynamic_notes(beam, viscous_modulus, m) + support_notes(support, el)
     if bias != 0.0:
         notes.append(f"small signal about the static state at {bias:g} V (circuit: R, C_d({bias:g} V), C_g; "
                      "dM_A/dV of the forward model); its error against a linearised PNP about the bias is not computed")

@@ -46,7 +46,15 @@ from ipmc_asym.dynamics.line_time import (
 )
 from ipmc_asym.dynamics.waveforms import Waveform, parse_waveform
 from ipmc_asym.forward.model import CHECKS, assumption_warnings, voltage_reason
-from ipmc_asym.model.params import NAFION_LI, SHEET_RESISTANCE_SOURCE, Material, Strip, check_finite, check_positive
+from ipmc_asym.model.params import (
+    NAFION_LI,
+    SHEET_RESISTANCE_SOURCE,
+    Material,
+    Strip,
+    bending_stiffness,
+    check_finite,
+    check_positive,
+)
 from ipmc_asym.model.permittivity import get_model
 
 __all__ = ["DRIVE_COLUMNS", "CHECK_COLUMNS", "LINE_COLUMNS", "CLAMPED_COLUMNS", "MAX_DRIVE_POINTS", "drive_info", "drive_chunks",
@@ -113,7 +121,7 @@ def drive_info(strip: Strip, model, material: Material, beam="dynamic", viscous_
     support, el = _support(support, electrode, strip, Rs)
     info = {"tau": float(time_constant(strip.thickness, perm, material)),
             "R": float(core_resistance(strip.thickness, material)), "model": perm.name, "beam": beam,
-            "viscous_modulus": float(viscous_modulus), "notes": dynamic_notes(beam, viscous_modulus)}
+            "viscous_modulus": float(viscous_modulus), "notes": dynamic_notes(beam, viscous_modulus, material)}
     if Rs > 0.0:
         info["sheet_resistance"] = Rs
         info["line_segments"] = 2 * int(line_segments)
@@ -313,7 +321,7 @@ def _line_mechanics(M, x, strip: Strip, material: Material):
     _, wt = line_weights(x.size - 1, L)
     Mt = M @ wt / L
     Mw = M @ (2.0 * (L - x) * wt / L**2)
-    EI = material.E * strip.I_p
+    EI = float(bending_stiffness(material, strip.width, strip.thickness))  # composite with electrode layers
     with np.errstate(all="ignore"):
         bt = solve_beam(Mt, L, EI, e=strip.e, strain_limit=material.strain_limit)
         bw = solve_beam(Mw, L, EI, e=strip.e, strain_limit=material.strain_limit)

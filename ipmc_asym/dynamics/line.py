@@ -46,7 +46,7 @@ from ipmc_asym.base.results import Panel, ResultMixin, ResultSpec
 from ipmc_asym.beam.dynamics import DEFAULT_MODES, distributed_transfer
 from ipmc_asym.dynamics.circuit import BEAM_CHOICES, FrequencyResult, dynamic_notes, frequency_response, strip_beam
 from ipmc_asym.model import groups
-from ipmc_asym.model.params import NAFION_LI, SHEET_RESISTANCE_SOURCE, Material, Strip, check_finite
+from ipmc_asym.model.params import NAFION_LI, SHEET_RESISTANCE_SOURCE, Material, Strip, bending_stiffness, check_finite
 
 __all__ = ["LineResult", "line_response", "line_factors", "voltage_profile", "moment_modal_integral",
            "ProfileQuadrature", "MAX_PROFILE_POINTS"]
@@ -285,7 +285,7 @@ def _line(u, strip: Strip, material: Material, Rs, beam, viscous_modulus, n_mode
     L = strip.length
     g = groups.line_propagation(L, Rs, u.Z_area)
     fz, fth, fw = line_factors(g)
-    EI = material.E * strip.I_p
+    EI = float(bending_stiffness(material, strip.width, strip.thickness))  # composite with electrode layers
     # H_w^u = -L^2 H_M/(2 E I_p): the moment per volt of the uniform strip's own transfer
     HM = -2.0 * EI * u.H_w / (L * L)
     Z = u.Z * fz

@@ -22,11 +22,12 @@ from ipmc_asym.base.registry import check_choice
 from ipmc_asym.forward.escalation import Escalated, check_tol, moment_escalating
 from ipmc_asym.forward.model import CHECKS, FREE_STRIP_KEYS, MECHANICAL_KEYS, _forward, assumption_warnings
 from ipmc_asym.model.groups import pressure_beta
-from ipmc_asym.model.params import NAFION_LI, Material, Strip, as_material, as_strip, debye_length
+from ipmc_asym.model.params import _PAPER_SETS, NAFION_LI, Material, Strip, as_material, as_strip, debye_length
 from ipmc_asym.model.permittivity import MODELS
 from ipmc_asym.model.request import Request
 
-__all__ = ["evaluate", "estimate_rows", "RESULT_KEYS", "CHECKS", "moment_escalating", "Escalated",
+__all__ = ["evaluate", "estimate_rows", "model_spread", "spread_of", "spread_variants", "SPREAD_KEYS",
+           "RESULT_KEYS", "CHECKS", "moment_escalating", "Escalated",
            "check_tol", "FREE_STRIP_KEYS", "MECHANICAL_KEYS"]
 
 RESULT_KEYS = ("model", "fidelity", "fidelity_used", "escalated", "C_moy", "A0", "A1", "A2", "A3", "A5",
@@ -156,3 +157,79 @@ def model_list(name: str) -> list:
     if name == "all":
         return list(MODELS)
     return [name]
+
+
+#: the outputs of a row that depend on the permittivity model (and on C_moy): the spread is
+#: reported for each
+SPREAD_KEYS = ("M_A", "theta", "w", "w_small", "F_block", "F_block_small")
+
+SPREAD_NOTE = (
+    "error_estimate is the numerical error of one model: how exactly the code solves the paper's equations for "
+    "that permittivity law. model_spread is the range of what the equally plausible model forms predict (the "
+    "three permittivity laws of section 6, and C_moy stated vs eq. (17) for the paper's Nafion Li+): a lower "
+    "bound on the model-form uncertainty of a prediction for a real strip, which is usually far larger than "
+    "the numerical error (docs/measurements.md compares the predictions with published measurements)")
+
+
+def spread_variants(material: Material):
+    """``[(label, material)]``: the C_moy forms to span (paper and formula for the paper's sets,
+    and a given value; ``label`` None for another set: its own C_moy only)."""
+    if material.name in _PAPER_SETS:
+        out = [("paper", material.with_(c_moy="paper")), ("formula", material.with_(c_moy="formula"))]
+        if material.c_moy not in ("paper", "formula"):  # a given value: spanned too
+            out.append((f"{material.C_moy:g}", material))
+        return out
+    return [(None, material)]
+
+
+def spread_of(values: dict, numerical_error=None) -> dict:
+    """``{"min", "max", "ratio", "values", "numerical_error"}`` of ``values`` (label -> number or
+    None); ``ratio`` = max|y|/min|y| (None when the sign changes or a value is 0)."""
+    got = [v for v in values.values() if v is not None]
+    lo, hi = (min(got), max(got)) if got else (None, None)
+    ratio = None
+    if got and (lo > 0 or hi < 0):
+        a = [abs(v) for v in got]
+        ratio = max(a) / min(a)
+    return {"min": lo, "max": hi, "ratio": ratio, "values": dict(values), "numerical_error": numerical_error}
+
+
+def model_spread(strip: Strip, material: Material = NAFION_LI, fidelity="quadrature", tol=None, rows=None, *,
+                 escalate: bool = True, pressure_term: bool = False) -> dict:
+    """The range of each model-dependent output over the model forms (the model-form spread).
+
+    Parameters
+    ----------
+    strip, material, fidelity, tol, escalate, pressure_term
+        As :func:`evaluate`.
+    rows : list of dict, optional
+        Rows already computed for ``material`` (:func:`estimate_rows`): reused, not recomputed.
+
+    Returns
+    -------
+    dict
+        ``over`` (list of str: what is spanned: the three permittivity models, and ``C_moy``
+        paper/formula for the paper's sets), ``variants`` (labels ``model`` or
+        ``model/c_moy``), ``quantities``: for each of :data:`SPREAD_KEYS` ``{"min", "max",
+        "ratio" (max|y|/min|y|, None if a sign changes or a value is 0), "values" {label: SI
+        value or None}, "numerical_error" (the largest error_estimate of the rows)}``, and
+        ``note`` (numerical error vs model-form spread).  Values withheld by a row (no valid
+        rung) are None and left out of min/max.
+    """
+    done = {r["model"]: r for r in rows or ()}
+    variants = spread_variants(material)
+    out_rows = {}
+    for cm, mat in variants:
+        for m in MODELS:
+            r = done.get(m) if mat.c_moy == material.c_moy else None
+            if r is None:
+                r = evaluate(strip, m, fidelity, mat, tol, escalate=escalate, on_invalid="nan",
+                             pressure_term=pressure_term)
+            out_rows[m if cm is None else f"{m}/{cm}"] = r
+    err = [r["error_estimate"] for r in out_rows.values() if r["error_estimate"] is not None]
+    q = {k: spread_of({lab: r.get(k) for lab, r in out_rows.items()}, max(err) if err else None)
+         for k in SPREAD_KEYS}
+    over = ["permittivity model: " + ", ".join(MODELS)]
+    if len(variants) > 1:
+        over.append("C_moy: paper (the stated 3082 mol/m^3) and formula (eq. (17) from the set's data)")
+    return {"over": over, "variants": list(out_rows), "quantities": q, "note": SPREAD_NOTE}

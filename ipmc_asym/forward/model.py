@@ -48,8 +48,9 @@ from ipmc_asym.forward.pressure import moment_pressure_escalating
 from ipmc_asym.integral.api import check_min_thickness, closed_model_id, validity_limit
 from ipmc_asym.integral.samples import moment_samples
 from ipmc_asym.model import groups
+from ipmc_asym.model.electrode import composite_stiffness
 from ipmc_asym.model.limits import slender_ok, slender_warnings
-from ipmc_asym.model.params import NAFION_LI, Material, moment_scale, second_moment
+from ipmc_asym.model.params import NAFION_LI, Material, moment_scale
 from ipmc_asym.model.request import Request
 
 __all__ = ["forward", "ForwardResult", "CHECKS", "NUMERICAL_CHECKS", "ASSUMPTION_CHECKS", "FLAGS", "MOMENT_KEYS",
@@ -472,7 +473,7 @@ def _forward(length, width, thickness, voltage, req: Request, *, modulus=None, c
         check_min_thickness(th)
     k = L.size
     A5 = moment_scale(wd, th, v, material.F, material.C_moy if c_moy is None else C)
-    EI = E * second_moment(wd, th)
+    EI = composite_stiffness(E, wd, th, material.electrode)  # E I_p, or the section with electrode layers
     # I depends on (thickness, voltage) (and C_moy) only: each distinct pair once
     first, inv = (None, None) if pair_code is None else distinct_pairs(np.broadcast_to(pair_code, shape))
 

@@ -41,6 +41,7 @@ else:  # pragma: no cover - Python 3.10
 
 from ipmc_asym.base.inputs import read_input_text
 from ipmc_asym.base.units import parse_quantity
+from ipmc_asym.model.electrode import METALS, NO_ELECTRODE, Electrode, electrode_from_spec
 
 __all__ = ["Parameter", "MaterialSet", "PARAMETERS", "MATERIAL_FIELDS", "set_names", "load_set", "read_set",
            "parse_set", "MAX_FILE_BYTES"]
@@ -74,7 +75,10 @@ MATERIAL_FIELDS = ("Z3", "rho3", "phi4", "rho2", "E", "T", "F", "R", "D")
 #: a set must give these (or IEC for Z3); the others fall back to the library default
 _REQUIRED = ("rho3", "phi4", "E")
 _TOP = {"schema", "name", "title", "membrane", "cation", "c_moy", "description", "sources", "parameters",
-        "permittivity"}
+        "permittivity", "electrode"}
+#: keys of the optional ``[electrode]`` table: the metal layers of the set's strips (the metal's
+#: handbook values unless modulus/density are given; a source for the thickness)
+_ELECTRODE_KEYS = {"metal", "thickness", "modulus", "density", "source", "where", "note"}
 _PARAM_KEYS = {"value", "unit", "source", "quoted_from", "where", "range", "note", "fallback"}
 _PERM_KEYS = {"eps0", "deps", "source", "where", "note"}
 
@@ -124,6 +128,7 @@ class MaterialSet:
     parameters : dict      name -> :class:`Parameter`
     sources : dict         key -> full citation
     permittivity : dict    model -> {"eps0", "deps", "source", "where", "note"} (F/m), as the source states
+    electrode : Electrode  the metal layers the set's source gives (``[electrode]``); none by default
     """
 
     name: str
@@ -136,6 +141,7 @@ class MaterialSet:
     cation: str = ""
     description: str = ""
     permittivity: dict = field(default_factory=dict)
+    electrode: Electrode = NO_ELECTRODE
 
     def material_kwargs(self) -> dict:
         """Keyword arguments of ``params.Material`` (SI): every field, the name and the sources."""
@@ -148,6 +154,8 @@ class MaterialSet:
         kw["c_moy"] = c
         kw["name"] = self.name
         kw["sources"] = self.citations()
+        if self.electrode.present:
+            kw["electrode"] = self.electrode
         return kw
 
     def citations(self) -> tuple:
@@ -161,6 +169,8 @@ class MaterialSet:
             c = p.get("source", "")
             if c and c not in out:
                 out.append(c)
+        if self.electrode.present and self.electrode.source and self.electrode.source not in out:
+            out.append(self.electrode.source)
         return tuple(out)
 
     def fallbacks(self) -> list:
@@ -320,7 +330,43 @@ def parse_set(data: dict, origin: str = "built-in", defaults: dict | None = None
     return MaterialSet(name=name.strip(), title=_text(name, data, "title"), c_moy=c_moy, origin=origin,
                        parameters=out, sources=cites, membrane=_text(name, data, "membrane"),
                        cation=_text(name, data, "cation"), description=_text(name, data, "description"),
-                       permittivity=perm)
+                       permittivity=perm, electrode=_electrode(name, data.get("electrode"), cites))
+
+
+def _electrode(name, d, cites) -> Electrode:
+    """The ``[electrode]`` table: ``thickness`` (each layer; a number in m or a string with a unit),
+    ``metal`` (:data:`ipmc_asym.model.electrode.METALS`) and/or ``modulus`` (Pa or with a unit),
+    ``density`` (kg/m^3), ``source`` (a key of ``[sources]``: where the thickness was read)."""
+    if d is None:
+        return NO_ELECTRODE
+    where = f"material {name}: electrode"
+    if not isinstance(d, dict):
+        raise ValueError(f"{where} must be a table (thickness, metal, source)")
+    for k in d:
+        if k not in _ELECTRODE_KEYS:
+            raise ValueError(f"{where}: unknown key {k!r}; allowed: {', '.join(sorted(_ELECTRODE_KEYS))}")
+    src = d.get("source", "")
+    if not isinstance(src, str) or src not in cites:
+        raise ValueError(f"{where}.source must name a key of [sources] ({', '.join(cites)}); got {src!r}")
+    spec = {}
+    if "metal" in d:
+        if d["metal"] not in METALS:
+            raise ValueError(f"{where}.metal must be one of {', '.join(METALS)}; got {d['metal']!r}")
+        spec["metal"] = d["metal"]
+    if "thickness" not in d:
+        raise ValueError(f"{where}.thickness is missing (each layer, e.g. \"5um\")")
+    spec["thickness"] = parse_quantity(f"{where}.thickness", d["thickness"], PARAMETERS["thickness"][1], "length")
+    if "modulus" in d:
+        spec["modulus"] = parse_quantity(f"{where}.modulus", d["modulus"], PARAMETERS["E"][1], "pressure")
+    if "density" in d:
+        spec["density"] = parse_quantity(f"{where}.density", d["density"], PARAMETERS["rho3"][1], "density")
+    el = electrode_from_spec(spec, {k: f"{where}.{k}" for k in spec})
+    if not el.present:
+        return NO_ELECTRODE
+    cite = f"electrode layers ({_text(where, d, 'where') or 'thickness'}): {cites[src]}"
+    note = _text(where, d, "note")
+    return Electrode(el.thickness, el.modulus, el.density, el.metal,
+                     "; ".join(x for x in (cite, note, el.source.replace("given by the user", "given by the set")) if x))
 
 
 def _files():

@@ -21,9 +21,9 @@ __all__ = ["names", "get", "info", "citations", "bibliography", "describe", "NOT
 
 #: sets the issue asks for that are not offered, and why (no source read for them here)
 NOT_OFFERED = (
-    "Nafion 212, Flemion, Aquivion, and Nafion 115/117 in the Li+, Na+, K+ forms: not offered -- no source "
-    "read gives their Z3 (or IEC), rho3, phi4 and hydrated E; nafion-115-h/-117-h take phi4 from the paper. "
-    "Write a material file (examples/materials/*.toml) with your membrane's values and citations",
+    "Flemion, Aquivion, and Nafion 115/117/NRE-211/NRE-212 in the Li+, Na+, K+ forms: not offered -- no source "
+    "read gives their Z3 (or IEC), rho3, phi4 and hydrated E; the H+ sets take phi4 from the paper. "
+    "Write a material file (docs/materials.md: the template) with your membrane's values and citations",
 )
 
 
@@ -69,6 +69,10 @@ def info(material) -> dict:
     d["used"] = {"Z3": m.Z3, "rho3": m.rho3, "phi4": m.phi4, "rho2": m.rho2, "E": m.E, "T": m.T, "F": m.F,
                  "R": m.R, "D": m.D, "C_moy": m.C_moy, "C_moy_formula": m.C_moy_formula,
                  "c_moy_source": m.c_moy if isinstance(m.c_moy, str) else "given"}
+    if m.electrode.present:
+        e = m.electrode
+        d["used"]["electrode"] = {"thickness": e.thickness, "modulus": e.modulus, "density": e.density,
+                                  "metal": e.metal, "source": e.source}
     d["sources"] = list(citations(m))
     return d
 

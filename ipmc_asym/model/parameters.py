@@ -10,9 +10,9 @@ bounds and which kinds of data see it.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
-from ipmc_asym.base.units import parse_diffusion, parse_pressure, parse_quantity, parse_sheet_resistance
+from ipmc_asym.base.units import parse_diffusion, parse_length, parse_pressure, parse_quantity, parse_sheet_resistance
 from ipmc_asym.model.limits import PLAUSIBLE
 from ipmc_asym.model.params import Material
 
@@ -85,12 +85,22 @@ PARAMETERS = {p.name: p for p in (
     Parameter("sheet_resistance", ("R_s",), "sheet_resistance", "Ohm/sq", "sheet resistance R_s of each electrode",
               None, (1e-3, 1e4), ("impedance",),
               "an impedance spectrum (f, Z_re, Z_im): the fit's time-domain model has ideal electrodes"),
+    # the metal layers of the composite beam (model.electrode): seen through the bending stiffness EI
+    Parameter("electrode_thickness", ("t_m",), "electrode.thickness", "m", "thickness t_m of each metal electrode layer",
+              None, (1e-8, 1e-4), ("static", "time_mech"),
+              "deflection or blocking-force data (static rows or a time series): the layers change the beam, not "
+              "the electrochemistry"),
+    Parameter("electrode_modulus", ("E_m",), "electrode.modulus", "Pa", "Young's modulus E_m of the electrode metal",
+              None, (1e9, 1e12), ("static", "time_mech"),
+              "deflection or blocking-force data (static rows or a time series): the layers change the beam, not "
+              "the electrochemistry"),
 )}
 
 #: alias -> canonical name (every other name a parameter is known by)
 ALIASES = {a: p.name for p in PARAMETERS.values() for a in p.aliases}
 
-_PARSERS = {"modulus": parse_pressure, "diffusion": parse_diffusion, "sheet_resistance": parse_sheet_resistance}
+_PARSERS = {"modulus": parse_pressure, "diffusion": parse_diffusion, "sheet_resistance": parse_sheet_resistance,
+            "electrode_thickness": parse_length, "electrode_modulus": parse_pressure}
 
 
 def canonical(name: str) -> str:
@@ -121,11 +131,15 @@ def with_values(material: Material, values: dict) -> Material:
     material fields (``eps0``, ``deps``: the permittivity model; ``viscous_modulus``: the beam) are
     left to their owners.
     """
-    kw = {}
+    kw, layer = {}, {}
     for k, v in values.items():
         f = PARAMETERS[canonical(k)].field
-        if f is not None:
+        if f is not None and f.startswith("electrode."):  # a field of the electrode layers
+            layer[f.split(".", 1)[1]] = float(v)
+        elif f is not None:
             kw[f] = float(v)
+    if layer:
+        kw["electrode"] = replace(material.electrode, **layer)
     return material.with_(**kw) if kw else material
 
 
@@ -134,4 +148,8 @@ def material_value(material: Material, name: str) -> float:
     p = PARAMETERS[canonical(name)]
     if p.field is None:
         raise ValueError(f"{p.name} is not a material parameter")
-    return float(material.C_moy) if p.field == "c_moy" else float(getattr(material, p.field))
+    if p.field == "c_moy":
+        return float(material.C_moy)
+    if p.field.startswith("electrode."):
+        return float(getattr(material.electrode, p.field.split(".", 1)[1]))
+    return float(getattr(material, p.field))

@@ -32,6 +32,7 @@ import numpy as np
 from ipmc_asym.base.settings import MIN_THICKNESS, STRAIN_LIMIT
 from ipmc_asym.base.units import parse_pressure
 from ipmc_asym.model import material_data
+from ipmc_asym.model.electrode import NO_ELECTRODE, Electrode, composite_stiffness, electrode_from_spec
 from ipmc_asym.model.groups import Groups, debye_length, make_groups, moment_scale
 
 __all__ = [
@@ -63,6 +64,9 @@ __all__ = [
     "material_from_spec",
     "named_material",
     "FALLBACK_DEFAULTS",
+    "bending_stiffness",
+    "ELECTRODE_SPEC_KEYS",
+    "set_thickness",
 ]
 
 #: Default cation diffusion coefficient (m^2/s) of the ``nafion-li`` preset and its source.
@@ -174,6 +178,9 @@ class Material:
     v1, v2 : float   partial molar volumes of the cation and the water, m^3/mol (pressure term of
                  eq. (5) only; sources :data:`V1_LI_SOURCE`, :data:`V2_WATER_SOURCE`)
     M1, M2 : float   molar masses of the cation and the water, kg/mol (source :data:`M_SOURCE`)
+    electrode : Electrode  metal layers on the faces (:mod:`ipmc_asym.model.electrode`); default
+                 none (the paper's bare membrane); they change the beam (stiffness, mass), never the
+                 electrochemistry
     """
 
     Z3: float = -9.0e4
@@ -196,8 +203,11 @@ class Material:
     #: the paper's)
     sources: tuple = ()
     strain_limit: float = STRAIN_LIMIT
+    electrode: Electrode = NO_ELECTRODE
 
     def __post_init__(self):
+        if not isinstance(self.electrode, Electrode):
+            raise ValueError(f"electrode must be an Electrode (ipmc_asym.model.electrode); got {self.electrode!r}")
         z3 = check_finite("Z3", self.Z3, "a finite number < 0 C/kg")
         if z3 >= 0.0:
             raise ValueError(f"Z3 must be a finite number < 0 C/kg (fixed anions); got {self.Z3!r}")
@@ -290,7 +300,11 @@ _PAPER_SETS = ("nafion-li", "nafion-li-formula")
 MATERIALS = {"nafion-li": NAFION_LI}
 
 #: keys of a material specification (scene ``[material]`` table, CLI options)
-MATERIAL_KEYS = ("preset", "E", "modulus", "c_moy", "phi4", "Z3", "rho3", "rho2", "T", "strain_limit")
+MATERIAL_KEYS = ("preset", "E", "modulus", "c_moy", "phi4", "Z3", "rho3", "rho2", "T", "strain_limit", "electrode",
+                 "electrode_thickness", "electrode_metal", "electrode_modulus", "electrode_density")
+#: flat keys of a material specification -> key of the electrode table (``[electrode]``)
+ELECTRODE_SPEC_KEYS = {"electrode_thickness": "thickness", "electrode_metal": "metal",
+                       "electrode_modulus": "modulus", "electrode_density": "density"}
 
 
 def material_from_spec(spec=None, labels=None) -> Material:
@@ -369,10 +383,20 @@ def material_from_spec(spec=None, labels=None) -> Material:
             raise ValueError(f"{name('c_moy')} = paper is the C_moy the paper states for its Nafion Li+; the material "
                              f"{base.name} takes formula (eq. (17) from its own data) or a number in mol/m^3")
         kw["c_moy"] = v
+    if "electrode" in spec and not isinstance(spec["electrode"], dict):
+        raise ValueError(f"{name('electrode')} must be a table (thickness, metal, modulus, density)")
+    el = dict(spec.get("electrode") or {})
+    el.update({ELECTRODE_SPEC_KEYS[k]: spec[k] for k in ELECTRODE_SPEC_KEYS if k in spec})
+    el_labels = {ELECTRODE_SPEC_KEYS[k]: name(k) for k in ELECTRODE_SPEC_KEYS}
+    if el:
+        kw["electrode"] = electrode_from_spec(el, el_labels, base.electrode)
     try:
-        if kw:  # the bibliography says which values are not from the set's sources
-            given = ", ".join(f"{k} = {v:g}" if isinstance(v, float) else f"{k} = {v}" for k, v in kw.items())
+        given = ", ".join(f"{k} = {v:g}" if isinstance(v, float) else f"{k} = {v}" for k, v in kw.items()
+                          if k != "electrode")
+        if given:  # the bibliography says which values are not from the set's sources
             kw["sources"] = tuple(base.sources) + (f"given by the user, not from these sources: {given}",)
+        if "electrode" in kw and kw["electrode"].present and kw["electrode"].source:
+            kw["sources"] = tuple(kw.get("sources", base.sources)) + (f"electrode layers: {kw['electrode'].source}",)
         return base.with_(**kw)
     except ValueError as exc:
         raise ValueError(f"material: {exc}") from None
@@ -388,6 +412,23 @@ def named_material(spec) -> Material:
     if spec.endswith(".toml"):
         return Material.from_file(spec)
     return Material.named(spec)
+
+
+def set_thickness(spec):
+    """The typical TOTAL membrane thickness a material set states, ``(value m, note)``, or None.
+
+    ``spec``: a set name or a file ``NAME.toml`` (as :func:`named_material`).  The paper's set
+    ``nafion-li`` states none (the strip's default 200 µm stays).  The note names the set, the
+    value and where the source gives it, for the output to say so.
+    """
+    if not isinstance(spec, str) or spec in MATERIALS:
+        return None
+    s = material_data.read_set(spec) if spec.endswith(".toml") else material_data.load_set(spec, FALLBACK_DEFAULTS)
+    p = s.parameters.get("thickness")
+    if p is None:
+        return None
+    return p.value, (f"thickness {p.value * 1e6:.4g} um: the typical thickness of material set {s.name} "
+                     f"({p.where or p.source}); --thickness to change it")
 
 
 @dataclass(frozen=True)
@@ -429,6 +470,17 @@ class Strip:
 
 
 NOMINAL_STRIP = Strip()
+
+
+def bending_stiffness(material: Material, width, thickness, modulus=None):
+    """Bending stiffness of the strip (N m^2), vectorised over TOTAL width and thickness (m).
+
+    The bare membrane ``E I_p`` (paper section 3) or, with ``material.electrode``, the symmetric
+    three-layer section (:func:`ipmc_asym.model.electrode.composite_stiffness`); ``modulus``
+    (Pa, per point) replaces the membrane's ``material.E``.
+    """
+    E = material.E if modulus is None else modulus
+    return composite_stiffness(E, width, thickness, material.electrode)
 
 
 def second_moment(width, thickness):

@@ -92,6 +92,27 @@ FREE_ALIASES = {a: k for a, k in ALIASES.items() if k in FREE_PARAMETERS}
 #: time: a transient t -> current/charge/deflection/force; impedance: a spectrum f -> Z), and
 #: for a parameter no kind present sees, the data that would identify it
 VISIBLE_TO = {k: (p.seen_by, p.identify) for k, p in PARAMETERS.items()}
+#: free parameters that deflection and force data see only through the bending stiffness EI
+#: (w = -M_A L^2/(2 EI), F from kappa L = M_A L/EI): at most one of them can be identified
+STIFFNESS_PARAMETERS = ("modulus", "electrode_thickness", "electrode_modulus")
+
+
+def check_stiffness_free(names, material: Material) -> None:
+    """Refuse (one line) electrode parameters the data cannot identify.
+
+    Deflection and force see ``E_p``, ``t_m`` and ``E_m`` only through the composite ``EI``
+    (:data:`STIFFNESS_PARAMETERS`): at most one of them is free; a layer parameter needs a layer
+    to start from (``--electrode-thickness > 0`` with ``--electrode-metal`` or
+    ``--electrode-modulus``), its start value.
+    """
+    stiff = [k for k in names if k in STIFFNESS_PARAMETERS]
+    if len(stiff) > 1:
+        raise ValueError(f"--free {', '.join(stiff)}: deflection and force data see these only through the bending "
+                         "stiffness EI (one number): free one of them, fix the others")
+    for k in stiff:
+        if k != "modulus" and not material.electrode.present:
+            raise ValueError(f"--free {k}: the strip has no electrode layer to fit; give a starting layer "
+                             "(--electrode-thickness > 0 and --electrode-metal or --electrode-modulus)")
 
 
 def check_visible(names, kinds) -> None:
@@ -561,6 +582,10 @@ def _start_values(names, model, material):
             v = material.E
         elif n == "c_moy":
             v = material.C_moy
+        elif n == "electrode_thickness":
+            v = material.electrode.thickness
+        elif n == "electrode_modulus":
+            v = material.electrode.modulus
         else:
             v = getattr(p, n)
             if v <= 0:
@@ -654,6 +679,7 @@ def fit(data: CalibrationData, free, model="constant", material: Material = NAFI
     bounds = parse_free(free)
     names = list(bounds)
     check_visible(names, ("static",))
+    check_stiffness_free(names, material)
     p = len(names)
     n = data.n_points
     check_count(names, n, data.has_sigma)

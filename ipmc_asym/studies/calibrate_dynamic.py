@@ -88,6 +88,7 @@ from ipmc_asym.studies.calibrate import (
     _solve,
     _start_values,
     check_count,
+    check_stiffness_free,
     check_visible,
     multistart_starts,
     parse_free,
@@ -557,7 +558,7 @@ def _bias(J, rm, s2):
 
 def _start(names, model, material, strip, viscous_modulus):
     out = []
-    stat = [n for n in names if n in ("modulus", "c_moy", "eps0", "deps")]
+    stat = [n for n in names if n in ("modulus", "c_moy", "eps0", "deps", "electrode_thickness", "electrode_modulus")]
     sv = dict(zip(stat, _start_values(stat, model, material)))
     for n in names:
         if n in sv:
@@ -641,6 +642,7 @@ def fit_dynamic(datasets, free, model="constant", material: Material = NAFION_LI
     names = list(bounds)
     kinds = set().union(*(_kinds(d) for d in parts))
     check_visible(names, kinds)
+    check_stiffness_free(names, material)
     if beam is None:
         beam = "dynamic" if "viscous_modulus" in names else "quasi-static"
     if "viscous_modulus" in names and beam != "dynamic":

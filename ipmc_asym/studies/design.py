@@ -69,6 +69,7 @@ from ipmc_asym.base.results import Panel, ResultMixin, ResultSpec
 from ipmc_asym.base.units import parse_force, parse_length, parse_quantity, parse_voltage
 from ipmc_asym.beam.dynamics import first_resonance
 from ipmc_asym.forward.model import CHECKS, forward
+from ipmc_asym.model.electrode import beam_label
 from ipmc_asym.model.materials import citations
 from ipmc_asym.model.params import NOMINAL_STRIP, Material, check_positive, named_material
 from ipmc_asym.studies.uq import UNCERTAIN_MATERIAL, _transform, parse_uncertain
@@ -510,6 +511,8 @@ class DesignResult(ResultMixin):
              "units": {**CONSTRAINABLE}, "thickness_is": "TOTAL 2e", "width_is": "TOTAL 2l"}
         if self.robust is not None:
             d["robust"] = self.robust
+        if m.electrode.present:  # the composite beam (the bare membrane is the paper's)
+            d["beam"] = beam_label(m.electrode)
         return d
 
 
