@@ -45,6 +45,7 @@ COMMANDS = {
     "materials": "materials",
     "design": "design",
     "drive": "drive",
+    "warmup": "warmup",
 }
 
 #: one-line summaries for ``ipmc-asym --help`` without importing every command module
@@ -66,6 +67,7 @@ SUMMARIES = {
     "materials": "the material sets: every value with its unit, source and range",
     "design": "choose length, width, thickness, voltage to meet a target (optimum, active constraints, Pareto front)",
     "drive": "response to any voltage waveform (step, ramp, sine, square, triangle, sums, CSV), streamed",
+    "warmup": "compile every Numba kernel once (later runs load them from the cache)",
 }
 
 

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from ipmc_asym.cli import SUMMARIES
-from ipmc_asym.cli.common import add_material_options, print_citations
+from ipmc_asym.cli.common import add_material_options, first_run_notice, print_citations
 from ipmc_asym.forward.model import CHECKS
 from ipmc_asym.io.fileio import check_output_path
 from ipmc_asym.io.jsonio import dumps
@@ -45,6 +45,7 @@ def run(args) -> int:
         spec["pareto"] = {"x": "tip_deflection", "y": "blocking_force", "points": 200}
     name = args.spec.rsplit("/", 1)[-1].removesuffix(".toml")
     spec.setdefault("name", name)
+    first_run_notice("design")
     res = design(spec)
     if args.cite:
         print_citations(res.spec.material, json_mode=args.json)

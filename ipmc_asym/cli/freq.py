@@ -13,6 +13,7 @@ from ipmc_asym.cli.common import (
     add_strip_options,
     arg_type,
     diffusion_type,
+    first_run_notice,
     fmt_num,
     material_from_args,
     model_help,
@@ -104,6 +105,7 @@ def run(args):
         raise ValueError("--export models the full-electrode strip (free tip): not with --support clamped-clamped or "
                          "--electrode")
     f = np.geomspace(args.f1, args.f2, args.points)
+    first_run_notice("freq")
     if args.voltage != 0.0 and args.method != "circuit":
         raise ValueError("--voltage (a DC bias) needs --method circuit: pnp-linear is the linearisation about 0 V")
     if args.sheet_resistance is not None:
@@ -116,7 +118,10 @@ def run(args):
                                beam=args.beam, viscous_modulus=args.viscous_modulus, voltage=args.voltage,
                                **({} if support is None and electrode is None else
                                   {"support": support, "electrode": electrode}))
-    cols = {"f": r.f, "Z_re": r.Z.real, "Z_im": r.Z.imag, "w_amp": r.w_amp, "w_phase": r.w_phase,
+    # |Z| (Ohm) and its phase in degrees: the impedance-spectrum columns `fit` reads (Z_im < 0, phase < 0
+    # for a capacitive strip; studies/calibrate_dynamic.py)
+    cols = {"f": r.f, "Z_re": r.Z.real, "Z_im": r.Z.imag, "Z_abs": np.abs(r.Z), "Z_phase": np.degrees(np.angle(r.Z)),
+            "w_amp": r.w_amp, "w_phase": r.w_phase,
             "theta_amp": np.abs(r.H_theta), "theta_phase": np.angle(r.H_theta),
             "F_amp": np.abs(r.H_F), "F_phase": np.angle(r.H_F)}
     if r.error is not None:
@@ -130,7 +135,8 @@ def run(args):
             "error_max": None if r.error is None else r.error_max,
             "reference": "pnp-linear (exact linearised Nernst-Planck/Gauss)",
             "electrode_area": strip.width * strip.length, "diffusion_coefficient": material.D,
-            "units": {"f": "Hz", "Z": "Ohm (strip, electrode area 2l L)", "w_amp": "m/V", "w_phase": "rad",
+            "units": {"f": "Hz", "Z": "Ohm (strip, electrode area 2l L)", "Z_abs": "Ohm", "Z_phase": "deg",
+                      "w_amp": "m/V", "w_phase": "rad",
                       "theta_amp": "rad/V (free tip)", "theta_phase": "rad", "F_amp": "N/V (blocked tip)",
                       "F_phase": "rad", "error": "relative, of Z and w against pnp-linear"},
             "notes": r.notes + [f"about phi0 = {args.voltage:g} V; w from the layers' charge, small displacements"]}
@@ -173,12 +179,16 @@ def run(args):
               + (f"; clamped-clamped {', '.join(f'{v:.4g}' for v in head['resonances']['clamped-clamped'])} Hz"
                  if clamped else ""))
     ecol = "error" in cols
-    print(f"{'f [Hz]':>11s} {'Z_re [Ohm]':>12s} {'Z_im [Ohm]':>12s} {'|w|/V [mm/V]':>13s} {'phase [rad]':>11s}"
-          + (f" {'error':>9s}" if ecol else ""))
+    print(f"{'f [Hz]':>11s} {'Z_re [Ohm]':>12s} {'Z_im [Ohm]':>12s} {'Z_abs [Ohm]':>12s} {'Z_phase [deg]':>13s} "
+          f"{'|w|/V [mm/V]':>13s} {'phase [rad]':>11s}" + (f" {'error':>9s}" if ecol else ""))
     for i in range(f.size):
         print(f"{fmt_num(f[i], '11.4g')} {fmt_num(cols['Z_re'][i], '12.5g')} {fmt_num(cols['Z_im'][i], '12.5g')} "
+              f"{fmt_num(cols['Z_abs'][i], '12.5g')} {fmt_num(cols['Z_phase'][i], '13.4g')} "
               f"{fmt_num(cols['w_amp'][i] * 1e3, '13.5g')} {fmt_num(cols['w_phase'][i], '11.4g')}"
               + (f" {fmt_num(cols['error'][i], '9.2g')}" if ecol else ""))
+    print("legend: Z = impedance of the strip (electrode area 2l L), Z_abs and Z_phase as `fit` reads them; "
+          "|w|/V, phase = free-tip deflection per volt and its phase against the voltage"
+          + ("; error = relative error of Z and w against pnp-linear" if ecol else ""))
     if clamped:  # amplitudes per volt
         print_clamped("f [Hz]", f, {n: cols[f"{n}_amp"] for n in CLAMPED_OUTPUTS}, per="/V")
     for n in head["notes"]:

@@ -207,7 +207,7 @@ def run(args):
     if args.diffusion is not None:
         material = material.with_(D=args.diffusion)
     strip = strip_from_args(args)
-    first_run_notice()
+    first_run_notice("step-pnp" if args.fidelity == "pnp" or args.tol is not None else "step")
     models = list(model_names()) if args.model == "all" else [args.model]
     if args.sheet_resistance > 0.0:
         for bad, why in ((args.fidelity != "circuit", "--fidelity pnp"), (args.tol is not None, "--tol")):

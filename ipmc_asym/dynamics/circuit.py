@@ -70,6 +70,7 @@ from ipmc_asym.kernels import _generated_charge as GC
 from ipmc_asym.kernels.jit import jit
 from ipmc_asym.model import groups
 from ipmc_asym.model.params import (
+    D_CATION_DEFAULT,
     D_CATION_SOURCE,
     NAFION_LI,
     Material,
@@ -99,10 +100,28 @@ DYNAMIC_NOTES = (
 BEAM_CHOICES = ("quasi-static", "dynamic")
 
 
-def dynamic_notes(beam="quasi-static", viscous_modulus=0.0):
-    """The notes every dynamic output carries (water transport out of scope, beam model, D source)."""
+def diffusion_note(diffusion=None):
+    """The note on the cation diffusion coefficient actually used.
+
+    Parameters
+    ----------
+    diffusion : float, optional
+        ``D`` of the run (m^2/s); ``None`` or the library default gives the default's source
+        (:data:`~ipmc_asym.model.params.D_CATION_SOURCE`), any other value is said as given.
+    """
+    if diffusion is None or float(diffusion) == D_CATION_DEFAULT:
+        return DYNAMIC_NOTES[2]
+    return (f"the cation diffusion coefficient D is not in the paper; D = {float(diffusion):g} m^2/s as given "
+            f"(--diffusion, the material or the fit), not the library's assumed {D_CATION_DEFAULT:g} m^2/s; "
+            "every dynamic time scales as 1/D")
+
+
+def dynamic_notes(beam="quasi-static", viscous_modulus=0.0, diffusion=None):
+    """The notes every dynamic output carries (water transport out of scope, beam model, the D used:
+    :func:`diffusion_note`)."""
     check_choice("beam", beam, BEAM_CHOICES)
     notes = list(DYNAMIC_NOTES)
+    notes[2] = diffusion_note(diffusion)
     if beam == "dynamic":
         notes[1] = INERTIA_NOTE + f"; viscous modulus {float(viscous_modulus):g} Pa s"
         notes.append(VISCOUS_MODULUS_SOURCE)
@@ -533,7 +552,7 @@ def step_response(voltage=1.0, duration=None, *, strip: Strip | None = None, mod
     tau = float(time_constant(s.thickness, perm, m))
     tgrid = _time_grid(5.0 * tau if duration is None and t is None else duration, t, points)
     R = float(core_resistance(s.thickness, m))
-    notes = dynamic_notes(beam, viscous_modulus)
+    notes = dynamic_notes(beam, viscous_modulus, m.D)
     extra = {}
     dyn = BeamDynamics(s, m, viscous_modulus, n_modes) if beam == "dynamic" else None
     tout = tgrid
@@ -843,7 +862,7 @@ def frequency_response(f, *, strip: Strip | None = None, model="constant", mater
     sups = ("clamped-free", "clamped-pinned") + (("clamped-clamped",) if support == "clamped-clamped" else ())
     resonances = {sup: natural_frequencies(sup, b, 3).tolist() for sup in sups}
     area = s.width * s.length
-    notes = dynamic_notes(beam, viscous_modulus) + support_notes(support, el)
+    notes = dynamic_notes(beam, viscous_modulus, m.D) + support_notes(support, el)
     if bias != 0.0:
         notes.append(f"small signal about the static state at {bias:g} V (circuit: R, C_d({bias:g} V), C_g; "
                      "dM_A/dV of the forward model); its error against a linearised PNP about the bias is not computed")

@@ -112,7 +112,7 @@ def drive_info(strip: Strip, model, material: Material, beam="dynamic", viscous_
     support, el = _support(support, electrode, strip, Rs)
     info = {"tau": float(time_constant(strip.thickness, perm, material)),
             "R": float(core_resistance(strip.thickness, material)), "model": perm.name, "beam": beam,
-            "viscous_modulus": float(viscous_modulus), "notes": dynamic_notes(beam, viscous_modulus)}
+            "viscous_modulus": float(viscous_modulus), "notes": dynamic_notes(beam, viscous_modulus, material.D)}
     if Rs > 0.0:
         info["sheet_resistance"] = Rs
         info["line_segments"] = 2 * int(line_segments)
