@@ -57,7 +57,7 @@ SUMMARIES = {
     "profiles": "C, phi, D, E, rhoZ, p through the thickness (paper Figs 4-7)",
     "sweep": "evaluate the strip on a grid of parameters",
     "validate": "each claim of the paper vs our numbers, with a verdict",
-    "figures": "regenerate the paper's Figs 4-10 (+ speed/accuracy) as PNG",
+    "figures": "regenerate the paper's Figs 4-10 (+ speed/accuracy) as PDF, SVG or PNG",
     "fit": "calibrate modulus, c_moy, permittivity, D, damping, sheet resistance on deflection/force, time series "
            "and impedance spectra (profile intervals)",
     "uq": "uncertainty quantiles and Sobol' indices of a scene's [uncertain] inputs",

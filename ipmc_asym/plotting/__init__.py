@@ -12,7 +12,33 @@ import os
 
 from ipmc_asym.io.fileio import atomic_path
 
-__all__ = ["pyplot", "savefig", "MODEL_COLOURS", "MODEL_LINES", "MODEL_MARKERS", "model_style"]
+__all__ = ["pyplot", "savefig", "MODEL_COLOURS", "MODEL_LINES", "MODEL_MARKERS", "model_style", "COLUMN_WIDTH_IN",
+           "PAGE_WIDTH_IN", "MIN_FONT_PT", "FORMATS", "check_figure_format", "raise_small_fonts"]
+
+#: print layout: a figure is one journal column wide (8.5 cm) or, with side-by-side panels, a
+#: page wide (17 cm); drawn at that size, so its fonts are what the page shows
+COLUMN_WIDTH_IN = 8.5 / 2.54
+PAGE_WIDTH_IN = 17.0 / 2.54
+#: smallest font on a printed figure (points)
+MIN_FONT_PT = 7.0
+#: the formats every drawing command writes (``--format``; pdf and svg are vector)
+FORMATS = ("png", "pdf", "svg")
+
+
+def check_figure_format(fmt) -> str:
+    """``fmt`` if it is one of :data:`FORMATS`, else a one-line ``ValueError``."""
+    if fmt not in FORMATS:
+        raise ValueError(f"format must be one of {', '.join(FORMATS)}; got {fmt!r}")
+    return fmt
+
+
+def raise_small_fonts(fig, minimum: float = MIN_FONT_PT) -> None:
+    """Every visible text of ``fig`` (labels, ticks, legends, titles, notes) at least ``minimum`` pt."""
+    from matplotlib.text import Text  # deferred: matplotlib is heavy and only figures need it
+
+    for t in fig.findobj(Text):
+        if t.get_visible() and t.get_text() and t.get_fontsize() < minimum:
+            t.set_fontsize(minimum)
 
 #: one colour per permittivity model, in every figure
 MODEL_COLOURS = {"constant": "C0", "linear": "C1", "affine": "C2"}
@@ -55,9 +81,17 @@ def pyplot():
 
 
 def savefig(fig, path, **kw) -> str:
-    """Save ``fig`` to ``path`` atomically and close it; returns the path."""
+    """Save ``fig`` to ``path`` atomically and close it; returns the path.
+
+    Fonts below :data:`MIN_FONT_PT` are raised to it; the format follows the extension
+    (``format=`` overrides it).
+    """
 
     fmt = kw.pop("format", None) or os.path.splitext(os.fspath(path))[1].lstrip(".") or "png"
+    raise_small_fonts(fig)
+    # the tight box keeps every label and legend inside the file (nothing cut at an edge)
+    kw.setdefault("bbox_inches", "tight")
+    kw.setdefault("pad_inches", 0.03)
     with atomic_path(path) as tmp:
         fig.savefig(tmp, format=fmt, **kw)
     pyplot().close(fig)

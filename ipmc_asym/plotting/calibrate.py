@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ipmc_asym.base.quantities import unit_and_long_name
-from ipmc_asym.plotting import pyplot, savefig
+from ipmc_asym.plotting import COLUMN_WIDTH_IN, PAGE_WIDTH_IN, pyplot, savefig
 
 __all__ = ["plot_fit", "plot_fit_dynamic"]
 
@@ -16,6 +16,13 @@ _AXIS = {"voltage": (1.0, "V", "voltage φ0"), "thickness": (1e6, "µm", "total 
 _DISPLAY = {"Pa": (1e-6, "MPa"), "mol/m^3": (1.0, "mol/m³"), "F/m": (1.0, "F/m")}
 _LABEL = {"deflection": ("tip deflection |w| [mm]", 1e3), "blocking_force": ("blocking force |F| [mN]", 1e3)}
 
+
+
+def _unit(name):
+    """The unit of a free parameter (``studies.calibrate.FREE_PARAMETERS``), for the annotations."""
+    from ipmc_asym.studies.calibrate import FREE_PARAMETERS  # deferred: the names only
+
+    return FREE_PARAMETERS.get(name, ("",))[0]
 
 def _parameter_text(name, p) -> str:
     """``modulus = 130 MPa ± 2.1 MPa``: the value with its unit from the output vocabulary."""
@@ -40,7 +47,7 @@ def plot_fit(result, path) -> str:
     plt = pyplot()
     d = result.data
     keys = list(d.measured)
-    fig, axes = plt.subplots(2, len(keys), figsize=(5.2 * len(keys), 5.6), squeeze=False,
+    fig, axes = plt.subplots(2, len(keys), figsize=(min(PAGE_WIDTH_IN, COLUMN_WIDTH_IN * len(keys)), 4.2), squeeze=False,
                              gridspec_kw={"height_ratios": [3, 1.3]}, sharex="col")
     # x axis: the first of voltage, thickness, length, width that varies; colour: the next
     varying = [k for k in ("voltage", "thickness", "length", "width") if np.unique(d.geometry[k]).size > 1]
@@ -68,7 +75,7 @@ def plot_fit(result, path) -> str:
             res = (y[s] - pred[s]) / (sig[s] if sig is not None else y[s])
             axr.plot(xs * v[s], res, "o", ms=4, color=c)
         ax.set_ylabel(lab)
-        ax.set_title(f"{k.replace('_', ' ')}: data (points) vs fit (lines)", fontsize=10)
+        ax.set_title(f"{k.replace('_', ' ')}: data (points) vs fit (lines)", fontsize=8)
         ax.legend(fontsize=7)
         axr.axhline(0, color="k", lw=0.8)
         axr.set_ylabel("(data − fit)/σ" if sig is not None else "(data − fit)/data")
@@ -82,10 +89,10 @@ def plot_fit(result, path) -> str:
             return f" ± {p['stderr']:.2g}"
         return f" [{p['ci95'][0]:.4g}, {p['ci95'][1]:.4g}]"
 
-    pars = ", ".join(f"{n} = {p['value']:.4g}{label(p)}" for n, p in result.parameters.items())
+    pars = ", ".join(f"{n} = {p['value']:.4g}{label(p)} {_unit(n)}" for n, p in result.parameters.items())
     gof = (f"χ²_red = {result.chi2_red:.3g}" if result.chi2_red is not None
            else f"noise s = {result.noise_scale:.2g} (relative, estimated)")
-    fig.suptitle(f"fit [{result.model}, {result.fidelity}]: {pars}; {gof}", fontsize=10)
+    fig.suptitle(f"fit [{result.model}, {result.fidelity}]: {pars};\n{gof}", fontsize=8, wrap=True)
     fig.tight_layout()
     return savefig(fig, path, dpi=120)
 
@@ -114,7 +121,8 @@ def plot_fit_dynamic(result, path) -> str:
         for k in d.measured:
             panels.append((d, k, pr[k]))
     n = len(panels)
-    fig, axes = plt.subplots(2, n, figsize=(4.2 * n, 5.4), squeeze=False, gridspec_kw={"height_ratios": [3, 1.3]})
+    fig, axes = plt.subplots(2, n, figsize=(min(PAGE_WIDTH_IN, COLUMN_WIDTH_IN * n), 4.2), squeeze=False,
+                             gridspec_kw={"height_ratios": [3, 1.3]})
     for j, (d, k, pred) in enumerate(panels):
         ax, axr = axes[0, j], axes[1, j]
         y = d.measured[k]
@@ -149,14 +157,14 @@ def plot_fit_dynamic(result, path) -> str:
         if k == "Z_abs":
             ax.set_yscale("log")
         ax.set_ylabel(lab)
-        ax.set_title(f"{d.source}: {k.replace('_', ' ')}", fontsize=9)
+        ax.set_title(f"{d.source}: {k.replace('_', ' ')}", fontsize=8)
         ax.legend(fontsize=7)
         axr.set_ylabel("(data − fit)/σ" if sig is not None else "(data − fit)/weight")
         axr.set_xlabel(xl)
-    pars = ", ".join(f"{nm} = {p['value']:.4g}" + ("" if p["status"] == "ok" else f" ({p['status']})")
+    pars = ", ".join(f"{nm} = {p['value']:.4g} {_unit(nm)}" + ("" if p["status"] == "ok" else f" ({p['status']})")
                      for nm, p in result.parameters.items())
     gof = (f"χ²_red = {result.chi2_red:.3g}" if result.chi2_red is not None
            else f"noise s = {result.noise_scale:.2g} (relative, estimated)")
-    fig.suptitle(f"fit [{result.model}]: {pars}; {gof}", fontsize=10)
+    fig.suptitle(f"fit [{result.model}]: {pars};\n{gof}", fontsize=8, wrap=True)
     fig.tight_layout()
     return savefig(fig, path, dpi=110)

@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
-from ipmc_asym.plotting import pyplot, savefig
+import numpy as np
+
+from ipmc_asym.base.quantities import BY_NAME, axis_label
+from ipmc_asym.plotting import COLUMN_WIDTH_IN, pyplot, savefig
 
 __all__ = ["plot_design"]
 
@@ -31,18 +34,24 @@ def plot_design(result, path) -> str:
     x = [p["outputs"][xn] * fx for p in result.pareto]
     y = [p["outputs"][yn] * fy for p in result.pareto]
     th = [p["inputs"]["thickness"] * 1e6 for p in result.pareto]
-    fig, ax = plt.subplots(figsize=(6.4, 4.6))
-    sc = ax.scatter(x, y, c=th, s=12, cmap="viridis")
-    fig.colorbar(sc, ax=ax, label="total thickness 2e [µm]")
+    fig, ax = plt.subplots(figsize=(COLUMN_WIDTH_IN, 2.9))
+    spread = (max(th) - min(th)) / max(th)
+    if spread > 0.02:
+        sc = ax.scatter(x, y, c=th, s=8, cmap="viridis")
+        fig.colorbar(sc, ax=ax, label="total thickness $2e$ [µm]")
+        same = ""
+    else:  # a colour bar over a sliver (e.g. 397.5-400 µm) would suggest a variation that is not there
+        ax.scatter(x, y, s=8, color="C0")
+        same = f"; $2e$ = {np.median(th):.4g} µm along the front"
     o = result.optimum["outputs"]
     if o.get(xn) is not None and o.get(yn) is not None:
         ax.plot([abs(o[xn]) * fx], [abs(o[yn]) * fy], "r*", ms=14,
                 label=f"optimum: {result.objective['sense']} {result.objective['name']}")
-        ax.legend(loc="best", fontsize=9)
-    ax.set_xlabel(f"|{xn}| [{ux}]")
-    ax.set_ylabel(f"|{yn}| [{uy}]")
+        ax.legend(loc="best", fontsize=7)
+    ax.set_xlabel("|" + axis_label(BY_NAME[xn].name, ux) + "|" if xn in BY_NAME else f"|{xn}| [{ux}]")
+    ax.set_ylabel("|" + axis_label(BY_NAME[yn].name, uy) + "|" if yn in BY_NAME else f"|{yn}| [{uy}]")
     ax.grid(alpha=0.3)
-    ax.set_title(f"Pareto front ({len(result.pareto)} points), model {sp.model}, material {sp.material.name}",
-                 fontsize=10)
+    ax.set_title(f"Pareto front ({len(result.pareto)} points), model {sp.model},\nmaterial {sp.material.name}{same}",
+                 fontsize=8)
     fig.tight_layout()
     return savefig(fig, path, dpi=110)

@@ -1,4 +1,4 @@
-"""The numbers the documentation pages (docs/*.md) and docs/design.md state about the toolkit itself, measured afresh.
+"""The numbers the documentation pages and docs/design.md state about the toolkit itself, measured afresh.
 
 Every number of the documentation's tables on accuracy and validity (the fidelity ladder, the
 ceilings, the thinnest strips each rung serves, the nominal predictions, the laws' ranges) and
