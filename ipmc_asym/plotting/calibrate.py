@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ipmc_asym.base.quantities import unit_and_long_name
-from ipmc_asym.plotting import COLUMN_WIDTH_IN, PAGE_WIDTH_IN, pyplot, savefig
+from ipmc_asym.plotting import COLUMN_WIDTH_IN, PAGE_WIDTH_IN, print_fonts, pyplot, savefig
 
 __all__ = ["plot_fit", "plot_fit_dynamic"]
 
@@ -93,6 +93,7 @@ def plot_fit(result, path) -> str:
     gof = (f"χ²_red = {result.chi2_red:.3g}" if result.chi2_red is not None
            else f"noise s = {result.noise_scale:.2g} (relative, estimated)")
     fig.suptitle(f"fit [{result.model}, {result.fidelity}]: {pars};\n{gof}", fontsize=8, wrap=True)
+    print_fonts(fig)
     fig.tight_layout()
     return savefig(fig, path, dpi=120)
 
@@ -166,5 +167,6 @@ def plot_fit_dynamic(result, path) -> str:
     gof = (f"χ²_red = {result.chi2_red:.3g}" if result.chi2_red is not None
            else f"noise s = {result.noise_scale:.2g} (relative, estimated)")
     fig.suptitle(f"fit [{result.model}]: {pars};\n{gof}", fontsize=8, wrap=True)
+    print_fonts(fig)
     fig.tight_layout()
     return savefig(fig, path, dpi=110)

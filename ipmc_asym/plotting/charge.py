@@ -7,7 +7,7 @@ import numpy as np
 from ipmc_asym.dynamics.circuit import frequency_response, step_response, time_constant
 from ipmc_asym.dynamics.electrode import charge
 from ipmc_asym.model.params import NAFION_LI, Strip
-from ipmc_asym.plotting import MODEL_COLOURS, MODEL_MARKERS, PAGE_WIDTH_IN, model_style, pyplot, savefig
+from ipmc_asym.plotting import MODEL_COLOURS, MODEL_MARKERS, PAGE_WIDTH_IN, model_style, print_fonts, pyplot, savefig
 
 __all__ = ["plot_charge_capacitance", "plot_step", "plot_bode"]
 
@@ -40,6 +40,7 @@ def plot_charge_capacitance(path, strip: Strip | None = None, material=NAFION_LI
     for a in (a1, a2):
         a.grid(alpha=0.3)
         a.legend()
+    print_fonts(fig)
     fig.tight_layout()
     return savefig(fig, path, dpi=110)
 
@@ -67,6 +68,7 @@ def plot_step(path, voltage=1.0, strip: Strip | None = None, material=NAFION_LI)
     for a in (a1, a2):
         a.grid(alpha=0.3)
         a.legend(fontsize=7)
+    print_fonts(fig)
     fig.tight_layout()
     del tau
     return savefig(fig, path, dpi=110)
@@ -101,5 +103,6 @@ def plot_bode(path, strip: Strip | None = None, material=NAFION_LI) -> str:
     ax[0, 0].legend(fontsize=7)
     ax[0, 0].set_title("impedance about 0 V")
     ax[0, 1].set_title("tip deflection / voltage (layers' moment)")
+    print_fonts(fig)
     fig.tight_layout()
     return savefig(fig, path, dpi=110)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ipmc_asym.base.quantities import BY_NAME, axis_label
-from ipmc_asym.plotting import COLUMN_WIDTH_IN, pyplot, savefig
+from ipmc_asym.plotting import COLUMN_WIDTH_IN, print_fonts, pyplot, savefig
 
 __all__ = ["plot_design"]
 
@@ -53,5 +53,6 @@ def plot_design(result, path) -> str:
     ax.grid(alpha=0.3)
     ax.set_title(f"Pareto front ({len(result.pareto)} points), model {sp.model},\nmaterial {sp.material.name}{same}",
                  fontsize=8)
+    print_fonts(fig)
     fig.tight_layout()
     return savefig(fig, path, dpi=110)

@@ -22,7 +22,7 @@ import numpy as np
 from ipmc_asym.base.registry import model_names
 from ipmc_asym.forward.model import flag_mask
 from ipmc_asym.model.params import NAFION_LI, Material, Strip
-from ipmc_asym.plotting import COLUMN_WIDTH_IN, MODEL_COLOURS, MODEL_MARKERS, check_figure_format, model_style, pyplot, savefig
+from ipmc_asym.plotting import COLUMN_WIDTH_IN, MODEL_COLOURS, MODEL_MARKERS, check_figure_format, model_style, print_fonts, pyplot, savefig
 from ipmc_asym.plotting.profiles import write_all
 from ipmc_asym.plotting.speed import plot_speed_accuracy
 from ipmc_asym.studies.profiles import compute_all
@@ -45,9 +45,9 @@ INFLUENCE = {
 }
 
 #: the three panels: (row key, small-displacement key, display factor, axis label, title)
-_PANELS = (("w", "w_small", 1e3, "tip deflection |w| (mm)", "(a) deflection"),
-           ("F_block", None, 1e3, r"blocking force $|F^p|$ (mN)", "(b) blocking force"),
-           ("theta", None, 1.0, r"rotation $|\theta|$ (rad)", "(c) rotation"))
+_PANELS = (("w", "w_small", 1e3, "$|w|$ (mm)", "(a) tip deflection"),
+           ("F_block", None, 1e3, r"$|F^p|$ (mN)", "(b) blocking force"),
+           ("theta", None, 1.0, r"$|\theta|$ (rad)", "(c) tip rotation"))
 
 
 def _si(value: float, unit: str) -> str:
@@ -146,7 +146,8 @@ def influence_figure(var, path, base: Strip | None = None, material: Material = 
     t = f"Influence of {var}" + (f" (paper Fig. {fig_no})" if fig_no else "") + ";\nfixed " + \
         ", ".join(f"{k} = {v}" for k, v in fixed.items()) + f", $E$ = {_si(material.E, 'Pa')}"
     fig.suptitle(t, fontsize=8)
-    fig.tight_layout(rect=(0, 0.17, 1, 1))
+    print_fonts(fig)
+    fig.tight_layout(rect=(0, 0.12, 1, 1))
     return savefig(fig, path)
 
 

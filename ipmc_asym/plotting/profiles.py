@@ -8,7 +8,7 @@ import numpy as np
 
 from ipmc_asym.base.registry import model_names
 from ipmc_asym.model.params import NAFION_LI, Material, Strip
-from ipmc_asym.plotting import COLUMN_WIDTH_IN, check_figure_format, model_style, pyplot, savefig
+from ipmc_asym.plotting import COLUMN_WIDTH_IN, check_figure_format, model_style, print_fonts, pyplot, savefig
 from ipmc_asym.studies.profiles import QUANTITIES, compute_all, profile_summary, write_csv
 
 __all__ = ["plot_profiles", "write_all"]
@@ -105,6 +105,7 @@ def plot_profiles(results: dict, quantity: str, path, e: float, dpi: int = 110, 
         ax.grid(True, alpha=0.3)
     axs[0].legend(fontsize=7)
     fig.suptitle(title or f"{quantity} profile through the thickness (nominal strip, full BVP)", fontsize=8, wrap=True)
+    print_fonts(fig)
     fig.tight_layout()
     savefig(fig, path)
 

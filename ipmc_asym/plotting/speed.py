@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import json
 
-from ipmc_asym.plotting import COLUMN_WIDTH_IN, MODEL_COLOURS, pyplot, savefig
+from ipmc_asym.plotting import COLUMN_WIDTH_IN, MODEL_COLOURS, print_fonts, pyplot, savefig
 
 __all__ = ["plot_speed_accuracy", "load_bench", "ERR_FLOOR"]
 
@@ -71,5 +71,6 @@ def plot_speed_accuracy(res: dict, path) -> str:
         h += [Line2D([], [], ls=":", color="0.6", label="target time per point")]
     # below the axes: never on a point
     ax.legend(handles=h, loc="upper center", bbox_to_anchor=(0.5, -0.28), fontsize=7, ncol=3, frameon=False)
+    print_fonts(fig)
     fig.tight_layout()
     return savefig(fig, path, dpi=120)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ipmc_asym.base.quantities import axis_label
-from ipmc_asym.plotting import COLUMN_WIDTH_IN, pyplot, savefig
+from ipmc_asym.plotting import COLUMN_WIDTH_IN, print_fonts, pyplot, savefig
 
 __all__ = ["plot_uq"]
 
@@ -68,5 +68,6 @@ def plot_uq(result, path) -> str:
     hist = f"; histogram of the first {stored}" if stored < result.n_samples else ""
     fig.suptitle(f"UQ of scene {result.scene!r} [{result.model}]: {result.n_samples} runs{note}{hist}"
                  "\ndashed: 2.5 / 97.5 %, solid: median (thickness = total $2e$)", fontsize=8, wrap=True)
+    print_fonts(fig)
     fig.tight_layout()
     return savefig(fig, path, dpi=110)
