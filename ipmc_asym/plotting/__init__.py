@@ -13,7 +13,7 @@ import os
 from ipmc_asym.io.fileio import atomic_path
 
 __all__ = ["pyplot", "savefig", "MODEL_COLOURS", "MODEL_LINES", "MODEL_MARKERS", "model_style", "COLUMN_WIDTH_IN",
-           "PAGE_WIDTH_IN", "MIN_FONT_PT", "FORMATS", "MAX_FONT_PT", "check_figure_format", "print_fonts"]
+           "PAGE_WIDTH_IN", "MIN_FONT_PT", "FORMATS", "MAX_FONT_PT", "check_figure_format", "print_fonts", "symbols"]
 
 #: print layout: a figure is one journal column wide (8.5 cm) or, with side-by-side panels, a
 #: page wide (17 cm); drawn at that size, so its fonts are what the page shows
@@ -25,6 +25,20 @@ MIN_FONT_PT = 7.0
 MAX_FONT_PT = 8.5
 #: the formats every drawing command writes (``--format``; pdf and svg are vector)
 FORMATS = ("png", "pdf", "svg")
+
+
+#: code names in the vocabulary's long names -> the paper's symbols (mathtext), for plot labels
+_SYMBOLS = (("M_A", "$M_A$"), ("theta", r"$\theta$"), ("phi0", r"$\varphi_0$"), ("C_moy", r"$C_{moy}$"),
+            ("w_p", "$w_p$"), ("eps0", r"$\varepsilon_0$"), ("eps_moy", r"$\varepsilon_{moy}$"))
+
+
+def symbols(label: str) -> str:
+    """``label`` with the code names of quantities written as the paper's symbols."""
+    import re
+
+    for code, sym in _SYMBOLS:
+        label = re.sub(rf"(?<![\w$]){re.escape(code)}(?![\w$])", lambda _m, s=sym: s, label)
+    return label
 
 
 def check_figure_format(fmt) -> str:

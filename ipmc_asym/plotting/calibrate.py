@@ -95,7 +95,7 @@ def plot_fit(result, path) -> str:
     fig.suptitle(f"fit [{result.model}, {result.fidelity}]: {pars};\n{gof}", fontsize=8, wrap=True)
     print_fonts(fig)
     fig.tight_layout()
-    return savefig(fig, path, dpi=120)
+    return savefig(fig, path, dpi=300)  # print resolution when the file is a PNG
 
 
 #: measured column -> (label, display scale) of the time series and spectra
@@ -169,4 +169,4 @@ def plot_fit_dynamic(result, path) -> str:
     fig.suptitle(f"fit [{result.model}]: {pars};\n{gof}", fontsize=8, wrap=True)
     print_fonts(fig)
     fig.tight_layout()
-    return savefig(fig, path, dpi=110)
+    return savefig(fig, path, dpi=300)  # print resolution when the file is a PNG

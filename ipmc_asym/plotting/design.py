@@ -4,10 +4,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from ipmc_asym.base.quantities import BY_NAME, axis_label
 from ipmc_asym.plotting import COLUMN_WIDTH_IN, print_fonts, pyplot, savefig
 
 __all__ = ["plot_design"]
+
+#: short axis names of the design outputs (the paper's symbols)
+_SHORT = {"tip_deflection": "tip deflection $|w|$", "blocking_force": "blocking force $|F|$",
+          "rotation": r"tip rotation $|\theta|$", "moment": "moment $|M_A|$", "I": "moment integral $I$",
+          "work": "work $|F|\\,|w|$", "max_strain": "largest strain", "first_resonance": "first resonance"}
 
 #: display scale of each output's unit
 _SCALE = {"m": (1e3, "mm"), "N": (1e3, "mN"), "N m": (1e6, "µN m"), "rad": (1.0, "rad"), "1": (1.0, "")}
@@ -45,14 +49,16 @@ def plot_design(result, path) -> str:
         same = f"; $2e$ = {np.median(th):.4g} µm along the front"
     o = result.optimum["outputs"]
     if o.get(xn) is not None and o.get(yn) is not None:
-        ax.plot([abs(o[xn]) * fx], [abs(o[yn]) * fy], "r*", ms=14,
-                label=f"optimum: {result.objective['sense']} {result.objective['name']}")
-        ax.legend(loc="best", fontsize=7)
-    ax.set_xlabel("|" + axis_label(BY_NAME[xn].name, ux) + "|" if xn in BY_NAME else f"|{xn}| [{ux}]")
-    ax.set_ylabel("|" + axis_label(BY_NAME[yn].name, uy) + "|" if yn in BY_NAME else f"|{yn}| [{uy}]")
+        name = result.objective["name"]
+        ax.plot([abs(o[xn]) * fx], [abs(o[yn]) * fy], "r*", ms=10, mec="k", mew=0.5,
+                label=f"optimum: {result.objective['sense']} {_SHORT.get(name, name)}")
+        ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.2), fontsize=7, frameon=False)  # off the front
+    ax.margins(0.08)  # the optimum, often at an end of the front, stays inside the axes
+    ax.set_xlabel(f"{_SHORT.get(xn, xn)} [{ux}]" if ux else _SHORT.get(xn, xn))
+    ax.set_ylabel(f"{_SHORT.get(yn, yn)} [{uy}]" if uy else _SHORT.get(yn, yn))
     ax.grid(alpha=0.3)
     ax.set_title(f"Pareto front ({len(result.pareto)} points), model {sp.model},\nmaterial {sp.material.name}{same}",
                  fontsize=8)
     print_fonts(fig)
     fig.tight_layout()
-    return savefig(fig, path, dpi=110)
+    return savefig(fig, path, dpi=300)  # print resolution when the file is a PNG

@@ -73,4 +73,4 @@ def plot_speed_accuracy(res: dict, path) -> str:
     ax.legend(handles=h, loc="upper center", bbox_to_anchor=(0.5, -0.28), fontsize=7, ncol=3, frameon=False)
     print_fonts(fig)
     fig.tight_layout()
-    return savefig(fig, path, dpi=120)
+    return savefig(fig, path, dpi=300)  # print resolution when the file is a PNG

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ipmc_asym.base.quantities import axis_label
-from ipmc_asym.plotting import COLUMN_WIDTH_IN, print_fonts, pyplot, savefig
+from ipmc_asym.plotting import COLUMN_WIDTH_IN, print_fonts, pyplot, savefig, symbols
 
 __all__ = ["plot_uq"]
 
@@ -49,7 +49,7 @@ def plot_uq(result, path) -> str:
         ax.hist(y, bins=bins, density=True, color="C0", alpha=0.75)
         for q in ("q2.5", "q50", "q97.5"):
             ax.axvline(s[q] * f, color="k", ls="--" if q != "q50" else "-", lw=0.9)
-        ax.set_xlabel(axis_label(o, u or "1"))
+        ax.set_xlabel(symbols(axis_label(o, u or "1")))
         # at most four ticks: values such as 0.002345 overlap at matplotlib's default count
         ax.xaxis.set_major_locator(MaxNLocator(4))
         ax.set_ylabel(f"density [1/{u}]" if u else "density")
@@ -58,7 +58,7 @@ def plot_uq(result, path) -> str:
             top = sorted(sob.items(), key=lambda kv: -kv[1]["ST"])[:2]
             ax.set_title(", ".join(f"$S_T$({k}) = {v['ST']:.2f}" for k, v in top), fontsize=8)
         ax.text(0.02, 0.95, f"mean {s['mean'] * f:.4g} {u}\nsd {s['sd'] * f:.3g} {u}", transform=ax.transAxes,
-                va="top", fontsize=7)
+                va="top", fontsize=7, bbox={"facecolor": "white", "edgecolor": "none", "alpha": 0.85, "pad": 1.5})
     for ax in list(axes.flat)[n:]:
         ax.set_visible(False)
     outside = getattr(result, "n_outside", 0)
@@ -70,4 +70,4 @@ def plot_uq(result, path) -> str:
                  "\ndashed: 2.5 / 97.5 %, solid: median (thickness = total $2e$)", fontsize=8, wrap=True)
     print_fonts(fig)
     fig.tight_layout()
-    return savefig(fig, path, dpi=110)
+    return savefig(fig, path, dpi=300)  # print resolution when the file is a PNG
