@@ -5,7 +5,7 @@ from __future__ import annotations
 from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import add_material_options, first_run_notice, print_citations
 from ipmc_asym.forward.model import CHECKS
-from ipmc_asym.io.fileio import check_output_path
+from ipmc_asym.io.fileio import FIGURE_FORMATS, check_output_path
 from ipmc_asym.io.jsonio import dumps
 from ipmc_asym.studies.design import INPUTS, OUTPUTS, design, load_spec
 
@@ -19,7 +19,8 @@ def register(sub):
     p.add_argument("spec", metavar="SPEC.toml", help="design specification (examples/design_blocking_force.toml)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--plot", default=None, metavar="F.png",
-                   help="the Pareto front of [pareto] (default: tip_deflection vs blocking_force, 200 points)")
+                   help=f"the Pareto front of [pareto] (default: tip_deflection vs blocking_force, 200 points); "
+                        f"format from the extension ({', '.join(FIGURE_FORMATS)})")
     add_material_options(p)
     p.set_defaults(material=None)
 
@@ -37,7 +38,7 @@ def _fmt(v, unit):
 
 def run(args) -> int:
     if args.plot:
-        check_output_path(args.plot, "file", "--plot")
+        check_output_path(args.plot, "file", "--plot", formats=FIGURE_FORMATS)
     spec = load_spec(args.spec)
     if args.material is not None:
         spec["material"] = args.material
