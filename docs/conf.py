@@ -20,6 +20,8 @@ extensions = [
     "sphinx.ext.autosummary",
     "numpydoc",
     "sphinx.ext.mathjax",
+    # MathJax copied into _static and loaded from there: equations render without a network
+    "sphinx-mathjax-offline",
     "sphinx_gallery.gen_gallery",
     "myst_parser",
 ]
@@ -41,12 +43,17 @@ exclude_patterns = ["_build", "**.ipynb_checkpoints", "auto_examples/*.ipynb", "
                     "auto_examples/*.zip", "auto_examples/*.json", "sg_execution_times.rst"]
 templates_path = []
 html_static_path = ["_static"]
-html_theme = "alabaster"
+# furo: code blocks with a readable contrast that scroll rather than cut, a content column wide
+# enough for the command tables
+html_theme = "furo"
+html_title = f"ipmc_asym {release}"
 
 autosummary_generate = True
 autosummary_imported_members = True
 autodoc_default_options = {"members": False}
 autodoc_typehints = "none"
+# signatures as written in the source (``material=NAFION_LI``), not the expanded default object
+autodoc_preserve_defaults = True
 numpydoc_show_class_members = False
 numpydoc_validation_checks = set()
 numpydoc_xref_param_type = False

@@ -46,6 +46,7 @@ COMMANDS = {
     "materials": "materials",
     "design": "design",
     "drive": "drive",
+    "warmup": "warmup",
 }
 
 #: one-line summaries for ``ipmc-asym --help`` without importing every command module
@@ -57,7 +58,7 @@ SUMMARIES = {
     "profiles": "C, phi, D, E, rhoZ, p through the thickness (paper Figs 4-7)",
     "sweep": "evaluate the strip on a grid of parameters",
     "validate": "each claim of the paper vs our numbers, with a verdict",
-    "figures": "regenerate the paper's Figs 4-10 (+ speed/accuracy) as PNG",
+    "figures": "regenerate the paper's Figs 4-10 (+ speed/accuracy) as PDF, SVG or PNG",
     "fit": "calibrate modulus, c_moy, permittivity, D, damping, sheet resistance on deflection/force, time series "
            "and impedance spectra (profile intervals)",
     "uq": "uncertainty quantiles and Sobol' indices of a scene's [uncertain] inputs",
@@ -67,6 +68,7 @@ SUMMARIES = {
     "materials": "the material sets: every value with its unit, source and range",
     "design": "choose length, width, thickness, voltage to meet a target (optimum, active constraints, Pareto front)",
     "drive": "response to any voltage waveform (step, ramp, sine, square, triangle, sums, CSV), streamed",
+    "warmup": "compile every Numba kernel once (later runs load them from the cache)",
 }
 
 

@@ -461,13 +461,38 @@ def sidecar_path(out: str) -> str:
     return out + ".json"
 
 
-def first_run_notice():
-    """Numba compiles on the first run after install: say so instead of hanging silently."""
+#: file in the Numba cache directory that ``ipmc-asym warmup`` writes once every kernel is compiled
+WARM_MARKER = ".ipmc_asym-warm"
+
+
+def first_run_notice(command: str | None = None):
+    """Say on stderr, before the work, that Numba compiles the kernels a command needs the first
+    time it runs after install, instead of hanging silently (one line).
+
+    Quiet once ``ipmc-asym warmup`` has compiled everything, or once ``command`` (a command and the
+    variant whose kernels differ, e.g. ``"step-pnp"``) has run with this cache.
+    """
     from ipmc_asym.kernels.jit import CACHE_DIR  # deferred: loads Numba; only the first-compile notice needs it
 
-    if not (os.path.isdir(CACHE_DIR) and any(f.endswith(".nbi") for _, _, fs in os.walk(CACHE_DIR) for f in fs)):
-        sys.stderr.write("ipmc-asym: compiling the Numba kernels (first run after install, ~10-30 s)...\n")
-        sys.stderr.flush()
+    ran = os.path.join(CACHE_DIR, f".ipmc_asym-ran-{command}") if command else None
+    if os.path.exists(os.path.join(CACHE_DIR, WARM_MARKER)) or (ran is not None and os.path.exists(ran)):
+        return
+    empty = not (os.path.isdir(CACHE_DIR) and any(f.endswith(".nbi") for _, _, fs in os.walk(CACHE_DIR) for f in fs))
+    if ran is None and not empty:
+        return
+    sys.stderr.write("ipmc-asym: compiling the Numba kernels this command needs, once (~20 s; up to ~2 min for "
+                     "the PNP solver on a busy machine); later runs load them from the cache ('ipmc-asym warmup' "
+                     "compiles all of them at once)\n")
+    sys.stderr.flush()
+    if ran is not None:
+        _touch(ran)
+
+
+def _touch(path):
+    with contextlib.suppress(OSError):
+        os.makedirs(os.path.dirname(path), exist_ok=True)
+        with open(path, "a", encoding="utf-8"):
+            pass
 
 
 # ---- the dynamic commands' options (step, drive, freq, fit): one definition each -------------------------

@@ -3,7 +3,14 @@
 from __future__ import annotations
 
 from ipmc_asym.cli import SUMMARIES
-from ipmc_asym.cli.common import add_electrode_options, add_material_options, add_output_option, electrode_spec, print_citations
+from ipmc_asym.cli.common import (
+    add_electrode_options,
+    add_material_options,
+    add_output_option,
+    electrode_spec,
+    first_run_notice,
+    print_citations,
+)
 from ipmc_asym.forward.model import CHECKS
 from ipmc_asym.io.fileio import FIGURE_FORMATS, check_output_path
 from ipmc_asym.io.jsonio import dumps
@@ -20,7 +27,8 @@ def register(sub):
     p.add_argument("spec", metavar="SPEC.toml", help="design specification (examples/design_blocking_force.toml)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     add_output_option(p, "--plot", formats=FIGURE_FORMATS, default=None, metavar="F.png",
-                   help="the Pareto front of [pareto] (default: tip_deflection vs blocking_force, 200 points)")
+                      help=f"the Pareto front of [pareto] (default: tip_deflection vs blocking_force, 200 points); "
+                           f"format from the extension ({', '.join(FIGURE_FORMATS)})")
     add_material_options(p)
     add_electrode_options(p)
     p.set_defaults(material=None)
@@ -51,6 +59,7 @@ def run(args) -> int:
         spec["pareto"] = {"x": "tip_deflection", "y": "blocking_force", "points": 200}
     name = args.spec.rsplit("/", 1)[-1].removesuffix(".toml")
     spec.setdefault("name", name)
+    first_run_notice("design")
     res = design(spec)
     if args.cite:
         print_citations(res.spec.material, json_mode=args.json)

@@ -44,6 +44,17 @@ def register(sub):
                         "a few points run interpreted, the same code and results, without the ~0.5 s load")
 
 
+#: printed under the table: what its columns are (paper's notation; lengths of the strip are TOTAL)
+LEGEND = (
+    "legend: I = the paper's moment integral (dimensionless, M_A = A5 I); M_A = active bending moment; "
+    "theta = tip rotation;",
+    "  w, w_small = tip deflection, large / small displacements; F_block, F_small = blocking force, large / small "
+    "displacements;",
+    "  rel.err = stated relative error of I at the fidelity used; regime = beam regime: small (the small-displacement "
+    "w within 1 %), large (|theta| <= pi/2), past-quarter-turn, multi-turn",
+)
+
+
 def run(args):
     material = material_from_args(args)
     strip = strip_from_args(args)
@@ -98,6 +109,8 @@ def run(args):
               f"{fmt_num(sc(r['w_small'], 1e3), '.4g'):>11s} {fmt_num(sc(r['F_block'], 1e3), '.4g'):>11s} "
               f"{fmt_num(sc(r['F_block_small'], 1e3), '.4g'):>11s} {fmt_num(r['error_estimate'], '8.1e')} "
               f"{r['regime']}")
+    for line in LEGEND:
+        print(line)
     if any(r["escalated"] for r in rows):
         print("* escalated: the requested fidelity is not valid here; the first valid rung was used")
     _print_spread(spread)

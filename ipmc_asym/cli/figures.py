@@ -1,4 +1,5 @@
-"""``ipmc-asym figures``: the paper's Figs 4-10 plus the speed/accuracy plot, as PNG."""
+"""``ipmc-asym figures``: the paper's Figs 4-10 plus the speed/accuracy plot, as PDF (vector, for
+print; ``--format png|svg``)."""
 
 from __future__ import annotations
 
@@ -20,6 +21,8 @@ def register(sub):
                    help="output directory (required: no default that would depend on the working directory; "
                         "only its last level is created)")
     add_size_option(p, "--dpi", default=110, maximum=MAX_DPI, minimum=10, help="resolution in dots per inch (>= 10)")
+    p.add_argument("--format", default="pdf", choices=("pdf", "svg", "png"),
+                   help="file format (default pdf: vector, one column 8.5 cm or a page 17 cm wide, fonts >= 7 pt)")
     p.add_argument("--quick", action="store_true", help="fewer points (for tests)")
     p.add_argument("--bench", default=None, metavar="FILE",
                    help="draw the speed/accuracy plot from a saved `ipmc-asym bench --json` "
@@ -37,7 +40,7 @@ def run(args) -> int:
 
     with new_dir_removed_on_failure(args.out):
         make_output_dir(args.out)
-        out = make_all(args.out, args.dpi, quick=args.quick, bench=bench,
+        out = make_all(args.out, args.dpi, quick=args.quick, bench=bench, fmt=args.format,
                        log=lambda msg: print(f"figures: {msg}", file=sys.stderr, flush=True))
     for f in out["files"]:
         print("wrote", f)

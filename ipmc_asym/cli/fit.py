@@ -14,6 +14,7 @@ from ipmc_asym.cli.common import (
     add_strip_options,
     count_type,
     diffusion_type,
+    first_run_notice,
     fmt_num,
     material_from_args,
     model_help,
@@ -109,6 +110,7 @@ def run(args) -> int:
         material = material.with_(sheet_resistance=args.sheet_resistance)
     strip = strip_from_args(args)
     files = [read_file(d, strip, waveform=args.waveform, max_rows=args.max_rows) for d in args.data]
+    first_run_notice("fit")
     static_only = len(files) == 1 and isinstance(files[0], CalibrationData)
     if static_only:
         for opt, val in (("--waveform", args.waveform), ("--beam", args.beam), ("--time-fidelity", args.time_fidelity)):

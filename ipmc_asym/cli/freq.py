@@ -18,6 +18,7 @@ from ipmc_asym.cli.common import (
     add_support_options,
     arg_type,
     diffusion_type,
+    first_run_notice,
     fmt_num,
     frequency_type,
     material_from_args,
@@ -92,12 +93,16 @@ def run(args):
         raise ValueError("--export models the full-electrode strip (free tip): not with --support clamped-clamped or "
                          "--electrode")
     f = np.geomspace(args.f1, args.f2, args.points)
+    first_run_notice("freq")
     # the library chooses the solver (dynamics.entry.spectrum): the electrode line with --sheet-resistance
     r = spectrum(f, strip, model=args.model, material=material, method=args.method, beam=args.beam,
                  viscous_modulus=args.viscous_modulus, voltage=args.voltage, sheet_resistance=args.sheet_resistance,
                  support=support, electrode=electrode)
-    # phases in degrees, as every phase the commands read or write (drive's sine PHASE_deg, fit's Z_phase)
-    cols = {"f": r.f, "Z_re": r.Z.real, "Z_im": r.Z.imag, "w_amp": r.w_amp, "w_phase": np.degrees(r.w_phase),
+    # phases in degrees, as every phase the commands read or write (drive's sine PHASE_deg, fit's Z_phase);
+    # |Z| (Ohm) and its phase: the impedance-spectrum columns `fit` reads (Z_im < 0, phase < 0 for a
+    # capacitive strip; studies/calibrate_dynamic.py)
+    cols = {"f": r.f, "Z_re": r.Z.real, "Z_im": r.Z.imag, "Z_abs": np.abs(r.Z), "Z_phase": np.angle(r.Z, deg=True),
+            "w_amp": r.w_amp, "w_phase": np.degrees(r.w_phase),
             "theta_amp": np.abs(r.H_theta), "theta_phase": np.angle(r.H_theta, deg=True),
             "F_amp": np.abs(r.H_F), "F_phase": np.angle(r.H_F, deg=True)}
     if r.error is not None:
@@ -111,7 +116,8 @@ def run(args):
             "error_max": None if r.error is None else r.error_max,
             "reference": "pnp-linear (exact linearised Nernst-Planck/Gauss)",
             "electrode_area": strip.width * strip.length, "diffusion_coefficient": material.D,
-            "units": {"f": "Hz", "Z": "Ohm (strip, electrode area 2l L)", "w_amp": "m/V", "w_phase": "deg",
+            "units": {"f": "Hz", "Z": "Ohm (strip, electrode area 2l L)", "Z_abs": "Ohm", "Z_phase": "deg",
+                      "w_amp": "m/V", "w_phase": "deg",
                       "theta_amp": "rad/V (free tip)", "theta_phase": "deg", "F_amp": "N/V (blocked tip)",
                       "F_phase": "deg", "error": "relative, of Z and w against pnp-linear"},
             "notes": r.notes + [f"about phi0 = {args.voltage:g} V; w from the layers' charge, small displacements"]}
@@ -154,12 +160,16 @@ def run(args):
               + (f"; clamped-clamped {', '.join(f'{v:.4g}' for v in head['resonances']['clamped-clamped'])} Hz"
                  if clamped else ""))
     ecol = "error" in cols
-    print(f"{'f [Hz]':>11s} {'Z_re [Ohm]':>12s} {'Z_im [Ohm]':>12s} {'|w|/V [mm/V]':>13s} {'phase [deg]':>11s}"
-          + (f" {'error':>9s}" if ecol else ""))
+    print(f"{'f [Hz]':>11s} {'Z_re [Ohm]':>12s} {'Z_im [Ohm]':>12s} {'Z_abs [Ohm]':>12s} {'Z_phase [deg]':>13s} "
+          f"{'|w|/V [mm/V]':>13s} {'phase [deg]':>11s}" + (f" {'error':>9s}" if ecol else ""))
     for i in range(f.size):
         print(f"{fmt_num(f[i], '11.4g')} {fmt_num(cols['Z_re'][i], '12.5g')} {fmt_num(cols['Z_im'][i], '12.5g')} "
+              f"{fmt_num(cols['Z_abs'][i], '12.5g')} {fmt_num(cols['Z_phase'][i], '13.4g')} "
               f"{fmt_num(cols['w_amp'][i] * 1e3, '13.5g')} {fmt_num(cols['w_phase'][i], '11.4g')}"
               + (f" {fmt_num(cols['error'][i], '9.2g')}" if ecol else ""))
+    print("legend: Z = impedance of the strip (electrode area 2l L), Z_abs and Z_phase as `fit` reads them; "
+          "|w|/V, phase = free-tip deflection per volt and its phase against the voltage"
+          + ("; error = relative error of Z and w against pnp-linear" if ecol else ""))
     if clamped:  # amplitudes per volt
         print_clamped("f [Hz]", f, {n: cols[f"{n}_amp"] for n in CLAMPED_OUTPUTS}, per="/V")
     for n in head["notes"]:

@@ -25,6 +25,8 @@ def register(sub):
                    help="output directory for the CSV and PNG files (only its last level is created); without it "
                         "the layer summary is printed and no file is written")
     p.add_argument("--json", action="store_true", help="print the layer summary as JSON")
+    p.add_argument("--format", default="png", choices=("png", "pdf", "svg"),
+                   help="file format of the figures with --out (pdf, svg: vector; default png)")
 
 
 def run(args) -> int:
@@ -42,7 +44,7 @@ def run(args) -> int:
 
         with new_dir_removed_on_failure(args.out):
             make_output_dir(args.out)
-            out = write_all(args.out, models, strip, mat)
+            out = write_all(args.out, models, strip, mat, fmt=args.format)
     if args.json:
         print(dumps(out, indent=2))
         return 0

@@ -187,7 +187,7 @@ def run(args):
     if args.diffusion is not None:
         material = material.with_(D=args.diffusion)
     strip = strip_from_args(args)
-    first_run_notice()
+    first_run_notice("step-pnp" if args.fidelity == "pnp" or args.tol is not None else "step")
     models = list(model_names()) if args.model == "all" else [args.model]
     # the library chooses the solver (dynamics.entry.time_path): rows streamed to --out where a stepped
     # path serves, the in-memory solve otherwise

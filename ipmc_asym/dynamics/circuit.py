@@ -70,6 +70,7 @@ from ipmc_asym.kernels.charge_time import integrate_circuit
 from ipmc_asym.model import groups
 from ipmc_asym.model.electrode import beam_label
 from ipmc_asym.model.params import (
+    D_CATION_DEFAULT,
     D_CATION_SOURCE,
     NAFION_LI,
     Material,
@@ -100,11 +101,31 @@ DYNAMIC_NOTES = (
 BEAM_CHOICES = ("quasi-static", "dynamic")
 
 
-def dynamic_notes(beam="quasi-static", viscous_modulus=0.0, material: Material | None = None):
-    """The notes every dynamic output carries (water transport out of scope, beam model, D source;
-    the composite section when ``material`` carries electrode layers)."""
+def diffusion_note(diffusion=None):
+    """The note on the cation diffusion coefficient actually used.
+
+    Parameters
+    ----------
+    diffusion : float, optional
+        ``D`` of the run (m^2/s); ``None`` or the library default gives the default's source
+        (:data:`~ipmc_asym.model.params.D_CATION_SOURCE`), any other value is said as given.
+    """
+    if diffusion is None or float(diffusion) == D_CATION_DEFAULT:
+        return DYNAMIC_NOTES[2]
+    return (f"the cation diffusion coefficient D is not in the paper; D = {float(diffusion):g} m^2/s as given "
+            f"(--diffusion, the material or the fit), not the library's assumed {D_CATION_DEFAULT:g} m^2/s; "
+            "every dynamic time scales as 1/D")
+
+
+def dynamic_notes(beam="quasi-static", viscous_modulus=0.0, material: Material | None = None, diffusion=None):
+    """The notes every dynamic output carries (water transport out of scope, beam model, the D used:
+    :func:`diffusion_note`, from ``material.D`` unless ``diffusion`` is given; the composite section
+    when ``material`` carries electrode layers)."""
+    if diffusion is None and material is not None:
+        diffusion = material.D
     check_choice("beam", beam, BEAM_CHOICES)
     notes = list(DYNAMIC_NOTES)
+    notes[2] = diffusion_note(diffusion)
     if beam == "dynamic":
         notes[1] = INERTIA_NOTE + f"; viscous modulus {float(viscous_modulus):g} Pa s"
         notes.append(VISCOUS_MODULUS_SOURCE)

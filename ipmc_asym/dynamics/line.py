@@ -380,7 +380,7 @@ def line_response(f, *, strip: Strip | None = None, model="constant", material: 
         if xs.size * g.size > MAX_PROFILE_POINTS:
             raise ValueError(f"x: {xs.size} positions x {g.size} frequencies exceed {MAX_PROFILE_POINTS} profile values")
         prof = voltage_profile(g[:, None], xs[None, :] / L)
-    notes = dynamic_notes(beam, viscous_modulus) + list(u.notes[len(dynamic_notes()):]) + [
+    notes = dynamic_notes(beam, viscous_modulus, m) + list(u.notes[len(dynamic_notes(material=m)):]) + [
         f"electrodes: sheet resistance R_s = {Rs:g} Ohm/sq each, in series along the length (r = 2 R_s/(2l)); "
         "the voltage decays along x as an RC line driven at the clamp; the moment follows the local voltage "
         + ("(small displacements, quasi-static beam)" if beam == "quasi-static" else

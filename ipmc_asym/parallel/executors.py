@@ -11,7 +11,7 @@ whatever runs it:
     ``concurrent.futures`` process pool (spawn) with the same settings;
 ``"tcp://HOST:PORT"``
     an existing dask scheduler (``dask scheduler`` + ``dask worker`` started elsewhere,
-    see README "Running on a Dask cluster");
+    see docs/dask.md);
 a ``distributed.Client``
     used as is (the tests give one on their own ``LocalCluster``).
 

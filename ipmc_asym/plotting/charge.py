@@ -7,7 +7,7 @@ import numpy as np
 from ipmc_asym.dynamics.circuit import frequency_response, step_response, time_constant
 from ipmc_asym.dynamics.electrode import charge
 from ipmc_asym.model.params import NAFION_LI, Strip
-from ipmc_asym.plotting import MODEL_COLOURS, MODEL_MARKERS, model_style, pyplot, savefig
+from ipmc_asym.plotting import MODEL_COLOURS, MODEL_MARKERS, PAGE_WIDTH_IN, model_style, print_fonts, pyplot, savefig
 
 __all__ = ["plot_charge_capacitance", "plot_step", "plot_bode"]
 
@@ -20,7 +20,7 @@ def plot_charge_capacitance(path, strip: Strip | None = None, material=NAFION_LI
     plt = pyplot()
     v = np.linspace(0.0, 3.0, 301)
     vb = np.array([0.05, 0.5, 1.0, 2.0, 3.0])
-    fig, (a1, a2) = plt.subplots(1, 2, figsize=(10, 4))
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(PAGE_WIDTH_IN, 2.8))
     for m in MODELS3:
         r = charge(s.thickness, v, m, "corrected", material=material)
         c = MODEL_COLOURS[m]
@@ -40,6 +40,7 @@ def plot_charge_capacitance(path, strip: Strip | None = None, material=NAFION_LI
     for a in (a1, a2):
         a.grid(alpha=0.3)
         a.legend()
+    print_fonts(fig)
     fig.tight_layout()
     return savefig(fig, path, dpi=110)
 
@@ -49,7 +50,7 @@ def plot_step(path, voltage=1.0, strip: Strip | None = None, material=NAFION_LI)
     s = Strip() if strip is None else strip
     plt = pyplot()
     tau = float(time_constant(s.thickness, "constant", material))
-    fig, (a1, a2) = plt.subplots(1, 2, figsize=(10, 4))
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(PAGE_WIDTH_IN, 2.8))
     for m, c in MODEL_COLOURS.items():
         tm = float(time_constant(s.thickness, m, material))
         rc = step_response(voltage, 6 * tm, strip=s, model=m, material=material, points=600)
@@ -67,6 +68,7 @@ def plot_step(path, voltage=1.0, strip: Strip | None = None, material=NAFION_LI)
     for a in (a1, a2):
         a.grid(alpha=0.3)
         a.legend(fontsize=7)
+    print_fonts(fig)
     fig.tight_layout()
     del tau
     return savefig(fig, path, dpi=110)
@@ -76,7 +78,7 @@ def plot_bode(path, strip: Strip | None = None, material=NAFION_LI) -> str:
     """|Z|, arg Z and |w|/V, arg w: exact linearised PNP (lines) and the circuit (dashed)."""
     s = Strip() if strip is None else strip
     plt = pyplot()
-    fig, ax = plt.subplots(2, 2, figsize=(10, 6), sharex=True)
+    fig, ax = plt.subplots(2, 2, figsize=(PAGE_WIDTH_IN, 4.4), sharex=True)
     for m in ("constant", "affine"):
         tau = float(time_constant(s.thickness, m, material))
         f = np.geomspace(1e-3 / tau, 1e4 / tau, 300)
@@ -101,5 +103,6 @@ def plot_bode(path, strip: Strip | None = None, material=NAFION_LI) -> str:
     ax[0, 0].legend(fontsize=7)
     ax[0, 0].set_title("impedance about 0 V")
     ax[0, 1].set_title("tip deflection / voltage (layers' moment)")
+    print_fonts(fig)
     fig.tight_layout()
     return savefig(fig, path, dpi=110)

@@ -2,9 +2,16 @@
 
 from __future__ import annotations
 
-from ipmc_asym.plotting import pyplot, savefig
+import numpy as np
+
+from ipmc_asym.plotting import COLUMN_WIDTH_IN, print_fonts, pyplot, savefig
 
 __all__ = ["plot_design"]
+
+#: short axis names of the design outputs (the paper's symbols)
+_SHORT = {"tip_deflection": "tip deflection $|w|$", "blocking_force": "blocking force $|F|$",
+          "rotation": r"tip rotation $|\theta|$", "moment": "moment $|M_A|$", "I": "moment integral $I$",
+          "work": "work $|F|\\,|w|$", "max_strain": "largest strain", "first_resonance": "first resonance"}
 
 #: display scale of each output's unit
 _SCALE = {"m": (1e3, "mm"), "N": (1e3, "mN"), "N m": (1e6, "µN m"), "rad": (1.0, "rad"), "1": (1.0, "")}
@@ -31,18 +38,27 @@ def plot_design(result, path) -> str:
     x = [p["outputs"][xn] * fx for p in result.pareto]
     y = [p["outputs"][yn] * fy for p in result.pareto]
     th = [p["inputs"]["thickness"] * 1e6 for p in result.pareto]
-    fig, ax = plt.subplots(figsize=(6.4, 4.6))
-    sc = ax.scatter(x, y, c=th, s=12, cmap="viridis")
-    fig.colorbar(sc, ax=ax, label="total thickness 2e [µm]")
+    fig, ax = plt.subplots(figsize=(COLUMN_WIDTH_IN, 2.9))
+    spread = (max(th) - min(th)) / max(th)
+    if spread > 0.02:
+        sc = ax.scatter(x, y, c=th, s=8, cmap="viridis")
+        fig.colorbar(sc, ax=ax, label="total thickness $2e$ [µm]")
+        same = ""
+    else:  # a colour bar over a sliver (e.g. 397.5-400 µm) would suggest a variation that is not there
+        ax.scatter(x, y, s=8, color="C0")
+        same = f"; $2e$ = {np.median(th):.4g} µm along the front"
     o = result.optimum["outputs"]
     if o.get(xn) is not None and o.get(yn) is not None:
-        ax.plot([abs(o[xn]) * fx], [abs(o[yn]) * fy], "r*", ms=14,
-                label=f"optimum: {result.objective['sense']} {result.objective['name']}")
-        ax.legend(loc="best", fontsize=9)
-    ax.set_xlabel(f"|{xn}| [{ux}]")
-    ax.set_ylabel(f"|{yn}| [{uy}]")
+        name = result.objective["name"]
+        ax.plot([abs(o[xn]) * fx], [abs(o[yn]) * fy], "r*", ms=10, mec="k", mew=0.5,
+                label=f"optimum: {result.objective['sense']} {_SHORT.get(name, name)}")
+        ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.2), fontsize=7, frameon=False)  # off the front
+    ax.margins(0.08)  # the optimum, often at an end of the front, stays inside the axes
+    ax.set_xlabel(f"{_SHORT.get(xn, xn)} [{ux}]" if ux else _SHORT.get(xn, xn))
+    ax.set_ylabel(f"{_SHORT.get(yn, yn)} [{uy}]" if uy else _SHORT.get(yn, yn))
     ax.grid(alpha=0.3)
-    ax.set_title(f"Pareto front ({len(result.pareto)} points), model {sp.model}, material {sp.material.name}",
-                 fontsize=10)
+    ax.set_title(f"Pareto front ({len(result.pareto)} points), model {sp.model},\nmaterial {sp.material.name}{same}",
+                 fontsize=8)
+    print_fonts(fig)
     fig.tight_layout()
-    return savefig(fig, path, dpi=110)
+    return savefig(fig, path, dpi=300)  # print resolution when the file is a PNG

@@ -22,7 +22,7 @@ import numpy as np
 from ipmc_asym.base.registry import model_names
 from ipmc_asym.forward.model import flag_mask
 from ipmc_asym.model.params import NAFION_LI, Material, Strip
-from ipmc_asym.plotting import MODEL_COLOURS, model_style, pyplot, savefig
+from ipmc_asym.plotting import COLUMN_WIDTH_IN, MODEL_COLOURS, MODEL_MARKERS, check_figure_format, model_style, print_fonts, pyplot, savefig
 from ipmc_asym.plotting.profiles import write_all
 from ipmc_asym.plotting.speed import plot_speed_accuracy
 from ipmc_asym.studies.profiles import compute_all
@@ -34,20 +34,20 @@ MODELS3 = model_names()
 
 #: variable -> (values SI, axis scale to display, axis label, file stem, paper fig)
 INFLUENCE = {
-    "length": (np.linspace(0.005, 0.04, 36), 1e2, "length L (cm)", "influence_length", 8),
-    "thickness": (np.linspace(50e-6, 400e-6, 36), 1e6, "TOTAL thickness 2e (µm)", "influence_thickness", 9),
+    "length": (np.linspace(0.005, 0.04, 36), 1e2, "length $L$ (cm)", "influence_length", 8),
+    "thickness": (np.linspace(50e-6, 400e-6, 36), 1e6, "TOTAL thickness $2e$ (µm)", "influence_thickness", 9),
     # dense at small voltage as well: I(phi0) changes regime around 0.1 V (Debye-Hueckel ->
     # layers); drawn on a linear axis as the paper (whose "approximately linear" is read
     # there) and on a log axis below it
     "voltage": (np.unique(np.concatenate([np.geomspace(0.01, 3.0, 60), np.linspace(0.05, 3.0, 60)])), 1.0,
                 r"voltage $\varphi_0$ (V)", "influence_voltage", 10),
-    "width": (np.linspace(1e-3, 10e-3, 19), 1e3, "TOTAL width 2l (mm)", "influence_width", None),
+    "width": (np.linspace(1e-3, 10e-3, 19), 1e3, "TOTAL width $2l$ (mm)", "influence_width", None),
 }
 
 #: the three panels: (row key, small-displacement key, display factor, axis label, title)
-_PANELS = (("w", "w_small", 1e3, "tip deflection |w| (mm)", "(a) deflection"),
-           ("F_block", None, 1e3, r"blocking force $|F^p|$ (mN)", "(b) blocking force"),
-           ("theta", None, 1.0, r"rotation $|\theta|$ (rad)", "(c) rotation"))
+_PANELS = (("w", "w_small", 1e3, "$|w|$ (mm)", "(a) tip deflection"),
+           ("F_block", None, 1e3, r"$|F^p|$ (mN)", "(b) blocking force"),
+           ("theta", None, 1.0, r"$|\theta|$ (rad)", "(c) tip rotation"))
 
 
 def _si(value: float, unit: str) -> str:
@@ -77,8 +77,12 @@ def influence_figure(var, path, base: Strip | None = None, material: Material = 
     base = Strip() if base is None else base
     arr = withhold(sweep({var: vals}, list(MODELS3), "quadrature", base, material))
     rows = 2 if var == "voltage" else 1
-    fig, axs = plt.subplots(rows, 3, figsize=(13, 3.6 * rows + 0.6), dpi=dpi, squeeze=False)
+    # print layout: the three panels stacked, one column wide (8.5 cm); the voltage figure has a
+    # second column (log voltage axis) and is a page-width figure (17 cm)
+    fig, axs = plt.subplots(3, rows, figsize=(COLUMN_WIDTH_IN * rows, 5.9), dpi=dpi, squeeze=False)
+    axs = axs.T  # axs[r, k]: axis row r (linear / log voltage), panel k
     ymax = [0.0, 0.0, 0.0]
+    drawn = {"dotted": False, "quarter": False}
     every = max(1, len(vals) // 8)
     for m in MODELS3:
         a = arr[arr["model"] == m]
@@ -92,27 +96,32 @@ def influence_figure(var, path, base: Strip | None = None, material: Material = 
             ok = ~flag_mask(lambda c: a["check_" + c], q)
             # the dotted part joins the solid one: it starts at the last point inside
             edge = ok & (np.roll(~ok, 1) | np.roll(~ok, -1))
+            ys = None if qs is None else np.where(ok, np.abs(a[qs]) * fac, np.nan)
             for ax in axs[:, k]:
                 ax.plot(x, np.where(ok, y, np.nan), **model_style(m, line=False, marker=True, markevery=every))
-                if (~ok).any():
+                if (~ok & np.isfinite(y)).any():
                     ax.plot(x, np.where(~ok | edge, y, np.nan), ":", color=MODEL_COLOURS[m], lw=1.3)
-                if qs is not None:
-                    ax.plot(x, np.where(ok, np.abs(a[qs]) * fac, np.nan), "--", color=MODEL_COLOURS[m],
-                            lw=0.8, alpha=0.7)
+                    drawn["dotted"] = True
+                if ys is not None:
+                    # dashed, with the model's marker filled: told apart in grayscale too
+                    ax.plot(x, ys, "--", color=MODEL_COLOURS[m], lw=0.8, marker=MODEL_MARKERS[m], ms=3,
+                            markevery=(every // 2, every))
                 if k == 0 and free_ok.any() and (~free_ok).any():
                     cross = np.flatnonzero(np.diff(free_ok.astype(int)))
                     for c in cross:
-                        ax.axvline(x[c + 1], color=MODEL_COLOURS[m], lw=0.7, ls=":", alpha=0.8)
-            if np.any(ok & np.isfinite(y)):
-                ymax[k] = max(ymax[k], float(np.nanmax(np.where(ok, y, np.nan))))
+                        ax.axvline(x[c + 1], color=MODEL_COLOURS[m], lw=0.7, ls=(0, (1, 3)))
+                        drawn["quarter"] = True
+            # the axis holds every curve drawn, the dotted and the small-displacement ones too
+            for v in (y, ys):
+                if v is not None and np.any(np.isfinite(v)):
+                    ymax[k] = max(ymax[k], float(np.nanmax(v)))
     for r in range(rows):
         for k, (_q, _qs, _f, lab, title) in enumerate(_PANELS):
             ax = axs[r, k]
             ax.set_ylabel(lab)
-            ax.set_xlabel(xlabel + (", log axis" if r == 1 else ""))
+            ax.set_xlabel(xlabel)
             ax.grid(True, alpha=0.3)
-            if r == 0:
-                ax.set_title(title, fontsize=9)
+            ax.set_title(title + (", log voltage axis" if r == 1 else ""), fontsize=8)
             if ymax[k] > 0:
                 ax.set_ylim(0.0, 1.15 * ymax[k] if k < 2 else max(1.15 * ymax[k], 1.7))
         axs[r, 2].axhline(np.pi / 2, color="k", lw=0.6, ls="--")
@@ -121,27 +130,29 @@ def influence_figure(var, path, base: Strip | None = None, material: Material = 
             ax.set_xlim(0.0, None)
         for ax in axs[1]:
             ax.set_xscale("log")
+    # legend entries only for what is drawn (a handle's style is that of its curves)
     handles = [Line2D([], [], label=m, **model_style(m, line=False, marker=True)) for m in MODELS3]
-    handles += [Line2D([], [], color="0.35", ls="--", lw=0.8, label="small displacement, eq. (13)"),
-                Line2D([], [], color="0.35", ls=":", lw=1.3,
-                       label="a model assumption fails (e.g. past a quarter turn, strain above the limit): kept, dotted"),
-                Line2D([], [], color="0.35", ls=":", lw=0.7, marker="|", ms=10,
-                       label="free strip reaches a quarter turn"),
-                Line2D([], [], color="k", ls="--", lw=0.6, label="θ = π/2")]
+    handles += [Line2D([], [], color="0.35", ls="--", lw=0.8, label="small displacement, eq. (13)")]
+    if drawn["dotted"]:
+        handles.append(Line2D([], [], color="0.35", ls=":", lw=1.3, label="model assumption fails (kept)"))
+    if drawn["quarter"]:
+        handles.append(Line2D([], [], color="0.35", ls=(0, (1, 3)), lw=0.7, label="free strip at a quarter turn"))
+    handles.append(Line2D([], [], color="k", ls="--", lw=0.6, label="θ = π/2 (panel c)"))
     # one legend for the figure, below the panels: never on a curve
-    fig.legend(handles=handles, loc="lower center", ncol=4, fontsize=8, frameon=False)
-    fixed = {"L": f"{base.length * 100:g} cm", "2l": f"{base.width * 1e3:g} mm",
-             "2e": f"{base.thickness * 1e6:g} µm", "φ0": f"{base.voltage:g} V"}
-    fixed.pop({"length": "L", "width": "2l", "thickness": "2e", "voltage": "φ0"}[var])
-    t = f"Influence of {var}" + (f" (paper Fig. {fig_no})" if fig_no else "") + "; fixed " + \
-        ", ".join(f"{k} = {v}" for k, v in fixed.items()) + f", E = {_si(material.E, 'Pa')}"
-    fig.suptitle(t, fontsize=10)
-    fig.tight_layout(rect=(0, 0.1 / rows, 1, 1))
+    fig.legend(handles=handles, loc="lower center", ncol=2, fontsize=7, frameon=False)
+    fixed = {"$L$": f"{base.length * 100:g} cm", "$2l$": f"{base.width * 1e3:g} mm",
+             "$2e$": f"{base.thickness * 1e6:g} µm", r"$\varphi_0$": f"{base.voltage:g} V"}
+    fixed.pop({"length": "$L$", "width": "$2l$", "thickness": "$2e$", "voltage": r"$\varphi_0$"}[var])
+    t = f"Influence of {var}" + (f" (paper Fig. {fig_no})" if fig_no else "") + ";\nfixed " + \
+        ", ".join(f"{k} = {v}" for k, v in fixed.items()) + f", $E$ = {_si(material.E, 'Pa')}"
+    fig.suptitle(t, fontsize=8)
+    print_fonts(fig)
+    fig.tight_layout(rect=(0, 0.12, 1, 1))
     return savefig(fig, path)
 
 
 def make_all(out_dir="figures", dpi=110, base: Strip | None = None, material: Material = NAFION_LI,
-             quick=False, bench=None, log=None) -> dict:
+             quick=False, bench=None, log=None, fmt="png") -> dict:
     """Write the paper's figures (Figs 4-10) and the speed/accuracy plot: ``ipmc-asym figures``.
 
     Parameters
@@ -149,7 +160,7 @@ def make_all(out_dir="figures", dpi=110, base: Strip | None = None, material: Ma
     out_dir : str or path
         Directory of the PNG and CSV files (created if missing).
     dpi : int
-        Resolution of the PNGs.
+        Resolution of the PNGs (and of the raster parts of a vector file).
     base : Strip, optional
         The strip the curves vary about (default: the nominal strip; lengths TOTAL).
     material : Material
@@ -161,11 +172,13 @@ def make_all(out_dir="figures", dpi=110, base: Strip | None = None, material: Ma
         that step); without it the figure is skipped with a note.
     log : callable, optional
         Called with one progress line per figure (the CLI prints them on stderr).
+    fmt : {"png", "pdf", "svg"}
+        File format of the figures (``pdf`` and ``svg``: vector, for print).
 
     Returns
     -------
     dict
-        ``{"files": [PNG paths], "notes": [str], "layers": [layer widths per model]}``.
+        ``{"files": [figure paths], "notes": [str], "layers": [layer widths per model]}``.
 
     Examples
     --------
@@ -176,6 +189,7 @@ def make_all(out_dir="figures", dpi=110, base: Strip | None = None, material: Ma
     ['influence_length.png', 'influence_thickness.png', 'influence_voltage.png']
     """
     log = log or (lambda msg: None)
+    check_figure_format(fmt)
     n_total = 2 + len(INFLUENCE) + (0 if quick or bench is None else 1)
     step = iter(range(1, n_total + 1))
     os.makedirs(out_dir, exist_ok=True)
@@ -184,23 +198,23 @@ def make_all(out_dir="figures", dpi=110, base: Strip | None = None, material: Ma
     log(f"[{next(step)}/{n_total}] profiles through the thickness (BVP, 3 models)")
     results = compute_all(strip=base, material=material)
     log(f"[{next(step)}/{n_total}] profile figures (Figs 4-7)")
-    out = write_all(out_dir, strip=base, material=material, dpi=dpi, results=results)
-    files += [f for f in out["files"] if f.endswith(".png")]
+    out = write_all(out_dir, strip=base, material=material, dpi=dpi, results=results, fmt=fmt)
+    files += [f for f in out["files"] if f.endswith("." + fmt)]
     for var, spec in INFLUENCE.items():
         log(f"[{next(step)}/{n_total}] influence of {var}")
         vals = spec[0][::3] if quick else None
-        p = os.path.join(out_dir, spec[3] + ".png")
+        p = os.path.join(out_dir, f"{spec[3]}.{fmt}")
         influence_figure(var, p, base, material, dpi, values=vals)
         files.append(p)
     if quick:
-        notes.append("speed_accuracy.png skipped in quick mode")
+        notes.append(f"speed_accuracy.{fmt} skipped in quick mode")
     elif bench is None:
-        notes.append("speed_accuracy.png skipped: no bench result (the `bench` command is not installed; "
+        notes.append(f"speed_accuracy.{fmt} skipped: no bench result (the `bench` command is not installed; "
                      "--bench FILE draws a saved `bench --json`)")
     else:
         measure = callable(bench)
         log(f"[{next(step)}/{n_total}] speed/accuracy " + ("(quick in-process measurement)" if measure else
                                                          "(from the saved bench)"))
         res = bench() if measure else bench
-        files.append(plot_speed_accuracy(res, os.path.join(out_dir, "speed_accuracy.png")))
+        files.append(plot_speed_accuracy(res, os.path.join(out_dir, f"speed_accuracy.{fmt}")))
     return {"files": files, "notes": notes, "layers": out["summaries"]}

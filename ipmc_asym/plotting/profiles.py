@@ -8,7 +8,7 @@ import numpy as np
 
 from ipmc_asym.base.registry import model_names
 from ipmc_asym.model.params import NAFION_LI, Material, Strip
-from ipmc_asym.plotting import model_style, pyplot, savefig
+from ipmc_asym.plotting import COLUMN_WIDTH_IN, check_figure_format, model_style, print_fonts, pyplot, savefig
 from ipmc_asym.studies.profiles import QUANTITIES, compute_all, profile_summary, write_csv
 
 __all__ = ["plot_profiles", "write_all"]
@@ -17,8 +17,9 @@ __all__ = ["plot_profiles", "write_all"]
 #: about as much room as each decade above it (asinh scale), so the layers at the faces, some
 #: 1e-4 e thick or less, are seen next to the neutral core instead of as spikes at z = +-1
 STRETCH_D0 = 1e-4
-#: left edge of the zoom panels (distance from the face, µm)
-ZOOM_MIN_UM = 1e-4
+#: left edge of the zoom panels (distance from the face, µm): 1 nm, the continuum scale (a few
+#: Nafion ionic clusters, ~4-5 nm, are the smallest structure the model averages over)
+ZOOM_MIN_UM = 1e-3
 
 
 def _stretch(z):
@@ -58,7 +59,8 @@ def plot_profiles(results: dict, quantity: str, path, e: float, dpi: int = 110, 
     """
     plt = pyplot()
     attr, label = QUANTITIES[quantity]
-    fig, axs = plt.subplots(1, 3, figsize=(13, 4.2), dpi=dpi)
+    # print layout: the three panels stacked, one column (8.5 cm) wide
+    fig, axs = plt.subplots(3, 1, figsize=(COLUMN_WIDTH_IN, 6.6), dpi=dpi)
     log_y = quantity == "E"
     grid = np.geomspace(ZOOM_MIN_UM, e * 1e6, 400)
     panel_max = [0.0, 0.0, 0.0]
@@ -80,15 +82,15 @@ def plot_profiles(results: dict, quantity: str, path, e: float, dpi: int = 110, 
                 panel_max[k] = max(panel_max[k], float(np.nanmax(y[keep])))
     axs[0].set_xscale("function", functions=(_stretch, _unstretch))
     ticks = [-1.0, -0.999, -0.99, -0.9, 0.0, 0.9, 0.99, 0.999, 1.0]
-    axs[0].set_xticks(ticks, [f"{t:g}" for t in ticks], fontsize=7)
+    axs[0].set_xticks(ticks, [f"{t:g}" for t in ticks], fontsize=7, rotation=45)
     axs[0].set_xlim(-1.0, 1.0)
     axs[0].set_xlabel(r"$\bar z = z/e$ ($e$ = HALF thickness = %.4g µm)" % (e * 1e6))
-    axs[0].set_title("full thickness, stretched near the faces (asinh scale)", fontsize=9)
+    axs[0].set_title("full thickness, stretched near the faces", fontsize=8)
     for ax, side in ((axs[1], "anode ($\\bar z=-1$)"), (axs[2], "cathode ($\\bar z=+1$)")):
         ax.set_xscale("log")
         ax.set_xlim(ZOOM_MIN_UM, e * 1e6)
-        ax.set_xlabel(f"distance from the {side.split(' ')[0]} face (µm, log)")
-        ax.set_title(f"zoom at the {side}", fontsize=9)
+        ax.set_xlabel(f"distance from the {side.split(' ')[0]} face (µm)")
+        ax.set_title(f"zoom at the {side}, from 1 nm (continuum scale)", fontsize=8)
     if quantity == "C":
         axs[2].set_yscale("log")
     if log_y:
@@ -101,15 +103,18 @@ def plot_profiles(results: dict, quantity: str, path, e: float, dpi: int = 110, 
     for ax in axs:
         ax.set_ylabel(label)
         ax.grid(True, alpha=0.3)
-    axs[0].legend(fontsize=8)
-    fig.suptitle(title or f"{quantity} profile through the thickness (nominal strip, full BVP)", fontsize=10)
+    axs[0].legend(fontsize=7)
+    fig.suptitle(title or f"{quantity} profile through the thickness (nominal strip, full BVP)", fontsize=8, wrap=True)
+    print_fonts(fig)
     fig.tight_layout()
     savefig(fig, path)
 
 
 def write_all(out_dir, models=model_names(), strip: Strip | None = None, material: Material = NAFION_LI,
-              dpi: int = 110, quantities=tuple(QUANTITIES), results=None) -> dict:
-    """CSV per model + one PNG per quantity; returns {"summaries": [...], "files": [...]}."""
+              dpi: int = 110, quantities=tuple(QUANTITIES), results=None, fmt: str = "png") -> dict:
+    """CSV per model + one figure per quantity (``fmt``: png, pdf or svg); returns
+    ``{"summaries": [...], "files": [...]}``."""
+    check_figure_format(fmt)
     strip = Strip() if strip is None else strip
     os.makedirs(out_dir, exist_ok=True)
     results = compute_all(models, strip, material) if results is None else results
@@ -120,11 +125,12 @@ def write_all(out_dir, models=model_names(), strip: Strip | None = None, materia
         files.append(p)
     figno = {"C": 4, "phi": 5, "D": 6, "p": 7}
     for q in quantities:
-        p = os.path.join(out_dir, f"profile_{q}.png")
+        p = os.path.join(out_dir, f"profile_{q}.{fmt}")
         t = f"{q} profile (paper Fig. {figno[q]})" if q in figno else f"{q} profile"
+        t += "\n"
         plot_profiles(results, q, p, strip.e, dpi=dpi,
-                      title=f"{t}: L={strip.length*100:g} cm, 2e={strip.thickness*1e6:g} µm, "
-                            f"phi0={strip.voltage:g} V, full BVP")
+                      title=f"{t}$L$ = {strip.length*100:g} cm, $2e$ = {strip.thickness*1e6:g} µm, "
+                            f"$\\varphi_0$ = {strip.voltage:g} V, full BVP")
         files.append(p)
     sums = [profile_summary(m, strip, material, res=r) for m, r in results.items()]
     return {"summaries": sums, "files": files}

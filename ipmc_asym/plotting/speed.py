@@ -11,7 +11,7 @@ from __future__ import annotations
 import json
 
 from ipmc_asym.base.inputs import read_input_text
-from ipmc_asym.plotting import MODEL_COLOURS, pyplot, savefig
+from ipmc_asym.plotting import COLUMN_WIDTH_IN, MODEL_COLOURS, print_fonts, pyplot, savefig
 
 __all__ = ["plot_speed_accuracy", "load_bench", "ERR_FLOOR"]
 
@@ -47,13 +47,13 @@ def plot_speed_accuracy(res: dict, path) -> str:
     from matplotlib.lines import Line2D  # deferred: matplotlib is heavy and only figures need it
 
     markers = {"leading": "o", "corrected": "s", "quadrature": "^", "exact": "P", "bvp": "D"}
-    fig, ax = plt.subplots(figsize=(7.5, 5.2))
+    fig, ax = plt.subplots(figsize=(COLUMN_WIDTH_IN, 3.6))
     for r in res["results"]:
         x, y = r["seconds_per_point_serial"], r["rel_error_max"]
         if x is None or y is None or r["fidelity"] not in markers:
             continue
         ax.scatter([x], [max(y, ERR_FLOOR)], marker=markers[r["fidelity"]], color=MODEL_COLOURS.get(r["model"], "k"),
-                   s=70, edgecolor="k", linewidth=0.6, zorder=3)
+                   s=30, edgecolor="k", linewidth=0.5, zorder=3)
     for f, t in res.get("targets", {}).items():
         ax.axvline(t["seconds_per_point"], color="0.6", ls=":", lw=0.8)
         ax.text(t["seconds_per_point"], 0.5, f" target time of {f}", rotation=90, fontsize=7, color="0.4",
@@ -62,12 +62,15 @@ def plot_speed_accuracy(res: dict, path) -> str:
     ax.set_yscale("log")
     ax.set_xlabel("time per point, single thread [s]")
     ax.set_ylabel("max relative error of I vs the BVP\n(BVP: its stated estimate; floor %.0e)" % ERR_FLOOR)
-    ax.set_title(f"moment integral: speed vs accuracy ({res['points']:.0e} points, "
-                 f"{res['bvp_points']} BVP points per model)", fontsize=10)
+    ax.set_title(f"moment integral: speed vs accuracy\n({res['points']:.0e} points, "
+                 f"{res['bvp_points']} BVP points per model)", fontsize=8)
     ax.grid(True, which="major", alpha=0.3)
     h = [Line2D([], [], ls="", marker=m, color="0.3", label=f) for f, m in markers.items()]
     h += [Line2D([], [], ls="", marker="o", color=c, label=m) for m, c in MODEL_COLOURS.items()]
-    h += [Line2D([], [], ls=":", color="0.6", label="target time per point")]
-    ax.legend(handles=h, loc="best", fontsize=8, ncol=2)
+    if res.get("targets"):
+        h += [Line2D([], [], ls=":", color="0.6", label="target time per point")]
+    # below the axes: never on a point
+    ax.legend(handles=h, loc="upper center", bbox_to_anchor=(0.5, -0.28), fontsize=7, ncol=3, frameon=False)
+    print_fonts(fig)
     fig.tight_layout()
-    return savefig(fig, path, dpi=120)
+    return savefig(fig, path, dpi=300)  # print resolution when the file is a PNG

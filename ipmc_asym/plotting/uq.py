@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ipmc_asym.base.quantities import axis_label
-from ipmc_asym.plotting import pyplot, savefig
+from ipmc_asym.plotting import COLUMN_WIDTH_IN, print_fonts, pyplot, savefig, symbols
 
 __all__ = ["plot_uq"]
 
@@ -31,9 +31,9 @@ def plot_uq(result, path) -> str:
 
     outs = list(result.outputs)
     n = len(outs)
-    cols = min(n, 3)
+    cols = min(n, 2)
     rows = -(-n // cols)
-    fig, axes = plt.subplots(rows, cols, figsize=(4.6 * cols, 3.4 * rows), squeeze=False)
+    fig, axes = plt.subplots(rows, cols, figsize=(COLUMN_WIDTH_IN * cols, 2.4 * rows + 0.8), squeeze=False)
     for ax, o in zip(axes.flat, outs):
         s = result.summary[o]
         f, u = _SCALE.get(s["unit"], (1.0, s["unit"]))
@@ -43,10 +43,13 @@ def plot_uq(result, path) -> str:
         if valid is not None and not getattr(result, "keep_invalid", True):
             y = y[valid]
         y = y[np.isfinite(y)]
-        ax.hist(y, bins=80, density=True, color="C0", alpha=0.75)
+        # numpy's "auto" rule (the larger of Sturges and Freedman-Diaconis: ~10 bins at 256
+        # samples), at most 50
+        bins = min(50, max(1, len(np.histogram_bin_edges(y, "auto")) - 1)) if y.size else 10
+        ax.hist(y, bins=bins, density=True, color="C0", alpha=0.75)
         for q in ("q2.5", "q50", "q97.5"):
             ax.axvline(s[q] * f, color="k", ls="--" if q != "q50" else "-", lw=0.9)
-        ax.set_xlabel(axis_label(o, u or "1"))
+        ax.set_xlabel(symbols(axis_label(o, u or "1")))
         # at most four ticks: values such as 0.002345 overlap at matplotlib's default count
         ax.xaxis.set_major_locator(MaxNLocator(4))
         # density=True: counts per unit of the (scaled) output
@@ -54,9 +57,9 @@ def plot_uq(result, path) -> str:
         sob = result.sobol.get(o)
         if sob:
             top = sorted(sob.items(), key=lambda kv: -kv[1]["ST"])[:2]
-            ax.set_title(", ".join(f"S_T({k}) = {v['ST']:.2f}" for k, v in top), fontsize=9)
-        ax.text(0.02, 0.95, f"mean {s['mean'] * f:.4g}\nsd {s['sd'] * f:.3g}", transform=ax.transAxes,
-                va="top", fontsize=8)
+            ax.set_title(", ".join(f"$S_T$({k}) = {v['ST']:.2f}" for k, v in top), fontsize=8)
+        ax.text(0.02, 0.95, f"mean {s['mean'] * f:.4g} {u}\nsd {s['sd'] * f:.3g} {u}", transform=ax.transAxes,
+                va="top", fontsize=7, bbox={"facecolor": "white", "edgecolor": "none", "alpha": 0.85, "pad": 1.5})
     for ax in list(axes.flat)[n:]:
         ax.set_visible(False)
     outside = getattr(result, "n_outside", 0)
@@ -65,6 +68,7 @@ def plot_uq(result, path) -> str:
     stored = getattr(result, "n_stored", result.n_samples)
     hist = f"; histogram of the first {stored}" if stored < result.n_samples else ""
     fig.suptitle(f"UQ of scene {result.scene!r} [{result.model}]: {result.n_samples} runs{note}{hist}"
-                 "\ndashed: 2.5 / 97.5 %, solid: median (thickness = total 2e)", fontsize=10)
+                 "\ndashed: 2.5 / 97.5 %, solid: median (thickness = total $2e$)", fontsize=8, wrap=True)
+    print_fonts(fig)
     fig.tight_layout()
-    return savefig(fig, path, dpi=110)
+    return savefig(fig, path, dpi=300)  # print resolution when the file is a PNG

@@ -204,6 +204,10 @@ def parse_spec(spec: dict, name: str = "design") -> DesignSpec:
             kind, vals = ("range", v["range"]) if "range" in v else ("choices", v["choices"])
         elif isinstance(v, list):
             kind, vals = ("range" if len(v) == 2 else "choices"), v
+            if len(v) == 2:
+                # a bare pair reads as [low, high]; two choices need {choices = [a, b]}
+                notes.append(f"{where} = {v!r} is read as a range [low, high]; write "
+                             f"{{range = [...]}} or {{choices = [...]}} to say which")
         else:
             raise ValueError(f"{where} must be [low, high] or a list of choices; got {v!r}")
         if not isinstance(vals, list) or not vals:

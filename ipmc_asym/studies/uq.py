@@ -205,6 +205,40 @@ def _transform(u, dist, vals):
     return np.where(u < c, left, right)
 
 
+def central_value(dist, vals) -> float:
+    """The nominal value of one uncertain input: the mean (normal), median (lognormal), midpoint
+    (uniform) or mode (triangular), SI."""
+    if dist == "normal" or dist == "lognormal":
+        return float(vals[0])
+    if dist == "uniform":
+        return 0.5 * (vals[0] + vals[1])
+    return float(vals[1])
+
+
+def check_nominal(model, material, base, unc, tol, fidelity=None):
+    """Refuse, before any sampling, a scene whose nominal point is outside the model.
+
+    The nominal point is the scene's fixed inputs with each ``[uncertain]`` input at its
+    :func:`central_value`; it goes through the same forward model as the samples.
+
+    Raises
+    ------
+    ValueError
+        One line naming the failed checks and the nominal inputs.
+    """
+    point = dict(base)
+    for k, (dist, vals) in unc.items():
+        point[k] = central_value(dist, vals)
+    cols = {k: np.array([float(v)]) for k, v in point.items()}
+    _, _, checks, warns = evaluate_samples(cols, (), model, material, tol, fidelity)
+    failed = [c for c, ok in checks.items() if not bool(ok[0])]
+    if failed:
+        shown = ", ".join(f"{k} = {point[k]:.4g}" for k in unc)
+        raise ValueError(f"uq: the nominal point ({shown}) is outside the model: failed check(s) {', '.join(failed)}"
+                         + (f" ({warns[0]})" if warns else "") + "; move the distributions inside the model or pass "
+                         "keep_invalid (--keep-invalid)")
+
+
 # ---- evaluation ------------------------------------------------------------------------------
 def evaluate_samples(cols: dict, outputs, model, material, tol, fidelity=None):
     """Outputs at sample columns (SI arrays of one length); returns (dict of arrays, fidelity
@@ -732,6 +766,8 @@ def run_uq(scene, samples: int = 10**6, *, seed: int = 0, fidelity: str | None =
     if isinstance(sketch_k, bool) or not isinstance(sketch_k, (int, np.integer)) or sketch_k < 2:
         raise ValueError(f"sketch_k must be an integer >= 2; got {sketch_k!r}")
     name, model, material, base, unc, outputs, tol = _scene_parts(scene)
+    if not keep_invalid:  # minutes of sampling would end in a refusal: say so first
+        check_nominal(model, material, base, unc, tol, fidelity)
     names = list(unc)
     D = len(names)
     base_n = 1 << max(1, math.ceil(math.log2(max(samples / (D + 2), 2))))

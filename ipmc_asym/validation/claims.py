@@ -1,4 +1,4 @@
-"""The numbers the README and docs/design.md state about the toolkit itself, measured afresh.
+"""The numbers the documentation pages and docs/design.md state about the toolkit itself, measured afresh.
 
 Every number of the documentation's tables on accuracy and validity (the fidelity ladder, the
 ceilings, the thinnest strips each rung serves, the nominal predictions, the laws' ranges) and
@@ -154,7 +154,7 @@ def exact_vs_bvp(thicknesses=(1e-6, 10e-6, 200e-6, 10e-3), voltages=(1e-4, 1.0, 
 
 
 def nominal_predictions(strip: Strip | None = None) -> dict:
-    """w, w_p (mm), F^p (mN), theta (rad) at the nominal strip, quadrature (README's slip-3 table)."""
+    """w, w_p (mm), F^p (mN), theta (rad) at the nominal strip, quadrature (docs/paper_choices.md, slip 3)."""
     s = Strip() if strip is None else strip
     out = {}
     for m in model_names():
@@ -194,7 +194,7 @@ def api_returns_flagged(thickness=1e-6, voltage=1.0) -> dict:
 
 
 def laws_numbers() -> dict:
-    """The README's numbers on the laws: spans where I ~ 1/e and I ~ phi0^(1/2) hold, exponents at 10 um."""
+    """The numbers of docs/fidelity.md on the laws: spans where I ~ 1/e and I ~ phi0^(1/2) hold, exponents at 10 um."""
     out = {}
     for m in model_names():
         r = law_ranges(m)

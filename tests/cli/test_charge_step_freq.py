@@ -3,6 +3,7 @@
 import csv
 import json
 
+import numpy as np
 import pytest
 
 from ipmc_asym.cli import main
@@ -99,3 +100,25 @@ def test_charge_tiny_voltages(capsys):
     assert main(["charge", "--model", "constant", "--voltage=5e-324"]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and "voltage" in err
+
+
+def test_freq_z_abs_phase_read_by_fit(capsys, tmp_path):
+    """freq's Z_abs (Ohm) and Z_phase (deg) written as a spectrum file are what the dynamic fit reads,
+    and its model at the same strip predicts them (the fit's forward model is the line, freq's the
+    uniform strip: equal with ideal electrodes)."""
+    from ipmc_asym.model.params import NAFION_LI, Strip
+    from ipmc_asym.studies.calibrate_dynamic import _impedance_columns, predict_impedance, read_file
+
+    assert main(["freq", "--from", "0.1Hz", "--to", "10kHz", "--points", "7", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["units"]["Z_abs"] == "Ohm" and out["units"]["Z_phase"] == "deg"
+    path = tmp_path / "spectrum.csv"
+    path.write_text("f,Z_abs,Z_phase\n" + "".join(f"{f!r},{a!r},{p!r}\n" for f, a, p in
+                                                    zip(out["f"], out["Z_abs"], out["Z_phase"])), encoding="utf-8")
+    data = read_file(path)
+    pred = _impedance_columns(predict_impedance({}, data, Strip(), "constant", NAFION_LI), data)
+    np.testing.assert_allclose(data.measured["Z_abs"], pred["Z_abs"], rtol=1e-9)
+    np.testing.assert_allclose(data.measured["Z_phase"], pred["Z_phase"], atol=1e-9)
+    # and they are |Z| and arg Z of the Z_re, Z_im columns
+    Z = np.array(out["Z_re"]) + 1j * np.array(out["Z_im"])
+    np.testing.assert_allclose(out["Z_phase"], np.degrees(np.angle(Z)), atol=1e-12)

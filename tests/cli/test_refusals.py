@@ -668,3 +668,40 @@ def test_no_output_path_defaults_to_the_working_directory(tmp_path, monkeypatch,
     assert main(["profiles", "--model", "constant"]) == 0
     assert "no files written" in capsys.readouterr().out
     assert list(tmp_path.iterdir()) == []
+
+
+def test_first_compile_notice_once_per_command(monkeypatch, tmp_path, capsys):
+    """With kernels of other commands in the cache, a command's first run still says that it
+    compiles (once); after `warmup` marked the cache, nothing is said."""
+    import ipmc_asym.kernels.jit as jit
+    from ipmc_asym.cli.common import WARM_MARKER, first_run_notice
+
+    cache = tmp_path / "cache"
+    (cache / "sub").mkdir(parents=True)
+    (cache / "sub" / "k.nbi").write_text("")  # another command's kernels
+    monkeypatch.setattr(jit, "CACHE_DIR", str(cache))
+    first_run_notice("step-pnp")
+    assert "compiling the Numba kernels" in capsys.readouterr().err
+    first_run_notice("step-pnp")
+    first_run_notice()  # a non-empty cache: the command-less notice stays quiet
+    assert capsys.readouterr().err == ""
+    (cache / WARM_MARKER).write_text("")
+    first_run_notice("fit")
+    assert capsys.readouterr().err == ""
+
+
+def test_warmup_runs_each_group_and_marks_the_cache(monkeypatch, tmp_path, capsys):
+    import ipmc_asym.cli.warmup as warmup
+    import ipmc_asym.kernels.jit as jit
+    from ipmc_asym.cli import main
+    from ipmc_asym.cli.common import WARM_MARKER, first_run_notice
+
+    ran = []
+    monkeypatch.setattr(jit, "CACHE_DIR", str(tmp_path / "cache"))
+    monkeypatch.setattr(warmup, "_steps", lambda: [("a", lambda: ran.append("a")), ("b", lambda: ran.append("b"))])
+    assert main(["warmup", "--json"]) == 0
+    cap = capsys.readouterr()
+    assert ran == ["a", "b"] and set(json.loads(cap.out)["seconds"]) == {"a", "b"} and "[2/2] b" in cap.err
+    assert (tmp_path / "cache" / WARM_MARKER).exists()
+    first_run_notice("step-pnp")
+    assert capsys.readouterr().err == ""

@@ -194,3 +194,15 @@ def test_first_resonance_objective_against_a_grid():
     best = np.max(np.where(ok, first_resonance(L, 5e-3, T, NAFION_LI), -np.inf))
     assert f_opt >= best * (1 - 1e-6)
     assert abs(abs(r.optimum["outputs"]["tip_deflection"]) - 1e-3) <= 1e-6  # the constraint is active
+
+
+def test_a_bare_pair_is_a_range_with_a_note():
+    """Two bare values are a range (as before) and say so; {range}/{choices} say which and add no note."""
+    base = {"strip": {"width": "5mm", "voltage": "1V"}, "objective": {"maximize": "blocking_force"}}
+    bare = parse_spec({**base, "vary": {"length": ["1cm", "4cm"]}})
+    assert bare.ranges["length"][:2] == (0.01, 0.04)
+    assert any("vary.length" in n and "read as a range" in n for n in bare.notes)
+    for v in ({"range": ["1cm", "4cm"]}, {"choices": ["1cm", "4cm"]}):
+        sp = parse_spec({**base, "vary": {"length": v}})
+        assert not any("read as a range" in n for n in sp.notes)
+    assert parse_spec({**base, "vary": {"length": {"choices": ["1cm", "4cm"]}}}).choices["length"] == (0.01, 0.04)

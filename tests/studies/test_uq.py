@@ -259,3 +259,22 @@ def test_peak_memory_does_not_grow_with_samples():
         peaks.append(tracemalloc.get_traced_memory()[1])
         tracemalloc.stop()
     assert peaks[1] < 1.5 * peaks[0], peaks
+
+
+def test_nominal_point_outside_the_model_is_refused_before_sampling(monkeypatch):
+    """A 6 cm strip at 1 V turns past a quarter turn (evaluate says so, independently of uq): uq
+    refuses at once, naming the check, without sampling; --keep-invalid samples it anyway."""
+    import ipmc_asym.studies.uq as uqmod
+
+    sc = _scene({"length": {"dist": "uniform", "low": "5.5cm", "high": "6.5cm"}}, ["rotation"])
+    row = evaluate(Strip(length=0.06, width=5e-3), "constant", "leading", NAFION_LI)
+    assert not row["checks"]["beam_regime"]
+    calls = []
+    monkeypatch.setattr(uqmod, "imap_chunks", lambda *a, **k: calls.append(a) or iter(()))
+    with pytest.raises(ValueError, match=r"nominal point \(length = 0\.06\).*beam_regime"):
+        run_uq(sc, 64, fidelity="leading")
+    assert calls == []
+    inside = _scene({"length": {"dist": "uniform", "low": "1.5cm", "high": "2.5cm"}}, ["rotation"])
+    uqmod.check_nominal("constant", NAFION_LI, {"length": 0.02, "width": 5e-3, "thickness": 200e-6, "voltage": 1.0,
+                                                "modulus": NAFION_LI.E, "c_moy": NAFION_LI.C_moy},
+                        parse_uncertain(inside["uncertain"]), 1e-2, "leading")

@@ -1,4 +1,5 @@
-"""The numbers README.md and docs/design.md state about the toolkit, against fresh measurements.
+"""The numbers the documentation pages (docs/*.md) and docs/design.md state about the toolkit, against
+fresh measurements.
 
 Each test reads a table row or sentence of the documents, parses its numbers, and compares them
 with :mod:`ipmc_asym.validation.claims` (errors against the ``exact`` rung, the registry, the
@@ -15,7 +16,9 @@ import pytest
 from ipmc_asym.validation import claims as cl
 
 ROOT = Path(__file__).resolve().parents[2]
-README = " ".join((ROOT / "README.md").read_text(encoding="utf-8").split())
+# the reference pages: README.md is the landing page, the numbers live in docs/*.md, one place each
+PAGES = sorted(p for p in (ROOT / "docs").glob("*.md") if p.name != "design.md")
+PAGES_TEXT = " ".join(" ".join(p.read_text(encoding="utf-8").split()) for p in PAGES)
 DESIGN_TEXT = (ROOT / "docs" / "design.md").read_text(encoding="utf-8")
 DESIGN = " ".join(DESIGN_TEXT.split())
 MODELS = ("constant", "linear", "affine")
@@ -100,23 +103,23 @@ def test_design_cites_no_missing_expected_failure():
         assert any("strict=True" in p.read_text(encoding="utf-8") for p in (ROOT / "tests").rglob("test_*.py"))
 
 
-# --- README: the fidelity ladder and where the closed forms serve -------------------------------
+# --- docs/fidelity.md: the fidelity ladder and where the closed forms serve -------------------------------
 def test_readme_fidelity_rows(errors):
-    lo, hi = _find(rf"~{NUM} \(constant\) to {NUM} \(linear\) at nominal", README)
+    lo, hi = _find(rf"~{NUM} \(constant\) to {NUM} \(linear\) at nominal", PAGES_TEXT)
     lead = cl.nominal_errors()
     assert cl.agrees(lo, lead["constant"]) and cl.agrees(hi, lead["linear"])
     nominal, grid = _find(rf"`corrected` \| `λ J1 \+ λ² J2`, closed form \| ≤ {NUM} at nominal \(rounding\); "
-                          rf"≤ {NUM} on 10 µm–4 mm × 1 mV–10 V", README)
+                          rf"≤ {NUM} on 10 µm–4 mm × 1 mV–10 V", PAGES_TEXT)
     assert max(cl.nominal_errors(fidelity="corrected").values()) <= nominal
     worst = max(errors["corrected"][m]["max"] for m in MODELS)
     assert worst <= grid and cl.agrees(grid, worst)
-    (q,) = _find(rf"same as `corrected` to ≤ {NUM} on that grid", README)
+    (q,) = _find(rf"same as `corrected` to ≤ {NUM} on that grid", PAGES_TEXT)
     assert cl.quadrature_vs_corrected() <= q
 
 
 def test_readme_thin_limits(thin):
     la_lo, la_hi, c_lo, c_hi, c20 = _find(
-        rf"Below {NUM}–{NUM} µm \(linear/affine; {NUM}–{NUM} µm for the constant model, {NUM} µm at 20 V\)", README)
+        rf"Below {NUM}–{NUM} µm \(linear/affine; {NUM}–{NUM} µm for the constant model, {NUM} µm at 20 V\)", PAGES_TEXT)
     _thin_limits(la_lo, la_hi, c_lo, c_hi, thin)
     assert max(thin[f]["constant"][20.0] for f in thin) * 1e6 == pytest.approx(c20, abs=0.05)
 
@@ -124,7 +127,7 @@ def test_readme_thin_limits(thin):
 def test_readme_nominal_predictions_table():
     pred = cl.nominal_predictions()
     for m in MODELS:
-        row = re.search(rf"\| {m} \| (−?[\d.]+) mm \| (−?[\d.]+) mm \| ([\d.]+) mN \| (−?[\d.]+) rad \|", README)
+        row = re.search(rf"\| {m} \| (−?[\d.]+) mm \| (−?[\d.]+) mm \| ([\d.]+) mN \| (−?[\d.]+) rad \|", PAGES_TEXT)
         assert row, m
         for key, text in zip(("w", "w_p", "F_p", "theta"), row.groups()):
             stated = float(text.replace("−", "-"))
@@ -138,20 +141,20 @@ def test_readme_nominal_predictions_table():
 def test_readme_laws_paragraph():
     lw = cl.laws_numbers()
     frm, cfrm, ex_l, ex_a = _find(r"from 2e = (\d+) µm to 4 mm for every model \(constant: down to (\d+) µm; at 10 µm the "
-                                  r"linear/affine exponent is −(\d\.\d+)/−(\d\.\d+)\)", README)
+                                  r"linear/affine exponent is −(\d\.\d+)/−(\d\.\d+)\)", PAGES_TEXT)
     assert max(lw[m]["e_law_from_m"] for m in MODELS) * 1e6 <= frm
     assert lw["constant"]["e_law_from_m"] * 1e6 == pytest.approx(cfrm, rel=1e-6)
     assert (round(lw["linear"]["exponent_at_10um"], 2), round(lw["affine"]["exponent_at_10um"], 2)) == (-ex_l, -ex_a)
-    (v_half,) = _find(r"within 0\.05 of 1/2 only above ~(\d+\.\d) V", README)
+    (v_half,) = _find(r"within 0\.05 of 1/2 only above ~(\d+\.\d) V", PAGES_TEXT)
     (start,) = [s[0] for s in lw["constant"]["voltage"]["I ~ phi0^0.5 (large voltage)"]]
     assert round(start, 1) == v_half
-    (v_lin,) = _find(r"`M_A` is independent of φ0 above ~(\d\.\d+) V", README)
+    (v_lin,) = _find(r"`M_A` is independent of φ0 above ~(\d\.\d+) V", PAGES_TEXT)
     (lstart,) = [s[0] for s in lw["linear"]["voltage"]["I ~ phi0^-1 (large voltage)"]]
     assert round(lstart, 2) == v_lin
 
 
 # --- statements of rule: which functions hand back a flagged number ----------------------------
-@pytest.mark.parametrize("text", [README, DESIGN], ids=["README", "design"])
+@pytest.mark.parametrize("text", [PAGES_TEXT, DESIGN], ids=["pages", "design"])
 def test_rule_statements_match_the_api(text):
     flags = cl.api_returns_flagged()
     ret = re.search(r"((?:`\w+`(?:, | and ))*`\w+`) return every number with its `valid` flag", text)
@@ -170,7 +173,7 @@ def test_rule_statements_match_the_api(text):
 @pytest.mark.slow
 def test_exact_against_bvp_as_stated():
     (bound,) = _find(r"≤ (\d\.\d+e-\d+) vs the BVP on 1 µm–10 mm × ±\(1e-4–20\) V", DESIGN)
-    (readme_bound,) = _find(r"`exact` \|.*?\| ≤ (\d\.\d+e-\d+) on 1 µm–10 mm × ±\(1e-4–20\) V, all models", README)
+    (readme_bound,) = _find(r"`exact` \|.*?\| ≤ (\d\.\d+e-\d+) on 1 µm–10 mm × ±\(1e-4–20\) V, all models", PAGES_TEXT)
     assert readme_bound == bound
     r = cl.exact_vs_bvp()
     for m in MODELS:

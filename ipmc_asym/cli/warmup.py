@@ -1,0 +1,103 @@
+"""``ipmc-asym warmup``: compile every Numba kernel once, so that later runs load them from the cache.
+
+Numba compiles a kernel the first time it is called after install (``cache=True``: the machine
+code then lives in the cache directory, ``kernels.jit.CACHE_DIR``).  Each command compiles what
+it needs on its first run; this command calls every compiled path once on a few points (each
+rung of the ladder for the three models, the charge, the circuit and PNP transients, the
+spectrum with the modal beam and the electrode line, a waveform drive, a sweep written to CSV),
+says how long each took, and marks the cache as warm.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import sys
+import tempfile
+import time
+
+from ipmc_asym.cli import SUMMARIES
+from ipmc_asym.cli.common import WARM_MARKER, _touch
+
+
+def register(sub):
+    p = sub.add_parser("warmup", help=SUMMARIES["warmup"],
+                       description="Compile every Numba kernel once (a few minutes on a busy 2-core machine); "
+                                   "later runs of every command load them from the cache.")
+    p.add_argument("--json", action="store_true", help="print {step: seconds} as one JSON object")
+
+
+def _steps():
+    """(label, callable) of each compiled path, cheapest first."""
+    import numpy as np
+
+    import ipmc_asym as ia
+
+    th = np.geomspace(20e-6, 2e-3, 64)  # enough points to run the compiled drivers, not their interpreted twins
+    models = ("constant", "linear", "affine")
+
+    def closed():
+        for m in models:
+            for fid in ("leading", "corrected", "quadrature", "exact"):
+                ia.moment_integral(th, 1.0, model=m, fidelity=fid, on_invalid="nan")
+
+    def forward():
+        ia.sweep({"thickness": th, "voltage": [0.5, 1.0]}, "constant", "quadrature")
+
+    def charge():
+        for m in models:
+            for fid in ("leading", "quadrature", "exact"):
+                ia.charge(th, 1.0, m, fid)
+
+    def transient():
+        ia.step_response(1.0, points=50)
+        ia.step_response(0.1, duration=0.05, points=20, fidelity="pnp")
+
+    def spectrum():
+        f = np.geomspace(1.0, 1e3, 20)
+        ia.frequency_response(f, beam="dynamic")
+        ia.line_response(f, sheet_resistance=2.5)
+
+    def drive():
+        ia.drive_response("sine:0.5V@10Hz", 0.2, 400)
+
+    def sweep_csv():
+        from ipmc_asym.cli import main
+
+        # the command's own report (fits along the axis, warnings) is not the warmup's
+        with tempfile.TemporaryDirectory() as d, open(os.devnull, "w") as null, \
+                contextlib.redirect_stdout(null), contextlib.redirect_stderr(null):
+            main(["sweep", "--vary", "thickness=100um:300um:2000", "--out", os.path.join(d, "w.csv"), "--no-progress"])
+
+    return [("moment integral: leading, corrected, quadrature, exact x 3 models", closed),
+            ("forward model and beam (a sweep)", forward),
+            ("electrode charge", charge),
+            ("charging transient: circuit and PNP solver", transient),
+            ("spectrum: modal beam and electrode line", spectrum),
+            ("waveform drive", drive),
+            ("sweep written to CSV (compiled formatter)", sweep_csv)]
+
+
+def run(args):
+    from ipmc_asym.kernels.jit import CACHE_DIR  # deferred: loads Numba
+
+    steps = _steps()
+    sys.stderr.write(f"ipmc-asym warmup: compiling the kernels of {len(steps)} groups into {CACHE_DIR} "
+                     "(a few minutes on a busy machine; once per install)\n")
+    took = {}
+    for i, (label, fn) in enumerate(steps, 1):
+        sys.stderr.write(f"  [{i}/{len(steps)}] {label} ...\n")
+        sys.stderr.flush()
+        t0 = time.perf_counter()
+        fn()
+        took[label] = time.perf_counter() - t0
+    _touch(os.path.join(CACHE_DIR, WARM_MARKER))
+    if args.json:
+        from ipmc_asym.io.jsonio import dumps
+
+        print(dumps({"cache_dir": CACHE_DIR, "seconds": took}, indent=1))
+        return 0
+    for label, s in took.items():
+        print(f"{s:8.1f} s  {label}")
+    print(f"{sum(took.values()):8.1f} s  in all; the kernels are in {CACHE_DIR}")
+    return 0
