@@ -99,6 +99,11 @@ DYNAMIC_NOTES = (
     "the cation diffusion coefficient D is not in the paper; " + D_CATION_SOURCE,
 )
 BEAM_CHOICES = ("quasi-static", "dynamic")
+#: the beam of every command and entry unless asked otherwise: the paper's quasi-static beam (the moment
+#: of the static problem bends the strip at once).  The dynamic beam adds inertia and a Kelvin-Voigt
+#: damping whose viscous modulus no source gives (default 0: undamped modes that ring for ever and put
+#: the poles of an exported model on the imaginary axis), so it is asked for, not assumed.
+DEFAULT_BEAM = "quasi-static"
 
 
 def diffusion_note(diffusion=None):

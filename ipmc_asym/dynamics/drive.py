@@ -23,6 +23,7 @@ from ipmc_asym.beam.dynamics import CLAMPED_OUTPUTS, natural_frequencies
 from ipmc_asym.beam.statics import solve_beam
 from ipmc_asym.dynamics.circuit import (
     BEAM_CHOICES,
+    DEFAULT_BEAM,
     TIME_MODES,
     BeamDynamics,
     CircuitStepper,
@@ -113,7 +114,7 @@ def _support(support, electrode, strip, Rs):
     return support, el
 
 
-def drive_info(strip: Strip, model, material: Material, beam="dynamic", viscous_modulus=0.0, sheet_resistance=0.0,
+def drive_info(strip: Strip, model, material: Material, beam=DEFAULT_BEAM, viscous_modulus=0.0, sheet_resistance=0.0,
                line_segments=DEFAULT_SEGMENTS, support=None, electrode=None):
     """Header of a run: time constant, R, resonances, notes (what is modelled and what is not)."""
     perm = get_model(model)
@@ -139,7 +140,7 @@ def drive_info(strip: Strip, model, material: Material, beam="dynamic", viscous_
 
 
 def drive_chunks(wave, duration, points, *, strip: Strip | None = None, model="constant",
-                 material: Material | None = None, beam="dynamic", viscous_modulus=0.0, n_modes=TIME_MODES,
+                 material: Material | None = None, beam=DEFAULT_BEAM, viscous_modulus=0.0, n_modes=TIME_MODES,
                  chunk=20_000, sheet_resistance=0.0, line_segments=DEFAULT_SEGMENTS, support=None, electrode=None):
     """Yield dicts of column arrays (:data:`DRIVE_COLUMNS`) over ``points`` equally spaced times in [0, duration].
 
@@ -150,7 +151,9 @@ def drive_chunks(wave, duration, points, *, strip: Strip | None = None, model="c
     duration : float   end time, s
     points : int       output times (2 .. :data:`MAX_DRIVE_POINTS`)
     strip, model, material : as in :func:`ipmc_asym.dynamics.circuit.step_response`
-    beam : {"dynamic", "quasi-static"} ; viscous_modulus : float (Pa s) ; n_modes : int
+    beam : {"quasi-static", "dynamic"}
+        Default :data:`~ipmc_asym.dynamics.circuit.DEFAULT_BEAM` (quasi-static).
+    viscous_modulus : float (Pa s) ; n_modes : int
     chunk : int        rows per chunk (memory ~ chunk, not points)
     sheet_resistance : float
         ``R_s`` of each electrode (Ohm/sq, default 0: the uniform strip, exactly).  > 0: the

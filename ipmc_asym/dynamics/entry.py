@@ -19,6 +19,7 @@ import numpy as np
 from ipmc_asym.base.registry import check_choice
 from ipmc_asym.dynamics.circuit import (
     BEAM_CHOICES,
+    DEFAULT_BEAM,
     FREQ_METHODS,
     STEP_FIDELITIES,
     TIME_MODES,
@@ -34,12 +35,6 @@ from ipmc_asym.dynamics.waveforms import Waveform, parse_waveform
 from ipmc_asym.model.params import NAFION_LI, Material, Strip, check_finite
 
 __all__ = ["DEFAULT_BEAM", "TIME_PATHS", "Drive", "TimeResponse", "time_path", "time_response", "spectrum"]
-
-#: the beam of every command and entry unless asked otherwise: the paper's quasi-static beam (the moment
-#: of the static problem bends the strip at once).  The dynamic beam adds inertia and a Kelvin-Voigt
-#: damping whose viscous modulus no source gives (default 0: undamped modes that ring for ever and put
-#: the poles of an exported model on the imaginary axis), so it is asked for, not assumed.
-DEFAULT_BEAM = "quasi-static"
 
 #: solvers of a time response: ``memory`` (step_response: circuit or PNP, optional tolerance, the dynamic
 #: beam on a refined grid), ``stream`` (the circuit stepped on the output grid, chunk by chunk, memory

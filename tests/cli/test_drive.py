@@ -164,7 +164,7 @@ def test_freq_and_drive_support_and_electrode(tmp_path, capsys):
     d = json.loads(capsys.readouterr().out)
     assert rows[0][-5:] == ["M_root", "M_tip", "F_root", "F_tip", "w_mid"] and all(c in rows[0] for c in d if
                                                                                      c in ("t", "w", "valid"))
-    r = drive_response("step:0.5V", 0.05, 201, support="clamped-clamped", electrode=(0.002, 0.012))
+    r = drive_response("step:0.5V", 0.05, 201, support="clamped-clamped", electrode=(0.002, 0.012), beam="dynamic")
     for c in ("w", "M_root", "F_tip", "w_mid"):
         assert np.allclose([float(x[rows[0].index(c)]) for x in rows[1:]], r[c], rtol=1e-15, atol=0), c
     side = json.loads((tmp_path / "d.csv.json").read_text())

@@ -16,15 +16,15 @@ SPEC = "step:1V+square:0.2V@30Hz"
 
 
 def test_chunks_are_one_run_and_equal_the_step_api():
-    a = drive_response(SPEC, 0.3, 3001, chunk=10**6)
-    b = drive_response(SPEC, 0.3, 3001, chunk=37)
+    a = drive_response(SPEC, 0.3, 3001, chunk=10**6, beam="dynamic")
+    b = drive_response(SPEC, 0.3, 3001, chunk=37, beam="dynamic")
     for k in a:
         assert np.array_equal(a[k], b[k]) or np.max(np.abs(a[k] - b[k])) <= 1e-12 * np.max(np.abs(a[k]))
     s = step_response(t=np.linspace(0, 0.3, 3001), waveform_kind=parse_waveform(SPEC), beam="dynamic")
     for k in ("sigma", "current_density", "M_A", "theta", "w", "F_block"):
         assert np.max(np.abs(a[k] - getattr(s, k))) <= 1e-12 * np.max(np.abs(a[k]))
     # memory: the chunks hold at most `chunk` rows
-    assert max(c["t"].size for c in drive_chunks(SPEC, 0.3, 3001, chunk=500)) <= 501
+    assert max(c["t"].size for c in drive_chunks(SPEC, 0.3, 3001, chunk=500, beam="dynamic")) <= 501
 
 
 def test_damped_slow_drive_ends_at_the_quasi_static_forward_model():
