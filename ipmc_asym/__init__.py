@@ -40,9 +40,12 @@ _LAZY = {
     "run_scene": ("ipmc_asym.studies.scenes", "run_scene"),
     "scene": ("ipmc_asym.studies.scenes", "run_scene"),
     "sweep": ("ipmc_asym.studies.sweeps", "sweep"),
-    # charge and dynamics (charge, step, drive, freq); the dynamic entry's Drive and time
-    # response join this group
-    "charge": ("ipmc_asym.dynamics.electrode", "charge"),
+    # charge and dynamics (charge, step, drive, freq): the dynamic entry (Drive, time_response,
+    # spectrum) makes the choice the commands make; the functions behind it stay public
+    "charge": ("ipmc_asym.integral.charge", "charge"),
+    "Drive": ("ipmc_asym.dynamics.entry", "Drive"),
+    "time_response": ("ipmc_asym.dynamics.entry", "time_response"),
+    "spectrum": ("ipmc_asym.dynamics.entry", "spectrum"),
     "step_response": ("ipmc_asym.dynamics.circuit", "step_response"),
     "frequency_response": ("ipmc_asym.dynamics.circuit", "frequency_response"),
     "drive_response": ("ipmc_asym.dynamics.drive", "drive_response"),
@@ -63,7 +66,7 @@ _LAZY = {
     "BVPResult": ("ipmc_asym.bvp.solver", "BVPResult"),
     "BeamResult": ("ipmc_asym.beam.statics", "BeamResult"),
     "ForwardResult": ("ipmc_asym.forward.model", "ForwardResult"),
-    "ChargeResult": ("ipmc_asym.dynamics.electrode", "ChargeResult"),
+    "ChargeResult": ("ipmc_asym.integral.charge", "ChargeResult"),
     "StepResult": ("ipmc_asym.dynamics.circuit", "StepResult"),
     "FrequencyResult": ("ipmc_asym.dynamics.circuit", "FrequencyResult"),
     "LineResult": ("ipmc_asym.dynamics.line", "LineResult"),

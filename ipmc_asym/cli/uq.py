@@ -72,8 +72,9 @@ def run(args) -> int:
         check_output_path(args.plot, "file", "--plot", formats=FIGURE_FORMATS)
     if args.scheduler is not None:
         check_scheduler(args.scheduler)
+    scene = scene_with_material(args.scene, args)  # read and checked first: a refusal is one line
     first_run_notice()
-    res = run_uq(scene_with_material(args.scene, args), args.samples, seed=args.seed, fidelity=args.fidelity,
+    res = run_uq(scene, args.samples, seed=args.seed, fidelity=args.fidelity,
                  scheduler=args.scheduler, keep_invalid=args.keep_invalid, store_samples=args.store_samples)
     if args.cite and res.material is not None:
         print_citations(res.material, json_mode=args.json)

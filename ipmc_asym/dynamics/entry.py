@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ipmc_asym.base.registry import check_choice
+from ipmc_asym.base.results import Panel, ResultMixin, ResultSpec
 from ipmc_asym.dynamics.circuit import (
     BEAM_CHOICES,
     DEFAULT_BEAM,
@@ -111,8 +112,8 @@ class Drive:
         return f"Drive.step({self.voltage!r})" if self.kind == "step" else f"Drive({self.spec!r})"
 
 
-@dataclass
-class TimeResponse:
+@dataclass(repr=False)
+class TimeResponse(ResultMixin):
     """What :func:`time_response` ran and its rows.
 
     Attributes
@@ -127,7 +128,16 @@ class TimeResponse:
                                 (:data:`ipmc_asym.dynamics.drive.DRIVE_COLUMNS`, checks, line columns)
                                 and ``warnings``, computed as iterated
     columns : dict or None      the stepped paths with ``stream=False``: every row in memory
+
+    Its summary, ``.plot()`` and ``.to_xarray()`` are those of the rows in memory (``result`` or
+    ``columns``); a streamed response has none until it is read.
     """
+
+    _result = ResultSpec("t", "t", ("phi0", "sigma", "current_density", "layer_voltage", "M_A", "theta", "w",
+                                    "F_block", "sigma_error"),
+                         (Panel("t", ("voltage", "layer_voltage")), Panel("t", ("sigma",)), Panel("t", ("w",))),
+                         (), {"phi0": "voltage"})
+    _HEADLINE = ("path",)
 
     path: str
     drive: Drive
@@ -136,6 +146,16 @@ class TimeResponse:
     result: StepResult | None = None
     chunks: Iterator | None = None
     columns: dict | None = field(default=None, repr=False)
+
+    def _arrays(self):
+        if self.result is not None:
+            return self.result._arrays()
+        if self.columns is None:
+            raise ValueError("a streamed time response has no rows in memory: read its chunks, or call "
+                             "time_response(..., stream=False)")
+        spec = self._result
+        cols = {spec.names.get(k, k): np.asarray(self.columns[k]) for k in spec.fields if k in self.columns}
+        return spec.dim, np.asarray(self.columns["t"]), cols
 
 
 def time_path(*, fidelity="circuit", tol=None, beam=DEFAULT_BEAM, sheet_resistance=0.0, support=None,

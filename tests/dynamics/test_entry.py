@@ -128,3 +128,24 @@ def test_the_commands_make_the_entry_s_choice(tmp_path, capsys):
     fout = json.loads(capsys.readouterr().out)
     fref = frequency_response(np.geomspace(0.1, 100.0, 5), strip=Strip(), beam="quasi-static")
     assert fout["beam"] == DEFAULT_BEAM and np.allclose(fout["Z_re"], fref.Z.real, rtol=1e-15, atol=0)
+
+
+def test_time_response_is_a_result_object_of_its_rows():
+    from ipmc_asym.base.quantities import BY_NAME
+
+    s = Strip(thickness=200e-6, voltage=0.5)
+    ref = step_response(0.5, strip=s, points=40)
+    for kw in ({}, {"stream": False, "sheet_resistance": 2.5}):
+        r = time_response(s, points=40, **kw)
+        ds = r.to_xarray()
+        t = ref.t if r.result is not None else r.columns["t"]
+        np.testing.assert_array_equal(ds["t"].values, t)
+        sigma = ref.sigma if r.result is not None else r.columns["sigma"]
+        np.testing.assert_array_equal(ds["sigma"].values, sigma)
+        for name, var in ds.data_vars.items():  # units and long names of the vocabulary
+            assert var.attrs["units"] == BY_NAME[name].unit and var.attrs["long_name"] == BY_NAME[name].long_name
+        fig = r.plot()
+        assert all("[" in ax.get_ylabel() for ax in fig.axes)
+    streamed = time_response(s, points=40, stream=True, sheet_resistance=2.5)
+    with pytest.raises(ValueError, match="streamed"):
+        streamed.to_xarray()
