@@ -15,7 +15,16 @@ import numpy as np
 from ipmc_asym.base.ladder import climb, rungs_from
 from ipmc_asym.base.registry import fidelity_names
 from ipmc_asym.integral.api import check_fidelity
-from ipmc_asym.integral.charge import SUBNORMAL, ChargeResult, accurate, capacitance_scale, charge, charge_scale
+from ipmc_asym.integral.charge import (
+    SUBNORMAL,
+    ChargeResult,
+    accurate,
+    capacitance_scale,
+    charge,
+    charge_at,
+    charge_inputs,
+    charge_scale,
+)
 from ipmc_asym.kernels.charge import CLOSED_TRUNCATION, charge_hat_point
 from ipmc_asym.model import groups
 from ipmc_asym.model.params import NAFION_LI, Material
@@ -37,6 +46,7 @@ def charge_escalated(thickness: float, voltage: float, model="constant", fidelit
     (one line) where no rung from ``fidelity`` up is accurate otherwise.
     """
     check_fidelity(fidelity)
+    args = charge_inputs(thickness, voltage, model, **kw)  # checked once; every rung trusts them
 
     def checks(f, r, idx):
         if bool(accurate(r.error, r.error_C_diff)):
@@ -47,11 +57,10 @@ def charge_escalated(thickness: float, voltage: float, model="constant", fidelit
             return True, ""
         return False, f"error estimates {float(r.error):.2g} / {float(r.error_C_diff):.2g}"
 
-    lad = climb(rungs_from(fidelity_names(), fidelity), lambda f, idx: charge(thickness, voltage, model, f, **kw),
-                checks)
+    lad = climb(rungs_from(fidelity_names(), fidelity), lambda f, idx: charge_at(*args, f), checks)
     if lad.left.size:
         raise ValueError(lad.message(f"thickness (total 2e) {float(thickness):.3g} m, voltage {float(voltage):.3g} V "
-                                     f"(model {get_model(model).name})"))
+                                     f"(model {args[2].name})"))
     return lad.last.result
 
 

@@ -44,7 +44,7 @@ from ipmc_asym.forward.escalation import (
     rung_reason,
     where_point,
 )
-from ipmc_asym.forward.pressure import moment_pressure_escalating
+from ipmc_asym.forward.pressure import pressure_ladder
 from ipmc_asym.integral.api import check_min_thickness, closed_model_id, validity_limit
 from ipmc_asym.integral.samples import moment_samples
 from ipmc_asym.model import groups
@@ -486,7 +486,7 @@ def _forward(length, width, thickness, voltage, req: Request, *, modulus=None, c
     if pressure_term:
         if c_moy is not None:
             raise ValueError("pressure_term: a per-point c_moy is not available with the pressure term")
-        r = moment_pressure_escalating(pairs(th), pairs(v), perm, fidelity, material, tol=tol, escalate=escalate)
+        r = pressure_ladder(pairs(th), pairs(v), req, material)
     elif c_moy is None:
         r = moment_ladder(pairs(th), pairs(v), req, material, progress=False).result()
     else:

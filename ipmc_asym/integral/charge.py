@@ -44,7 +44,7 @@ from ipmc_asym.model import groups
 from ipmc_asym.model.params import NAFION_LI, Material, Strip, check_positive
 from ipmc_asym.model.permittivity import Permittivity, get_model
 
-__all__ = ["ChargeResult", "charge", "charge_scale", "capacitance_scale", "SUBNORMAL"]
+__all__ = ["ChargeResult", "charge", "charge_inputs", "charge_at", "charge_scale", "capacitance_scale", "SUBNORMAL"]
 
 #: largest subnormal magnitude: below it a float carries an absolute rounding of 2^-1075
 SUBNORMAL = 2.2250738585072014e-308
@@ -121,6 +121,12 @@ def charge(thickness, voltage, model="constant", fidelity="corrected", *, width=
         Arrays of the broadcast shape (0-d for scalar inputs), SI.
     """
     check_fidelity(fidelity)
+    return charge_at(*charge_inputs(thickness, voltage, model, width, length, material), fidelity)
+
+
+def charge_inputs(thickness, voltage, model="constant", width=5.0e-3, length=0.02, material: Material | None = None):
+    """The checked arguments of :func:`charge` (one-line ``ValueError`` each): ``(thickness,
+    voltage, perm, width, length, material)``, thickness and voltage broadcast arrays."""
     perm = get_model(model)
     mat = NAFION_LI if material is None else material
     w = check_positive("width (total, 2l)", width, "m")
@@ -132,9 +138,14 @@ def charge(thickness, voltage, model="constant", fidelity="corrected", *, width=
     if not np.all(np.isfinite(v)):
         raise ValueError("voltage must be finite (volts)")
     th, v = np.broadcast_arrays(th, v)
+    check_min_thickness(th)
+    return th, v, perm, w, L, mat
+
+
+def charge_at(th, v, perm: Permittivity, w: float, L: float, mat: Material, fidelity: str) -> ChargeResult:
+    """:func:`charge` on the checked arguments of :func:`charge_inputs` at the rung ``fidelity``."""
     if perm.is_custom and fidelity != "bvp":
         raise ValueError(f"a custom eps(C) needs fidelity 'bvp'; got fidelity {fidelity!r}")
-    check_min_thickness(th)
     if fidelity == "bvp":
         sig, cdv, err, errc, core = _bvp(th, v, perm, mat)
     else:
