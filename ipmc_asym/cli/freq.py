@@ -105,9 +105,9 @@ def run(args):
         raise ValueError("--export models the full-electrode strip (free tip): not with --support clamped-clamped or "
                          "--electrode")
     f = np.geomspace(args.f1, args.f2, args.points)
-    first_run_notice("freq")
     if args.voltage != 0.0 and args.method != "circuit":
         raise ValueError("--voltage (a DC bias) needs --method circuit: pnp-linear is the linearisation about 0 V")
+    first_run_notice("freq")  # after every refusal of the options: a refused command compiles nothing
     if args.sheet_resistance is not None:
         # the electrode line: Z at the clamp, the distributed moment into the quasi-static or modal beam
         r = line_response(f, strip=strip, model=args.model, material=material, method=args.method,

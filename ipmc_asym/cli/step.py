@@ -207,13 +207,15 @@ def run(args):
     if args.diffusion is not None:
         material = material.with_(D=args.diffusion)
     strip = strip_from_args(args)
-    first_run_notice("step-pnp" if args.fidelity == "pnp" or args.tol is not None else "step")
     models = list(model_names()) if args.model == "all" else [args.model]
     if args.sheet_resistance > 0.0:
         for bad, why in ((args.fidelity != "circuit", "--fidelity pnp"), (args.tol is not None, "--tol")):
             if bad:
                 raise ValueError(f"--sheet-resistance with {why}: the electrode line is a ladder of reduced circuits "
                                  f"(its discretisation error is stated); drop {why}")
+    # after every refusal of the options: a refused command compiles nothing
+    first_run_notice("step-pnp" if args.fidelity == "pnp" or args.tol is not None else "step")
+    if args.sheet_resistance > 0.0:
         if not args.out or args.json:
             return _line_in_memory(args, strip, material, models)
         return _stream_csv(args, strip, material, models)
