@@ -67,6 +67,7 @@ _LAZY = {
     "BeamResult": ("ipmc_asym.beam.statics", "BeamResult"),
     "ForwardResult": ("ipmc_asym.forward.model", "ForwardResult"),
     "ChargeResult": ("ipmc_asym.integral.charge", "ChargeResult"),
+    "TimeResponse": ("ipmc_asym.dynamics.entry", "TimeResponse"),
     "StepResult": ("ipmc_asym.dynamics.circuit", "StepResult"),
     "FrequencyResult": ("ipmc_asym.dynamics.circuit", "FrequencyResult"),
     "LineResult": ("ipmc_asym.dynamics.line", "LineResult"),

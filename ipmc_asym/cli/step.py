@@ -35,7 +35,7 @@ from ipmc_asym.dynamics.drive import (
     CHECK_COLUMNS,  # per time point: the forward model's checks, as drive
     LINE_COLUMNS,
 )
-from ipmc_asym.dynamics.entry import time_response
+from ipmc_asym.dynamics.entry import time_path, time_response
 from ipmc_asym.forward.model import CHECKS
 from ipmc_asym.io.fileio import atomic_write, check_output_path
 from ipmc_asym.io.jsonio import dumps
@@ -187,14 +187,18 @@ def run(args):
     if args.diffusion is not None:
         material = material.with_(D=args.diffusion)
     strip = strip_from_args(args)
-    first_run_notice("step-pnp" if args.fidelity == "pnp" or args.tol is not None else "step")
     models = list(model_names()) if args.model == "all" else [args.model]
+    stream = bool(args.out) and not args.json
+    # the choice's refusals first (a refused command compiles nothing), then the first-run notice
+    time_path(fidelity=args.fidelity, tol=args.tol, beam=args.beam, sheet_resistance=args.sheet_resistance,
+              stream=stream)
+    first_run_notice("step-pnp" if args.fidelity == "pnp" or args.tol is not None else "step")
     # the library chooses the solver (dynamics.entry.time_path): rows streamed to --out where a stepped
     # path serves, the in-memory solve otherwise
     resps = {m: time_response(strip, args.waveform, duration=args.duration, points=args.points, model=m,
                               material=material, fidelity=args.fidelity, tol=args.tol, beam=args.beam,
                               viscous_modulus=args.viscous_modulus, sheet_resistance=args.sheet_resistance,
-                              line_segments=args.line_segments, stream=bool(args.out) and not args.json)
+                              line_segments=args.line_segments, stream=stream)
              for m in models}
     path = resps[models[0]].path
     if path == "line" and resps[models[0]].chunks is None:
