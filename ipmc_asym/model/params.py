@@ -423,7 +423,7 @@ def set_thickness(spec):
     """
     if not isinstance(spec, str) or spec in MATERIALS:
         return None
-    s = material_data.read_set(spec) if spec.endswith(".toml") else material_data.load_set(spec, FALLBACK_DEFAULTS)
+    s = (material_data.read_set if spec.endswith(".toml") else material_data.load_set)(spec, FALLBACK_DEFAULTS)
     p = s.parameters.get("thickness")
     if p is None:
         return None

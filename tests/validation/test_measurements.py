@@ -6,11 +6,12 @@ import json
 import math
 
 import pytest
+from references import REPO
 
 from ipmc_asym.cli import main
 from ipmc_asym.forward.model import forward
 from ipmc_asym.model.params import NAFION_LI, named_material
-from ipmc_asym.validation.measurements import MEASUREMENTS, compare, cross_prediction
+from ipmc_asym.validation.measurements import MEASUREMENTS, compare, cross_prediction, to_markdown
 
 
 @pytest.fixture(scope="module")
@@ -49,3 +50,9 @@ def test_cli_json(capsys):
     assert main(["validate", "--measurements", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert len({r["key"] for r in out["measurements"]}) >= 5 and "D" in out["cross_prediction"]
+
+
+def test_docs_page_holds_the_current_table(rows):
+    """docs/measurements.md shows what the code gives (regenerate with validate --measurements --out)."""
+    page = (REPO / "docs" / "measurements.md").read_text(encoding="utf-8")
+    assert to_markdown(rows) in page
