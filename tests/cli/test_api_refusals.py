@@ -78,3 +78,14 @@ def test_solve_beam_withholds_like_evaluate():
     for k in ("F_block", "w", "w_small"):
         assert (row[k] is None) == (getattr(b, k) is None), k
     assert row["F_block"] is None
+
+
+def test_uq_file_with_a_nan_parameter_refused_by_name(tmp_path, capsys):
+    from ipmc_asym.cli import main
+
+    f = tmp_path / "u.toml"
+    f.write_text('name = "n"\noutputs = ["tip_deflection"]\n[uncertain]\n'
+                 'c_moy = {dist = "normal", mean = nan, sd = 60}\n')
+    rc = main(["uq", str(f), "--samples", "128"])
+    err = capsys.readouterr().err
+    assert rc == 2 and err.count("\n") == 1 and "uncertain.c_moy.mean" in err and "finite" in err, err

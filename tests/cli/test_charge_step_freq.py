@@ -92,14 +92,18 @@ def test_charge_below_min_thickness_names_the_limit(capsys):
 
 
 def test_charge_tiny_voltages(capsys):
-    """sigma -> C_d(0) phi0 (not 0, not a constant); a Q below the double range is refused in one line."""
+    """sigma -> C_d(0) phi0 (not 0, not a constant); a Q below the double range is answered with its
+    rounding as the error estimate, flagged not valid, with one warning line."""
     for v in ("1e-300", "-1e-100", "1e-20"):
         assert main(["charge", "--json", "--model", "affine", f"--voltage={v}"]) == 0
         r = json.loads(capsys.readouterr().out)["results"][0]
         assert r["sigma"] / float(v) == pytest.approx(float(charge(200e-6, 0.0, "affine").C_diff), rel=1e-12)
-    assert main(["charge", "--model", "constant", "--voltage=5e-324"]) == 2
-    err = capsys.readouterr().err.strip()
-    assert len(err.splitlines()) == 1 and "voltage" in err
+    assert main(["charge", "--json", "--model", "constant", "--voltage=5e-324"]) == 0
+    cap = capsys.readouterr()
+    r = json.loads(cap.out)["results"][0]
+    assert r["valid"] is False and r["error_estimate"] >= 0.01
+    err = [ln for ln in cap.err.splitlines() if "warning" in ln]
+    assert len(err) == 1 and "subnormal" in err[0]
 
 
 def test_freq_z_abs_phase_read_by_fit(capsys, tmp_path):
