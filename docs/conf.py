@@ -31,7 +31,7 @@ myst_heading_anchors = 3
 
 
 def setup(app):
-    # design.md's machine-readable blocks (```layers, ```studies: read by tests/test_layers.py)
+    # design.md's machine-readable blocks (```layers, ```studies: read by tests/integration/test_layers.py)
     # are plain text to the highlighter
     from pygments.lexers.special import TextLexer
     from sphinx.highlighting import lexers

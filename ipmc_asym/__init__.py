@@ -8,7 +8,7 @@ ia``; lazy: importing the package loads no Numba, SciPy or SymPy): the strip and
 the functions behind the commands and their result types.  The subpackages are internal:
 their modules, names and signatures may change without notice.  One subpackage per concern;
 each imports only the ones before it in this list (the layer rule, ``docs/design.md``,
-checked by ``tests/test_layers.py``)::
+checked by ``tests/integration/test_layers.py``)::
 
     base -> model -> kernels -> bvp -> integral -> beam -> io -> forward -> dynamics
          -> parallel -> studies -> validation -> plotting -> cli
@@ -79,7 +79,7 @@ _LAZY = {
     "QUANTITIES": ("ipmc_asym.base.quantities", "QUANTITIES"),
 }
 
-#: the public API (at most 60 names, ``tests/test_public_face.py``)
+#: the public API (at most 60 names, ``tests/integration/test_public_face.py``)
 __all__ = list(_LAZY)
 
 

@@ -3,7 +3,7 @@
 Every number of the documentation's tables on accuracy and validity (the fidelity ladder, the
 ceilings, the thinnest strips each rung serves, the nominal predictions, the laws' ranges) and
 every statement of rule about what the API returns is produced here, and
-``tests/validation/test_claims.py`` reads the documents and compares each stated number with
+``tests/integration/test_claims.py`` reads the documents and compares each stated number with
 a fresh measurement from this module (``python -m ipmc_asym.validation.claims`` prints them).
 
 References: the fidelity errors are measured against the ``exact`` rung (nothing neglected,

@@ -1,5 +1,5 @@
 """Leading order at nominal, convergence orders, API behaviour (the fidelity contract on a grid:
-tests/integral/test_fidelity_contract.py)."""
+tests/integration/test_fidelity_contract.py)."""
 
 import math
 

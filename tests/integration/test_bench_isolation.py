@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 BENCH = "ipmc_asym_bench"
 
 #: what a plugin command of ``ipmc-asym`` may import besides ``ipmc_asym.__all__``: the CLI's

@@ -11,7 +11,7 @@ import pytest
 
 import ipmc_asym
 
-ROOT = pathlib.Path(__file__).resolve().parents[1]
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 
 
 def _doctests():
