@@ -29,9 +29,9 @@ def register(sub):
 
 def _steps():
     """(label, callable) of each compiled path, cheapest first."""
-    import numpy as np
+    import numpy as np  # deferred: heavy module, start-up (ipmc-asym --help lists warmup)
 
-    import ipmc_asym as ia
+    import ipmc_asym as ia  # deferred: the whole public API (start-up of the other commands)
 
     th = np.geomspace(20e-6, 2e-3, 64)  # enough points to run the compiled drivers, not their interpreted twins
     models = ("constant", "linear", "affine")
@@ -62,7 +62,7 @@ def _steps():
         ia.drive_response("sine:0.5V@10Hz", 0.2, 400)
 
     def sweep_csv():
-        from ipmc_asym.cli import main
+        from ipmc_asym.cli import main  # deferred: cli/__init__ imports this module
 
         # the command's own report (fits along the axis, warnings) is not the warmup's
         with tempfile.TemporaryDirectory() as d, open(os.devnull, "w") as null, \
@@ -93,7 +93,7 @@ def run(args):
         took[label] = time.perf_counter() - t0
     _touch(os.path.join(CACHE_DIR, WARM_MARKER))
     if args.json:
-        from ipmc_asym.io.jsonio import dumps
+        from ipmc_asym.io.jsonio import dumps  # deferred: heavy module, start-up
 
         print(dumps({"cache_dir": CACHE_DIR, "seconds": took}, indent=1))
         return 0

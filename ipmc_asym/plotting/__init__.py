@@ -9,6 +9,7 @@ switched (a notebook user's backend stays as it is) and no figure enters pyplot'
 from __future__ import annotations
 
 import os
+import re
 
 from ipmc_asym.io.fileio import atomic_path
 
@@ -34,8 +35,6 @@ _SYMBOLS = (("M_A", "$M_A$"), ("theta", r"$\theta$"), ("phi0", r"$\varphi_0$"), 
 
 def symbols(label: str) -> str:
     """``label`` with the code names of quantities written as the paper's symbols."""
-    import re
-
     for code, sym in _SYMBOLS:
         label = re.sub(rf"(?<![\w$]){re.escape(code)}(?![\w$])", lambda _m, s=sym: s, label)
     return label
