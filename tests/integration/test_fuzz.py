@@ -219,9 +219,16 @@ def _write(tmp_path, name, text):
 def test_every_command_is_covered():
     """The fuzz covers every command ``ipmc-asym --help`` lists."""
     listed = set(COMMANDS) | set(plugin_commands())
-    covered = set(CHEAP) | set(WRITERS) | {"fit", "uq", "scene", "design"}
+    covered = set(CHEAP) | set(WRITERS) | {"fit", "uq", "scene", "design", "warmup"}
     assert listed <= covered, listed - covered
     assert len(listed) >= 14
+
+
+@pytest.mark.parametrize("argv", [["warmup", "--nope"], ["warmup", "--json", "x"]])
+def test_warmup_refuses_in_one_line(argv):
+    """warmup compiles every kernel (minutes on a cold cache): only its refusals are fuzzed here."""
+    rc, out, err = run_cli(argv)
+    assert rc == 2 and out == "" and len(err.strip().splitlines()) == 1, (rc, err)
 
 
 @FAST

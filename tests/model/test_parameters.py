@@ -67,8 +67,14 @@ def test_every_field_is_a_material_field_and_the_files_spell_it_as_an_alias():
     from ipmc_asym.model.material_data import MATERIAL_FIELDS
     from ipmc_asym.model.params import Material
 
+    from ipmc_asym.model.electrode import Electrode
+
     fields = {f.name for f in dataclasses.fields(Material)}
+    layer_fields = {f.name for f in dataclasses.fields(Electrode)}
     for p in PARAMETERS.values():
+        if p.field is not None and p.field.startswith("electrode."):  # a field of Material.electrode
+            assert "electrode" in fields and p.field.split(".", 1)[1] in layer_fields, p.name
+            continue
         if p.field is not None:
             assert p.field in fields, p.name
             # the material files (material_data) key a parameter by its Material field: the table knows that name
