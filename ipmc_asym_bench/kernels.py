@@ -125,9 +125,13 @@ def startup_time(repeats: int = 3) -> dict:
 
 
 def bvp_sample(model, th, v):
-    """CPU seconds and ``I`` of ``ia.solve_bvp_profile`` on the sample; points where it fails are
-    dropped.  Returns ``(times, I, kept indices)``."""
+    """CPU seconds and ``I`` of ``ia.solve_bvp_profile`` on the sample (after one untimed solve);
+    points where it fails are dropped.  Returns ``(times, I, kept indices)``."""
     times, I, keep = [], [], []
+    try:  # untimed: SciPy's imports and first calls are not a solve's cost
+        ia.solve_bvp_profile(ia.Strip(thickness=float(th[0]), voltage=float(v[0])), model, ia.NAFION_LI)
+    except (ValueError, RuntimeError, FloatingPointError):
+        pass
     for k, (t, u) in enumerate(zip(th, v)):
         t0 = time.process_time()
         try:

@@ -511,10 +511,10 @@ COMPILED_S = {"leading": 4e-8, "corrected": 5e-8, "quadrature": 2.5e-6, "exact":
 PARALLEL_MIN_S = 1e-4
 
 
-def _run_driver(driver, n: int, fidelity: str, args):
-    """``driver(*args)``, or its interpreted twin where :func:`interpret_small` says so; on one
-    Numba thread where the work is below :data:`PARALLEL_MIN_S` (the thread count changes no
-    bit: blocks and points are independent, the counts are integers)."""
+def _run_driver(driver, n: int, fidelity: str, args, parallel: bool = False):
+    """``driver(*args)``, or its interpreted twin where :func:`interpret_small` says so; a
+    ``parallel`` driver on one Numba thread where the work is below :data:`PARALLEL_MIN_S` (the
+    thread count changes no bit: blocks and points are independent, the counts are integers)."""
     cost = _FIDELITY_SPECS[fidelity].interpreted_s
     if _INTERPRET.get() and not driver.signatures and 0.0 < n * cost <= INTERPRET_BUDGET_S:
         try:
@@ -522,7 +522,7 @@ def _run_driver(driver, n: int, fidelity: str, args):
                 return interpreted(driver)(*args)
         except (ArithmeticError, ValueError):  # the compiled code returns inf/NaN there
             pass
-    if n * COMPILED_S.get(fidelity, 0.0) < PARALLEL_MIN_S:
+    if parallel and n * COMPILED_S.get(fidelity, 0.0) < PARALLEL_MIN_S:
         old = numba.get_num_threads()
         if old > 1:
             numba.set_num_threads(1)
@@ -804,7 +804,7 @@ def _fused(thickness, voltage, perm: Permittivity, mat: Material, fidelity: str,
     outs = [a.reshape(-1) for a in extra] if full else [np.empty(0)] * 5
     counts = _run_driver(_sweep_fused, I.size, fidelity, (
         _flat_input(th, shape), _flat_input(v, shape), *_driver_constants(perm, mat, fidelity),
-        I.reshape(-1), *outs, valid.reshape(-1), not full))
+        I.reshape(-1), *outs, valid.reshape(-1), not full), parallel=True)
     return I, valid, extra, counts
 
 
