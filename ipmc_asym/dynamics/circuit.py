@@ -613,6 +613,9 @@ def step_response(voltage=1.0, duration=None, *, strip: Strip | None = None, mod
         # the voltage left across the layers: phi0 minus the ohmic drop of the core (exact at
         # t = 0+ and t -> infinity; the bulk's displacement current is O(lambda) of J)
         u = fun(tgrid) - core_resistance(s.thickness, m) * J
+        # t = 0 is the run's uncharged initial state: the layers hold no charge, so no voltage (phi0 - R J
+        # there evaluates the step's discontinuity, and its current is the rate at a jump)
+        u = np.where(tgrid == 0.0, 0.0, u)
         success, message = r.success, r.message
         extra = dict(extra, **r.extra)
         notes.append("pnp: M_A(t) is the layers' quasi-static moment at the layer voltage phi0 - R J; the moment of the transient "

@@ -451,3 +451,13 @@ def test_small_signal_current_within_its_stated_error_of_the_exact_linearised_cu
         err = np.abs(r.current_density[idx] - ref)
         assert np.all(err <= r.current_error[idx]), (kw, (err / r.current_error[idx]).tolist())
         assert np.max(r.current_error[idx]) <= 0.05 * abs(ref[0])
+
+
+@pytest.mark.parametrize("fidelity", ["circuit", "pnp"])
+def test_deflection_at_t0_is_that_of_uncharged_layers(fidelity):
+    """At t = 0 the run is in its uncharged initial state: the layers carry no charge, so the moment and
+    the deflection are those of 0 V (the linear model printed w(0) = -3.98 mm at 0.5 V, phi0 - R J
+    evaluated at the step's discontinuity)."""
+    r = step_response(0.5, model="linear", points=21, fidelity=fidelity)
+    assert r.layer_voltage[0] == 0.0 and r.w[0] == 0.0 and r.M_A[0] == 0.0
+    assert abs(r.w[-1]) > 1e-3  # the step does bend the strip (m)
