@@ -616,6 +616,14 @@ def step_response(voltage=1.0, duration=None, *, strip: Strip | None = None, mod
         # t = 0 is the run's uncharged initial state: the layers hold no charge, so no voltage (phi0 - R J
         # there evaluates the step's discontinuity, and its current is the rate at a jump)
         u = np.where(tgrid == 0.0, 0.0, u)
+        # and, as in the circuit (CircuitStepper.advance), within the hull of 0 and the voltages applied
+        # so far: the current's rounding noise once charged (~1e-5 of J(0), either sign) would put
+        # phi0 - R J past phi0 and flip the checks at their limits
+        # (the applied voltage sampled finely between the output times: a coarse grid may miss a peak)
+        tf = np.union1d(tgrid, np.linspace(0.0, tgrid[-1], 20001))
+        af = fun(tf)
+        k = np.searchsorted(tf, tgrid)
+        u = np.clip(u, np.minimum.accumulate(np.minimum(af, 0.0))[k], np.maximum.accumulate(np.maximum(af, 0.0))[k])
         success, message = r.success, r.message
         extra = dict(extra, **r.extra)
         notes.append("pnp: M_A(t) is the layers' quasi-static moment at the layer voltage phi0 - R J; the moment of the transient "
