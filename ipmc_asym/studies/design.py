@@ -692,7 +692,7 @@ def design(spec, *, pareto: bool = True) -> DesignResult:
     active = []
     for k, (lo, hi) in sp.constraints.items():
         for bound, lim in (("min", lo), ("max", hi)):
-            a = float(vb.get(f"{k}:{bound}", vb[k])[0])  # robust: the quantile the constraint holds at
+            a = float(vb.get(f"{k}:{bound}", vb[k])[0])  # robust: the order statistic the constraint holds at
             if lim is not None and abs(a - lim) <= ACTIVE_RTOL * abs(lim):
                 active.append({"name": k, "bound": bound, "limit": lim, "value": a})
     for k, (lo, hi, _log) in sp.ranges.items():
