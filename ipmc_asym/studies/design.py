@@ -499,6 +499,52 @@ def _search(problem: _Problem, u0, c0, s0, step0, score=None, step_min=STEP_MIN)
     return u, s
 
 
+class _Pinned:
+    """The problem with continuous coordinate ``j`` held at ``value`` (unit box)."""
+
+    def __init__(self, problem, j, value):
+        self.problem, self.j, self.value = problem, j, value
+
+    def inputs(self, u, combo_idx):
+        u = np.array(u, dtype=float)
+        u[:, self.j] = self.value
+        return self.problem.inputs(u, combo_idx)
+
+    def __getattr__(self, name):
+        return getattr(self.problem, name)
+
+
+def _polish_bounds(problem, u, c, s, step, near=0.02, n=512):
+    """The optimum on a variable's bound when the search stopped short of it.
+
+    A pattern search along a constraint ridge that ends on a bound stalls near it (the blocking-force
+    example: 398.5 um of the 400 um bound).  For each continuous variable within ``near`` (unit box)
+    of a bound: the best feasible of ``n`` seeded points with it held there, refined by the same
+    search; kept where it scores higher.  Returns ``(u, s)``.
+    """
+    rng = np.random.default_rng(2)
+    for j in range(u.size):
+        for bound in (0.0, 1.0):
+            if abs(u[j] - bound) > near or u[j] == bound:
+                continue
+            pin = _Pinned(problem, j, bound)
+            cand = np.vstack([u, rng.uniform(size=(n, u.size))])
+            cand[:, j] = bound
+            cc = np.full(len(cand), c)
+            vals, feas, _ = problem.evaluate(pin.inputs(cand, cc))
+            sc = problem.score(vals, feas)
+            if not np.isfinite(sc).any():
+                continue
+            top = np.argsort(-sc)[:2]
+            top = top[np.isfinite(sc[top])]
+            up, sp_ = _search(pin, cand[top], cc[top], sc[top], step)
+            k = int(np.argmax(sp_))
+            if sp_[k] > s:
+                u, s = up[k].copy(), float(sp_[k])
+                u[j] = bound
+    return u, s
+
+
 @dataclass
 class DesignResult:
     """The answer of :func:`design` (``as_dict()`` is the ``--json`` object).
@@ -684,7 +730,9 @@ def design(spec, *, pareto: bool = True) -> DesignResult:
     starts = np.array(starts)
     uu, ss = _search(problem, u[starts], c[starts], s[starts], max(step, 1e-3))
     b = int(np.argmax(ss))
-    xb = problem.inputs(uu[b:b + 1], c[starts][b:b + 1])
+    ub, cb, sb = uu[b].copy(), c[starts][b], float(ss[b])
+    ub, sb = _polish_bounds(problem, ub, cb, sb, max(step, 1e-3))
+    xb = problem.inputs(ub[None, :], np.array([cb]))
     vb, fb, _ = problem.evaluate(xb)
     if not bool(fb[0]):  # the search only keeps feasible points; this re-check is the contract
         raise ValueError("design: the optimum failed its re-evaluation")

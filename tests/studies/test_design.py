@@ -232,3 +232,24 @@ def test_robust_sample_size_is_the_binomial_bound():
     assert binom.cdf(m, n, 0.1) <= 0.05 < binom.cdf(m + 1, n, 0.1)
     with pytest.raises(ValueError, match="robust"):
         robust_sample_size(0.999, 0.99, 32)
+
+
+def test_optimum_on_a_variable_bound_is_reported_there():
+    """examples/design_blocking_force.toml: the optimum lies on the thickness bound (400 um) with the
+    deflection constraint active; the reference is independent: at 400 um the force falls with the
+    length and the deflection rises, so the best design is the root of w(L) = 2 mm (forward model)."""
+    from pathlib import Path
+
+    from scipy.optimize import brentq
+
+    path = Path(__file__).resolve().parents[2] / "examples" / "design_blocking_force.toml"
+    res = design(path, pareto=False)
+
+    def run(L):
+        return forward(L, 5e-3, 400e-6, 1.0, fidelity="corrected").withhold()
+
+    L = brentq(lambda x: abs(float(np.asarray(run(x).w).reshape(-1)[0])) - 2e-3, 0.01, 0.04, xtol=1e-12)
+    F = abs(float(np.asarray(run(L).F_block).reshape(-1)[0]))
+    assert res.optimum["inputs"]["thickness"] == pytest.approx(400e-6, rel=1e-12)
+    assert res.objective["value"] >= F * (1 - 1e-5)
+    assert {(a["name"], a["bound"]) for a in res.active_constraints} >= {("thickness", "max"), ("tip_deflection", "min")}
