@@ -47,8 +47,9 @@ def register(sub):
     p.add_argument("--to", dest="f2", type=frequency_type("--to"), required=True, help="last frequency (e.g. 1kHz)")
     add_size_option(p, "--points", default=50, maximum=MAX_POINTS, minimum=2, help="log-spaced points")
     p.add_argument("--model", default="constant", choices=list(model_names()), help=model_help("constant"))
-    add_solver_option(p, "freq", dest="method", default="pnp-linear", choices=FREQ_METHODS,
-                      help="pnp-linear (exact linearised PNP, closed form) or circuit (R + 1/(i w C_d))")
+    add_solver_option(p, "freq", dest="method", default=None, choices=FREQ_METHODS,
+                      help="pnp-linear (exact linearised PNP, closed form; the default at 0 V) or circuit "
+                           "(R + 1/(i w C_d); the default with a --voltage bias, which pnp-linear does not support)")
     p.add_argument("--diffusion", type=diffusion_type(), default=None,
                    help="cation diffusion coefficient D (1e-10m2/s, 1e-6cm2/s; a bare number is m^2/s)")
     p.add_argument("--voltage", type=voltage_type("--voltage"), default=0.0,

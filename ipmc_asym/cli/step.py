@@ -56,8 +56,8 @@ def _num(x, scale):
 
 
 #: units of the CSV columns (the sidecar's "units")
-UNITS = {"t": "s", "phi0": "V", "sigma": "C/m^2", "sigma_error": "C/m^2", "current_density": "A/m^2", "M_A": "N m",
-         "theta": "rad", "w": "m", "w_error": "m"}
+UNITS = {"t": "s", "phi0": "V", "sigma": "C/m^2", "sigma_error": "C/m^2", "current_density": "A/m^2",
+         "current_error": "A/m^2", "M_A": "N m", "theta": "rad", "w": "m", "w_error": "m"}
 
 
 def _write_rows(wr, model, values, flags):
@@ -207,11 +207,14 @@ def run(args):
         return _stream_csv(args, strip, resps)
     results = {m: resp.result for m, resp in resps.items()}
 
-    columns = COLUMNS + (("sigma_error",) if args.tol is not None else ())
+    # the errors wherever they are stated: with --tol, and always for the pnp (its default tolerance)
+    stated = args.tol is not None or args.fidelity == "pnp"
+    columns = COLUMNS + (("sigma_error", "current_error") if stated else ())
 
     def cols_of(r):
         cols = {"t": r.t, "phi0": r.phi0, "sigma": r.sigma, "sigma_error": r.sigma_error,
-                "current_density": r.current_density, "M_A": r.M_A, "theta": r.theta, "w": r.w}
+                "current_density": r.current_density, "current_error": r.current_error, "M_A": r.M_A,
+                "theta": r.theta, "w": r.w}
         return {c: cols[c] for c in columns}
 
     def flags_of(r):
@@ -237,7 +240,9 @@ def run(args):
         return {"tau": r.tau, "R": r.R, "C_d0": r.C_d0, "model": r.model, "fidelity": r.fidelity,
                 "voltage": strip.voltage, "thickness_total": strip.thickness, "half_thickness_e": strip.e,
                 "diffusion_coefficient": material.D, "seconds": r.seconds, "notes": r.notes, "message": r.message,
-                "waveform": drive, "beam": args.beam, "warnings": r.warnings, "tol": args.tol,
+                "waveform": drive, "beam": args.beam, "warnings": r.warnings,
+                # the tolerance the run met: --tol, or the pnp's default
+                "tol": args.tol if args.tol is not None else r.extra.get("tol"),
                 "valid_from": r.extra.get("valid_from")}
 
     for mname in models:  # the forward model's flags, one line each (also in --json's "warnings")

@@ -66,7 +66,7 @@ from ipmc_asym.forward.model import assumption_warnings, forward
 from ipmc_asym.integral.api import paper_model_id
 from ipmc_asym.kernels import _generated_charge as GC
 from ipmc_asym.kernels.charge import GL_W, GL_X
-from ipmc_asym.kernels.charge_time import integrate_circuit
+from ipmc_asym.kernels.charge_time import integrate_circuit, shat
 from ipmc_asym.model import groups
 from ipmc_asym.model.electrode import beam_label
 from ipmc_asym.model.params import (
@@ -289,6 +289,10 @@ class StepResult(ResultMixin):
     warnings : list of str        one line per failed model assumption (count of time points)
     sigma_error : ndarray         error estimate of sigma (C/m^2) at each time; NaN for the circuit
                                   without ``tol``
+    current_error : ndarray       error estimate of current_density (A/m^2) at each time, stated like
+                                  sigma's (pnp: Richardson; circuit with ``tol``: its difference from
+                                  the reference PNP plus that run's estimate); NaN for the circuit
+                                  without ``tol``
     """
 
     _result = ResultSpec("t", "t", ("phi0", "sigma", "current_density", "layer_voltage", "M_A", "theta", "w",
@@ -326,6 +330,7 @@ class StepResult(ResultMixin):
             out &= v
         return out
     sigma_error: np.ndarray | None = None
+    current_error: np.ndarray | None = None
 
 
 def quasi_static_forward(u, strip: Strip, perm: Permittivity, material: Material, checked_voltage=None):
@@ -397,6 +402,9 @@ class CircuitStepper:
         self.Cg = float(groups.geometric_capacitance(strip.thickness, perm.eps_moy))
         self.S = charge_scale(perm, material)
         self.t_last = 0.0
+        # hull of 0 (the uncharged start) and the applied psi0 so far (R T/F): see advance
+        self.ps_lo = 0.0
+        self.ps_hi = 0.0
 
     def advance(self, t):
         t = np.asarray(t, dtype=float)
@@ -410,6 +418,14 @@ class CircuitStepper:
         A = np.empty(tt.size)
         s = np.empty(tt.size)
         integrate_circuit(tt, ps, self.rho, self.mid, GL_X, GL_W, A, s, self.state)
+        # the layers charge through the core's resistance towards phi0 (ds/dt = (psi0 - A)/2 with
+        # s(A) increasing), so the exact A never leaves the hull of 0 and the psi0 applied so far;
+        # BDF2 is not monotone and may step past it by rounding (20.000000000004 V at a 20 V step,
+        # which would flip the validity checks at their limits): the output is held in the hull
+        lo = np.minimum(np.minimum.accumulate(ps), self.ps_lo)
+        hi = np.maximum(np.maximum.accumulate(ps), self.ps_hi)
+        self.ps_lo, self.ps_hi = float(lo[-1]), float(hi[-1])
+        A = np.clip(A, lo, hi)
         A, s = A[idx], s[idx]
         u = self.VT * A
         self.t_last = float(t[-1])
@@ -419,6 +435,32 @@ class CircuitStepper:
         # R C_g = lambda^2 e^2/D is instantaneous on the scale tau); C_g/C_d(0) = lambda
         sigma = self.S * s + self.Cg * ub
         return u, ub, sigma
+
+
+    def current(self, t, u):
+        """The model's current density (A/m^2) at the output times ``t`` (s) where the layers hold ``u`` (V).
+
+        From the model's own equations, not from differences over the output times:
+        ``J = S ds/dt + C_g d(phi0 - u)/dt`` with ``ds/dt = (psi0 - A)/(2 tau)`` (the charging law
+        integrated by :meth:`advance`) and ``du/dt = (R T/F) (ds/dt)/s'(A)`` (the layers'
+        differential capacitance ``s'(A)``); ``dphi0/dt`` by a central difference of ``phi0`` over
+        ``1e-7 max(t, tau/1000)`` (0 across a step's discontinuity at ``t = 0``: the ideal step's
+        displacement impulse is not a current density).
+        """
+        t = np.asarray(t, dtype=float)
+        A = np.asarray(u, dtype=float) / self.VT
+        ps = self.fun(t) / self.VT
+        cx = np.array([shat(float(a), self.rho, self.mid, GL_X, GL_W)[1] for a in A])
+        sdot = (ps - A) / (2.0 * self.tau)
+        # dA/dt = (psi0 - A)/(2 s'(A)) per tau: the layers relax on 2 s'(A) tau; below the largest
+        # substep (5e-3 tau, substep_grid) that relaxation is not resolved -- the L-stable BDF2 settles
+        # A on psi0 within a substep and psi0 - A is the Newton residual -- so the rate is taken over
+        # the substep there (a saturated linear-model layer has s' ~ e^{-A}: 1e-34 at 2 V)
+        Adot = (ps - A) / (2.0 * np.maximum(cx, 2.5e-3) * self.tau)
+        dt = 1e-7 * np.maximum(t, 1e-3 * self.tau)
+        lo = np.maximum(t - dt, 0.0)
+        dphi = np.where(t > 0.0, (self.fun(t + dt) - self.fun(lo)) / (t + dt - lo), 0.0)
+        return self.S * sdot + self.Cg * (dphi - self.VT * Adot)
 
 
 def substep_grid(t, tau, h_max, substeps, too_long):
@@ -443,10 +485,7 @@ def circuit_response(t, phi0_fun, strip: Strip, perm: Permittivity, material: Ma
     """Integrate the reduced model on the time grid ``t`` (s); returns ``(sigma, u, J)``."""
     stepper = CircuitStepper(phi0_fun, strip, perm, material, substeps)
     u, ub, sigma = stepper.advance(t)
-    J = ub / float(core_resistance(strip.thickness, material))
-    if t.size > 2:
-        J = J + stepper.Cg * np.gradient(ub, t)
-    return sigma, u, J
+    return sigma, u, stepper.current(t, u)
 
 
 def step_response(voltage=1.0, duration=None, *, strip: Strip | None = None, model="constant",
@@ -517,6 +556,7 @@ def step_response(voltage=1.0, duration=None, *, strip: Strip | None = None, mod
     if dyn is not None:
         tgrid, keep = _beam_grid(tgrid, dyn.period)
     sig_err = np.full(tgrid.size, np.nan)
+    cur_err = np.full(tgrid.size, np.nan)
     opts = dict(pnp_options or {})
     if tol is not None:
         tol = check_finite("tol", tol, "a relative tolerance in [1e-8, 0.5)")
@@ -560,13 +600,26 @@ def step_response(voltage=1.0, duration=None, *, strip: Strip | None = None, mod
     if fidelity == "circuit":
         sigma, u, J, sig_err = lad.last.result
         success, message = True, "reduced model integrated (variable-step BDF2, 2 substeps per output interval)"
+        if pnp_ref:  # tol given: the reference PNP run bounds the circuit's current too
+            cur_err = np.abs(J - pnp_ref[0].current_density) + pnp_ref[0].current_error
     else:
         r = lad.last.result
-        sig_err = r.sigma_error
+        sig_err, cur_err = r.sigma_error, r.current_error
         sigma, J = r.sigma, r.current_density
         # the voltage left across the layers: phi0 minus the ohmic drop of the core (exact at
         # t = 0+ and t -> infinity; the bulk's displacement current is O(lambda) of J)
         u = fun(tgrid) - core_resistance(s.thickness, m) * J
+        # t = 0 is the run's uncharged initial state: the layers hold no charge, so no voltage (phi0 - R J
+        # there evaluates the step's discontinuity, and its current is the rate at a jump)
+        u = np.where(tgrid == 0.0, 0.0, u)
+        # and, as in the circuit (CircuitStepper.advance), within the hull of 0 and the voltages applied
+        # so far: the current's rounding noise once charged (~1e-5 of J(0), either sign) would put
+        # phi0 - R J past phi0 and flip the checks at their limits
+        # (the applied voltage sampled finely between the output times: a coarse grid may miss a peak)
+        tf = np.union1d(tgrid, np.linspace(0.0, tgrid[-1], 20001))
+        af = fun(tf)
+        k = np.searchsorted(tf, tgrid)
+        u = np.clip(u, np.minimum.accumulate(np.minimum(af, 0.0))[k], np.maximum.accumulate(np.maximum(af, 0.0))[k])
         success, message = r.success, r.message
         extra = dict(extra, **r.extra)
         notes.append("pnp: M_A(t) is the layers' quasi-static moment at the layer voltage phi0 - R J; the moment of the transient "
@@ -585,15 +638,15 @@ def step_response(voltage=1.0, duration=None, *, strip: Strip | None = None, mod
         extra = dict(extra, theta_quasi_static=th[keep], w_quasi_static=w[keep], F_block_quasi_static=Fb[keep],
                      beam_frequencies={"clamped-free": natural_frequencies("clamped-free", dyn.beam, 3).tolist(),
                                        "clamped-pinned": natural_frequencies("clamped-pinned", dyn.beam, 3).tolist()})
-        sigma, J, u, M, th, w, Fb, applied, sig_err = (a[keep] for a in (sigma, J, u, M, thd, wd, Fd, applied,
-                                                                           np.asarray(sig_err)))
+        sigma, J, u, M, th, w, Fb, applied, sig_err, cur_err = (
+            a[keep] for a in (sigma, J, u, M, thd, wd, Fd, applied, np.asarray(sig_err), np.asarray(cur_err)))
         checks = {c: v[keep] for c, v in checks.items()}
         tgrid = tout
     return StepResult(t=tgrid, phi0=applied, sigma=sigma, current_density=J, layer_voltage=u, M_A=M,
                       theta=th, w=w, F_block=Fb, tau=tau, R=R, C_d0=0.5 * capacitance_scale(perm, m),
                       fidelity=fidelity, model=perm.name, notes=notes, success=success, message=message,
                       extra=extra, seconds=time.perf_counter() - t0, checks=checks, warnings=warns,
-                      sigma_error=sig_err)
+                      sigma_error=sig_err, current_error=cur_err)
 
 
 def circuit_impedance_error(f, thickness, perm: Permittivity, material: Material):

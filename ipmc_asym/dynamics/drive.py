@@ -6,8 +6,9 @@ mechanics of each time point from the one forward model and its checks
 one ``warnings`` list per chunk) and, with ``beam="dynamic"``, the
 strip's inertia and damping (:class:`ipmc_asym.dynamics.circuit.BeamDynamics`), each carrying
 its state from one chunk to the next: the rows are those of one run over the whole grid (the
-current's displacement part uses the same central differences, a row is handed out once its
-successor is known).
+circuit's current from its model, :meth:`~ipmc_asym.dynamics.circuit.CircuitStepper.current`; the
+electrode line's displacement part by central differences over the rows, so a row is handed out
+once its successor is known).
 """
 
 from __future__ import annotations
@@ -234,6 +235,7 @@ def drive_chunks(wave, duration, points, *, strip: Strip | None = None, model="c
                 th = _linear_statics(lb, M, "clamped-free", ("theta",))["theta"]
                 Fb = _linear_statics(lb, M, "clamped-pinned", ("F",))["F"]
             cc = _linear_statics(lb, M, "clamped-clamped") if clamped else {}
+            lc = {"_J": stepper.current(t, u)}  # the model's current (not a difference over the rows)
         else:
             o = line.advance(t)
             # every node at every time through the forward model; a time point passes a check where every node does
@@ -289,7 +291,7 @@ def drive_chunks(wave, duration, points, *, strip: Strip | None = None, model="c
         if prev is not None:
             g = g[1:]
         emit = slice(None) if last else slice(0, -1)
-        J = uu / R + Cg * g
+        J = cols["_J"] if line is None else uu / R + Cg * g
         out = {k: cols[k][emit] for k in DRIVE_COLUMNS + CHECK_COLUMNS + lcols + ccols if k != "current_density"}
         out["current_density"] = J[emit]
         if not last:

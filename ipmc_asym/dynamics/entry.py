@@ -259,7 +259,7 @@ def time_response(strip: Strip | None = None, drive=None, *, duration=None, poin
 
 
 def spectrum(f, strip: Strip | None = None, *, model="constant", material: Material | None = None,
-             method="pnp-linear", beam=DEFAULT_BEAM, viscous_modulus=0.0, voltage=0.0, sheet_resistance=None,
+             method=None, beam=DEFAULT_BEAM, viscous_modulus=0.0, voltage=0.0, sheet_resistance=None,
              support=None, electrode=None):
     """Small-signal impedance and transfer functions of the strip at frequencies ``f`` (Hz).
 
@@ -273,7 +273,8 @@ def spectrum(f, strip: Strip | None = None, *, model="constant", material: Mater
         Frequencies, Hz, > 0.
     strip, model, material, method, beam, viscous_modulus, voltage :
         As in :func:`~ipmc_asym.dynamics.circuit.frequency_response` (``voltage``: DC bias, V, with
-        ``method="circuit"``); ``beam`` default :data:`DEFAULT_BEAM`.
+        ``method="circuit"``); ``method`` None: ``pnp-linear`` (the reference) at 0 V, ``circuit`` (the
+        method that supports a bias) with a ``voltage``; ``beam`` default :data:`DEFAULT_BEAM`.
     sheet_resistance : float, optional
     support, electrode :
         Supports of the uniform strip only (``ValueError`` with a sheet resistance).
@@ -282,6 +283,8 @@ def spectrum(f, strip: Strip | None = None, *, model="constant", material: Mater
     -------
     FrequencyResult or LineResult
     """
+    if method is None:  # the reference where it applies, else the method that supports the bias
+        method = "pnp-linear" if float(voltage) == 0.0 else "circuit"
     check_choice("method", method, FREQ_METHODS)
     check_choice("beam", beam, BEAM_CHOICES)
     if sheet_resistance is not None:

@@ -52,6 +52,20 @@ def test_freq_json(capsys):
     assert out["f"][0] == pytest.approx(0.1) and out["f"][-1] == pytest.approx(1e3)
 
 
+def test_freq_bias_without_method_picks_the_method_that_supports_it(capsys):
+    """--voltage without --method runs the method that supports a bias (circuit) instead of refusing;
+    an explicit --method pnp-linear with a bias is still refused in one line."""
+    base = ["freq", "--from", "1Hz", "--to", "100Hz", "--points", "4", "--voltage", "0.5V", "--beam", "quasi-static",
+            "--json"]
+    assert main(base) == 0
+    a = json.loads(capsys.readouterr().out)
+    assert main(base + ["--method", "circuit"]) == 0
+    b = json.loads(capsys.readouterr().out)
+    assert a["method"] == "circuit" and a == b
+    assert main(base + ["--method", "pnp-linear"]) == 2
+    assert "--voltage" in capsys.readouterr().err
+
+
 @pytest.mark.parametrize("args,word", [
     (["charge", "--thickness", "0"], "thickness"),
     (["charge", "--fidelity", "exact-ish"], "fidelity"),

@@ -67,7 +67,7 @@ def test_freq_bias_and_beam(capsys):
     (["drive", "--waveform", "sine:1V@1Hz", "--duration", "10s", "--points", "100", "--beam", "dynamic"], "points"),
     (["drive", "--waveform", "sine:1V@1Hz", "--duration", "1s", "--points", "2e6", "--json"], "--json"),
     (["drive", "--waveform", "sine:1V@1Hz", "--duration", "1s", "--viscous-modulus", "-1"], "viscous"),
-    (["freq", "--from", "1Hz", "--to", "10Hz", "--voltage", "0.5V"], "circuit"),
+    (["freq", "--from", "1Hz", "--to", "10Hz", "--voltage", "0.5V", "--method", "pnp-linear"], "circuit"),
 ])
 def test_bad_input_exit_2_one_line(args, word, capsys):
     with pytest.raises(SystemExit) as ei:

@@ -90,3 +90,21 @@ def test_step_tol_bounds_the_circuit_for_the_linear_model(capsys):
     sig, err = np.array(out["sigma"]), np.array(out["sigma_error"])
     ref = solve_transient(np.array(out["t"]), waveform("step", 0.5), Strip(), "linear", NAFION_LI, moment=False)
     assert np.all(np.abs(sig - ref.sigma) <= err + ref.sigma_error)
+
+
+def test_step_pnp_json_states_its_default_tolerance_and_errors(capsys):
+    """Without --tol the pnp runs at its default tolerance: the JSON says which and carries the
+    per-time errors of sigma and J; the errors bound the difference from an independent run at a
+    tolerance ten times tighter."""
+    tau = float(time_constant(Strip().thickness))
+    assert main(["step", "--voltage", "0.5V", "--fidelity", "pnp", "--points", "6", "--duration", f"{2 * tau}s",
+                 "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["tol"] == 1e-6
+    sig, err = np.array(out["sigma"]), np.array(out["sigma_error"])
+    J, jerr = np.array(out["current_density"]), np.array(out["current_error"])
+    ref = solve_transient(np.array(out["t"]), waveform("step", 0.5), Strip(), "constant", NAFION_LI, moment=False,
+                          tol=1e-7)
+    assert np.all(np.abs(sig - ref.sigma) <= err + ref.sigma_error)
+    assert np.all(np.abs(J - ref.current_density) <= jerr + ref.current_error)
+    assert np.all(err <= 1e-6 * np.max(np.abs(sig)))

@@ -336,3 +336,139 @@ def test_step_tol_bounds_the_circuit_for_the_linear_model():
 def test_step_tol_refused_out_of_range():
     with pytest.raises(ValueError, match="tol"):
         step_response(1.0, TAU, points=3, tol=0.7)
+
+
+def _exact_linear_step_sigma(V, t, strip, model="constant", current=False):
+    """sigma(t) (or J(t) with ``current``) of a V step from the inverse Laplace transform (Talbot) of the
+    exact linearised PNP impedance about 0 V (derivations.charge:small_signal, Z = (e/kappa) Zhat):
+    sigma(p) = V/(p^2 Z(p)), J(p) = V/(p Z(p)), with i W -> p e^2/D."""
+    import mpmath as mp
+
+    from ipmc_asym.model import groups
+    from ipmc_asym.model.permittivity import get_model
+
+    perm = get_model(model)
+    e = strip.e
+    lam = mp.mpf(float(groups.debye_length(strip.thickness, perm.eps_moy, NAFION_LI)))
+    kappa = float(groups.kappa(NAFION_LI))
+    ts = e * e / NAFION_LI.D
+
+    def F(p):
+        q = p * ts
+        a = q + lam**-2
+        zh = 2 * lam**-2 * (1 / a - (1 / a - 1 / q) * mp.tanh(mp.sqrt(a)) / mp.sqrt(a))
+        return V / ((p if current else p * p) * (e / kappa) * zh)
+
+    with mp.workdps(30):
+        return np.array([float(mp.invertlaplace(F, float(x), method="talbot")) for x in t])
+
+
+@pytest.mark.parametrize("model,V", [("constant", 1e-4), ("constant", 1e-5), ("linear", 1e-5)])
+def test_small_signal_step_within_its_stated_error_of_the_exact_linearised_response(model, V):
+    """At 0.1 mV and 10 uV the PNP at tol 1e-6 is within its own per-time error of the exact
+    linearised step response (sigma is odd in V by the strip's mirror symmetry, so the nonlinear
+    terms are O(psi0^2) relative, psi0^2 = 1.5e-5 and 1.5e-7 with small coefficients), and the 10 uV
+    step is solved, not refused: the time integration's absolute tolerance follows the signal.  The
+    linear model linearises about eps_core like the constant one (at 0.1 mV its O(psi0^2) term is
+    already ~1e-6: 10 uV)."""
+    tau = float(time_constant(S0.thickness, model))
+    t = np.linspace(0.0, 5 * tau, 21)
+    r = solve_transient(t, waveform("step", V), S0, model, NAFION_LI, moment=False, tol=1e-6)
+    assert r.success, r.message
+    idx = [1, 2, 3, 4, 6, 10, 20]  # t > 0 (the transform's t = 0+ is the geometric charge C_g V)
+    ref = _exact_linear_step_sigma(V, t[idx], S0, model)
+    err = np.abs(r.sigma[idx] - ref)
+    assert np.all(err <= r.sigma_error[idx]), (err / r.sigma_error[idx]).tolist()
+    assert np.max(r.sigma_error) <= 1e-6 * np.max(np.abs(r.sigma))
+
+
+@pytest.mark.parametrize("model", ["constant", "linear", "affine"])
+def test_circuit_layer_voltage_stays_within_the_applied_hull_at_the_validated_limit(model):
+    """The layers charge through the core towards phi0 with a charge increasing in their voltage, so
+    the exact layer voltage never leaves the hull of 0 and the voltages applied so far: a step of
+    exactly VALIDATED_VOLTAGE is inside the validated range at every time, and a sine's layer
+    voltage never passes its amplitude (a rounding overshoot would flip the checks at their limits)."""
+    from ipmc_asym.base.settings import VALIDATED_VOLTAGE
+
+    r = step_response(VALIDATED_VOLTAGE, model=model)
+    assert np.all(r.layer_voltage <= VALIDATED_VOLTAGE) and np.all(r.layer_voltage >= 0.0)
+    assert np.all(r.checks["voltage"])
+    tau = float(time_constant(S0.thickness, model))
+    rs = step_response(1.3, model=model, waveform_kind="sine", frequency=0.2 / tau, duration=12 * tau, points=601)
+    assert np.max(np.abs(rs.layer_voltage)) <= 1.3
+
+
+def test_circuit_current_is_the_models_not_a_difference_over_the_output_times():
+    """Linear model, 20 um, 2 V, 21 output times (0.25 tau apart): the circuit's current is the model's
+    own (layers' charging law plus the bulk's displacement current), so 21 and 2001 output times give
+    the same current at their shared times, and after t = 0 it is within 1e-3 of J(0) of the PNP's
+    (the charging is over by 0.25 tau; a difference over the output times printed -0.1 J(0))."""
+    s = Strip(thickness=20e-6)
+    a = step_response(2.0, strip=s, model="linear", points=21)
+    b = step_response(2.0, strip=s, model="linear", points=2001)
+    j0 = abs(a.current_density[0])
+    assert np.max(np.abs(a.current_density - b.current_density[::100])) <= 1e-9 * j0
+    p = step_response(2.0, strip=s, model="linear", points=21, fidelity="pnp", tol=1e-4)
+    assert np.max(np.abs(a.current_density[1:] - p.current_density[1:])) <= 1e-3 * j0
+
+
+@pytest.mark.parametrize("model", ["linear", "affine"])
+def test_circuit_current_of_a_step_has_the_sign_of_the_step(model):
+    """A step charges the layers monotonically (the charge increases with the layer voltage, which moves
+    towards phi0): J has the sign of V at every time (200 um, 2 V: the difference over 0.25 tau printed
+    the opposite sign)."""
+    for V in (2.0, -2.0):
+        r = step_response(V, model=model, points=21)
+        assert np.all(np.sign(V) * r.current_density >= -1e-12 * abs(r.current_density[0]))
+
+
+def test_circuit_small_signal_current_is_the_closed_form():
+    """1 uV on 20 um (constant model): the circuit is linear, u = V (1 - e^{-t/tau}), and its current
+    J = (V/R) e^{-t/tau} (1 - C_g/C_d(0)) (conduction through the core less the bulk's displacement
+    current), to the BDF2 substeps' error; with tol its stated error bounds the difference."""
+    from ipmc_asym.dynamics.electrode import capacitance_scale, core_resistance
+    from ipmc_asym.model import groups
+    from ipmc_asym.model.permittivity import get_model
+
+    s = Strip(thickness=20e-6)
+    V = 1e-6
+    r = step_response(V, strip=s, points=21)
+    perm = get_model("constant")
+    R = float(core_resistance(s.thickness, NAFION_LI))
+    Cd = 0.5 * capacitance_scale(perm, NAFION_LI)
+    Cg = float(groups.geometric_capacitance(s.thickness, perm.eps_moy))
+    ref = V / R * np.exp(-r.t / (R * Cd)) * (1 - Cg / Cd)
+    assert np.max(np.abs(r.current_density - ref)) <= 1e-4 * ref[0]
+
+
+def test_small_signal_current_within_its_stated_error_of_the_exact_linearised_current():
+    """0.1 mV on 200 um: the PNP's current (tol 1e-6) and the circuit's with tol 1e-3 are within their
+    stated current errors of the exact linearised current (inverse Laplace transform of V/(p Z))."""
+    tau = float(time_constant(S0.thickness))
+    V = 1e-4
+    idx = [1, 2, 4, 8, 20]
+    for kw in ({"fidelity": "pnp", "tol": 1e-6}, {"fidelity": "circuit", "tol": 1e-3}):
+        r = step_response(V, 5 * tau, points=21, **kw)
+        ref = _exact_linear_step_sigma(V, r.t[idx], S0, current=True)
+        err = np.abs(r.current_density[idx] - ref)
+        assert np.all(err <= r.current_error[idx]), (kw, (err / r.current_error[idx]).tolist())
+        assert np.max(r.current_error[idx]) <= 0.05 * abs(ref[0])
+
+
+@pytest.mark.parametrize("fidelity", ["circuit", "pnp"])
+def test_deflection_at_t0_is_that_of_uncharged_layers(fidelity):
+    """At t = 0 the run is in its uncharged initial state: the layers carry no charge, so the moment and
+    the deflection are those of 0 V (the linear model printed w(0) = -3.98 mm at 0.5 V, phi0 - R J
+    evaluated at the step's discontinuity)."""
+    r = step_response(0.5, model="linear", points=21, fidelity=fidelity)
+    assert r.layer_voltage[0] == 0.0 and r.w[0] == 0.0 and r.M_A[0] == 0.0
+    assert abs(r.w[-1]) > 1e-3  # the step does bend the strip (m)
+
+
+def test_pnp_layer_voltage_stays_within_the_applied_hull():
+    """The PNP's layer voltage phi0 - R J: once the layers are charged the current is rounding noise of
+    either sign (~1e-5 of J(0)), which must not put the layer voltage past the applied one (affine,
+    2 V: the layers charge before 0.25 tau)."""
+    r = step_response(2.0, model="affine", points=21, fidelity="pnp")
+    assert np.all(r.layer_voltage <= 2.0) and np.all(r.layer_voltage >= 0.0)
+    assert r.layer_voltage[-1] == pytest.approx(2.0, rel=1e-5)

@@ -64,10 +64,9 @@ def test_fit_and_uq_tables_are_the_parameter_table():
 def test_every_field_is_a_material_field_and_the_files_spell_it_as_an_alias():
     import dataclasses
 
+    from ipmc_asym.model.electrode import Electrode
     from ipmc_asym.model.material_data import MATERIAL_FIELDS
     from ipmc_asym.model.params import Material
-
-    from ipmc_asym.model.electrode import Electrode
 
     fields = {f.name for f in dataclasses.fields(Material)}
     layer_fields = {f.name for f in dataclasses.fields(Electrode)}

@@ -197,3 +197,62 @@ def test_a_bare_pair_is_a_range_with_a_note():
         sp = parse_spec({**base, "vary": {"length": v}})
         assert not any("read as a range" in n for n in sp.notes)
     assert parse_spec({**base, "vary": {"length": {"choices": ["1cm", "4cm"]}}}).choices["length"] == (0.01, 0.04)
+
+
+def test_robust_example_meets_its_probability_exactly_and_says_with_what_confidence():
+    """examples/design_robust.toml (probability 0.95, 32 samples): the deflection falls as the modulus
+    rises, so the design's exact probability of meeting w >= 2 mm is the lognormal CDF at the modulus
+    where w = 2 mm (a root of the forward model); it must reach 0.95 (the 0.05 quantile of 32 samples
+    gave 0.939).  The report states the confidence and the sample size that meets it."""
+    import math
+    from pathlib import Path
+
+    from scipy.optimize import brentq
+
+    path = Path(__file__).resolve().parents[2] / "examples" / "design_robust.toml"
+    res = design(path)
+    x = res.optimum["inputs"]
+    assert res.robust["confidence"] == 0.95 and res.robust["samples"] == 59 and res.robust["failures_allowed"] == 0
+    assert any("raised from 32 to 59" in n for n in res.notes)
+
+    def w(E):
+        r = forward(x["length"], x["width"], x["thickness"], x["voltage"], modulus=E, fidelity="corrected").withhold()
+        return abs(float(np.asarray(r.w).reshape(-1)[0]))
+
+    Ec = brentq(lambda E: w(E) - 2e-3, 50e6, 500e6, xtol=1.0)
+    prob = 0.5 * (1 + math.erf(math.log(Ec / 130e6) / (0.15 * math.sqrt(2))))  # lognormal CDF
+    assert prob >= 0.95
+
+
+def test_robust_sample_size_is_the_binomial_bound():
+    from scipy.stats import binom
+
+    from ipmc_asym.studies.design import robust_sample_size
+
+    assert robust_sample_size(0.95, 0.95, 32)[:2] == (59, 0)  # Wilks: 0.95^59 < 0.05 < 0.95^58
+    n, m, note = robust_sample_size(0.9, 0.95, 100)
+    assert n == 100 and note is None
+    assert binom.cdf(m, n, 0.1) <= 0.05 < binom.cdf(m + 1, n, 0.1)
+    with pytest.raises(ValueError, match="robust"):
+        robust_sample_size(0.999, 0.99, 32)
+
+
+def test_optimum_on_a_variable_bound_is_reported_there():
+    """examples/design_blocking_force.toml: the optimum lies on the thickness bound (400 um) with the
+    deflection constraint active; the reference is independent: at 400 um the force falls with the
+    length and the deflection rises, so the best design is the root of w(L) = 2 mm (forward model)."""
+    from pathlib import Path
+
+    from scipy.optimize import brentq
+
+    path = Path(__file__).resolve().parents[2] / "examples" / "design_blocking_force.toml"
+    res = design(path, pareto=False)
+
+    def run(L):
+        return forward(L, 5e-3, 400e-6, 1.0, fidelity="corrected").withhold()
+
+    L = brentq(lambda x: abs(float(np.asarray(run(x).w).reshape(-1)[0])) - 2e-3, 0.01, 0.04, xtol=1e-12)
+    F = abs(float(np.asarray(run(L).F_block).reshape(-1)[0]))
+    assert res.optimum["inputs"]["thickness"] == pytest.approx(400e-6, rel=1e-12)
+    assert res.objective["value"] >= F * (1 - 1e-5)
+    assert {(a["name"], a["bound"]) for a in res.active_constraints} >= {("thickness", "max"), ("tip_deflection", "min")}
