@@ -33,8 +33,7 @@ from ipmc_asym.io.jsonio import dumps
 from ipmc_asym.parallel.executors import check_scheduler
 from ipmc_asym.studies.fits import sweep_fits
 from ipmc_asym.studies.sweep_chunks import sweep_chunked
-from ipmc_asym.studies.sweeps import (DTYPE, SPREAD_DTYPE, iter_sweep, prefetched, sweep, warm_writer, withhold,
-                                     write_csv, write_json)
+from ipmc_asym.studies.sweeps import DTYPE, SPREAD_DTYPE, iter_sweep, prefetched, sweep, warm_writer, withhold, write_csv, write_json
 
 #: extensions of --out (the format follows the extension)
 OUT_FORMATS = (".csv", ".json", ".nc")
