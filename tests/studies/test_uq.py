@@ -295,3 +295,24 @@ def test_spread_is_the_range_of_the_runs_of_each_model():
             vals = [runs[m].summary[o][st] for m in runs]
             assert sp["quantities"][o][st]["min"] == min(vals) and sp["quantities"][o][st]["max"] == max(vals)
     assert "model_spread" not in runs["linear"].as_dict()  # asked for only
+
+
+def test_cli_uq_spread_text_and_json(tmp_path, capsys):
+    """uq --spread: the text names the spread per output; the JSON's min/max bracket the scene's
+    own model's statistics (one of the three runs)."""
+    import json
+
+    from ipmc_asym.cli import main
+
+    sc = tmp_path / "u.toml"
+    sc.write_text('name = "n"\nmodel = "constant"\nvoltage = "1V"\noutputs = ["I"]\n[uncertain]\n'
+                  'thickness = {dist = "uniform", low = "180um", high = "220um"}\n')
+    base = ["uq", str(sc), "--samples", "128", "--fidelity", "quadrature", "--keep-invalid"]
+    assert main(base + ["--spread"]) == 0
+    assert "model-form spread" in capsys.readouterr().out
+    assert main(base + ["--spread", "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    q = d["model_spread"]["quantities"]["I"]["mean"]
+    assert q["min"] <= d["summary"]["I"]["mean"] <= q["max"] and set(q["values"]) == {"constant", "linear", "affine"}
+    assert main(base + ["--json"]) == 0
+    assert "model_spread" not in json.loads(capsys.readouterr().out)
