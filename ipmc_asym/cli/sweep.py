@@ -33,7 +33,7 @@ from ipmc_asym.io.jsonio import dumps
 from ipmc_asym.parallel.executors import check_scheduler
 from ipmc_asym.studies.fits import sweep_fits
 from ipmc_asym.studies.sweep_chunks import sweep_chunked
-from ipmc_asym.studies.sweeps import iter_sweep, prefetched, sweep, warm_writer, withhold, write_csv, write_json
+from ipmc_asym.studies.sweeps import DTYPE, SPREAD_DTYPE, iter_sweep, prefetched, sweep, warm_writer, withhold, write_csv, write_json
 
 #: extensions of --out (the format follows the extension)
 OUT_FORMATS = (".csv", ".json", ".nc")
@@ -74,6 +74,10 @@ def register(sub):
                         "held in memory)")
     p.add_argument("--json", action="store_true",
                    help='JSON {"rows": [...], "fits": [...]} on stdout (with --out F.csv: a summary only)')
+    p.add_argument("--spread", action="store_true",
+                   help="add per row the range of M_A, theta, w, w_small, F_block, F_block_small over the three "
+                        "permittivity models at that point (columns <name>_model_min, <name>_model_max: the "
+                        "model-form spread beside the numerical error column; three times the work)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
 
 
@@ -139,6 +143,9 @@ def run(args) -> int:
         what = "--out F.nc writes its dataset at once" if to_nc else "--scheduler returns its chunks as arrays"
         raise ValueError(f"the sweep has {n:.3g} rows; {what}, held in memory: at most {MAX_MEMORY_ROWS:g} rows "
                          "(< 1 GB); narrow it, or write --out F.csv / F.json (streamed)")
+    if args.spread and (to_nc or args.scheduler is not None):
+        raise ValueError("--spread: written to CSV or JSON only (stdout or --out F.csv / F.json), "
+                         "not with --out F.nc or --scheduler")
     vary = {k: vary_values(*sp[1:]) for k, sp in specs.items()}
     if args.out:
         check_output_path(args.out, "file", formats=OUT_FORMATS)
@@ -176,7 +183,7 @@ def run(args) -> int:
             # computed one chunk ahead of the formatting and writing: one core each
             chunks = prefetched((counted(withhold(c, copy=False)) for c in iter_sweep(
                 vary, args.model, args.fidelity, base, mat, args.tol, escalate=not args.no_escalate,
-                progress=bar, failures=failures)), threads=1)
+                progress=bar, failures=failures, spread=args.spread)), threads=1)
             # meanwhile, the formatter loads from the cache (serial code: no second parallel
             # launch); CSV and JSON share the one compiled kernel
             warm_writer()
@@ -191,6 +198,7 @@ def run(args) -> int:
                 fits, notes = fits_and_notes()
                 return {"fits": fits, "fit_notes": notes, "seconds": time.perf_counter() - t0}
 
+            names = (SPREAD_DTYPE if args.spread else DTYPE).names
             to_json_file = bool(args.out) and args.out.lower().endswith(".json")
             head = {"n_rows": n, "material": mat.name, "material_sources": list(mat.sources)}
             if to_nc:
@@ -201,11 +209,12 @@ def run(args) -> int:
                 with atomic_write(args.out) as fh:
                     rows = write_json(chunks, fh, head, tail, workers=FORMAT_WORKERS)
             elif args.out:
-                rows = write_csv(chunks, args.out, workers=FORMAT_WORKERS, comments=material_comments(mat))
+                rows = write_csv(chunks, args.out, workers=FORMAT_WORKERS, comments=material_comments(mat),
+                                 names=names)
             elif args.json:
                 rows = write_json(chunks, sys.stdout, head, tail)
             else:
-                rows = write_csv(chunks, "-")
+                rows = write_csv(chunks, "-", names=names)
         finally:
             bar.close()
         fits, notes = fits_and_notes()

@@ -59,6 +59,10 @@ def register(sub):
                    help="keep the samples outside a model assumption (past a quarter turn, above the strain limit, "
                         "beyond the validated voltage, not slender) in the statistics; by default they are counted "
                         "and left out (their check_* variables are in the NetCDF either way)")
+    p.add_argument("--spread", action="store_true",
+                   help="also run the study with the other two permittivity models and report the range of each "
+                        "output's mean, sd and quantiles over the three (JSON model_spread; the model-form spread "
+                        "beside the sampling error; three times the work)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     add_material_options(p)
     add_electrode_options(p)
@@ -75,7 +79,8 @@ def run(args) -> int:
     scene = scene_with_material(args.scene, args)  # read and checked first: a refusal is one line
     first_run_notice()
     res = run_uq(scene, args.samples, seed=args.seed, fidelity=args.fidelity,
-                 scheduler=args.scheduler, keep_invalid=args.keep_invalid, store_samples=args.store_samples)
+                 scheduler=args.scheduler, keep_invalid=args.keep_invalid, store_samples=args.store_samples,
+                 spread=args.spread)
     if args.cite and res.material is not None:
         print_citations(res.material, json_mode=args.json)
     if res.n_outside:
@@ -115,6 +120,14 @@ def run(args) -> int:
     rank = max(s["quantile_rank_error"] for s in res.summary.values())
     if rank > 0:
         print(f"quantiles from a sketch: rank error <= {rank:.2g} (each quantile's guaranteed interval in --json)")
+    if res.model_spread is not None:
+        sp = res.model_spread
+        print(f"model-form spread ({sp['over']}): min .. max of each statistic")
+        for o, q in sp["quantities"].items():
+            print(f"  {o}: " + "; ".join(f"{st} {fmt_num(q[st]['min'], '.4g')} .. {fmt_num(q[st]['max'], '.4g')}"
+                                          for st in ("mean", "q2.5", "q97.5")))
+        for m, why in sp["refused"].items():
+            print(f"  {m}: refused: {why}")
     print("Sobol' indices (first S1 / total ST, ± 95 % half-width):")
     for o, sob in res.sobol.items():
         if sob is None:

@@ -21,6 +21,7 @@ Layer rule: stdlib + numpy at import.
 from __future__ import annotations
 
 import contextvars
+import functools
 import io
 import queue
 import sys
@@ -38,6 +39,7 @@ from ipmc_asym.base.settings import CHUNK_ROWS, MAX_ROWS
 from ipmc_asym.base.units import SWEEP_VARIABLES as VARIABLES
 from ipmc_asym.base.units import parse_vary, parse_vary_spec, vary_values
 from ipmc_asym.forward.escalation import check_tol
+from ipmc_asym.forward.estimate import SPREAD_KEYS
 from ipmc_asym.forward.model import CHECKS, FREE_STRIP_KEYS, MECHANICAL_KEYS, WITHHOLD, forward
 from ipmc_asym.integral.api import check_fidelity
 from ipmc_asym.io.fileio import atomic_write
@@ -46,7 +48,8 @@ from ipmc_asym.io.textfmt import SHORTEST, format_table, shortest_text
 from ipmc_asym.model.params import NAFION_LI, Material, Strip
 from ipmc_asym.model.permittivity import get_model
 
-__all__ = ["VARIABLES", "DTYPE", "LABELS", "CHECK_COLS", "parse_vary", "parse_vary_spec", "vary_values", "sweep", "iter_sweep",
+__all__ = ["VARIABLES", "DTYPE", "LABELS", "CHECK_COLS", "SPREAD_COLS", "SPREAD_DTYPE", "parse_vary",
+           "parse_vary_spec", "vary_values", "sweep", "iter_sweep",
            "prefetched", "count_rows",
            "withhold", "format_chunk", "warm_writer", "csv_header", "write_csv", "write_json"]
 
@@ -65,6 +68,11 @@ LABELS = {"width": "width_total_2l", "thickness": "thickness_total_2e"}
 #: the free-strip and mechanical outputs (forward.model) that are columns here (no tip position)
 _FREE = tuple(c for c in FREE_STRIP_KEYS if c in DTYPE.names)
 _MECH = tuple(c for c in MECHANICAL_KEYS if c in DTYPE.names)
+#: with ``spread=True``: per row, the range of each model-dependent output over the three
+#: permittivity models of the paper's section 6 at the same grid point (the model-form spread of
+#: ``estimate``, forward.estimate.SPREAD_KEYS), columns ``<name>_model_min`` / ``<name>_model_max``
+SPREAD_COLS = tuple(f"{c}_model_{s}" for c in SPREAD_KEYS for s in ("min", "max"))
+SPREAD_DTYPE = np.dtype(DTYPE.descr + [(c, "f8") for c in SPREAD_COLS])
 
 
 def _models(model):
@@ -98,8 +106,9 @@ def count_rows(vary: dict, model="constant") -> int:
 
 def iter_sweep(vary: dict, model="constant", fidelity="quadrature", base: Strip | None = None,
                material: Material = NAFION_LI, tol=None, *, chunk_rows: int = CHUNK_ROWS,
-               escalate: bool = True, progress=None, failures: list | None = None):
-    """The sweep as a generator of structured-array chunks (dtype :data:`DTYPE`).
+               escalate: bool = True, progress=None, failures: list | None = None, spread: bool = False):
+    """The sweep as a generator of structured-array chunks (dtype :data:`DTYPE`, or
+    :data:`SPREAD_DTYPE` with ``spread``).
 
     Memory is ``O(chunk_rows)`` whatever the number of rows: each chunk's grid points are
     decoded from their flat index (``np.unravel_index``), never from a full meshgrid.  Rows
@@ -116,6 +125,9 @@ def iter_sweep(vary: dict, model="constant", fidelity="quadrature", base: Strip 
         ``update(k)`` is called with the rows of each chunk computed.
     failures : list, optional
         Receives one line per chunk that has points with no valid rung (why).
+    spread : bool
+        Add the :data:`SPREAD_COLS`: each chunk's grid points are evaluated with all three
+        permittivity models (three times the work per requested model).
 
     Yields
     ------
@@ -146,7 +158,9 @@ def iter_sweep(vary: dict, model="constant", fidelity="quadrature", base: Strip 
                     cols[c] = axes[j][idx[j]]
                 else:
                     cols[c] = np.full(k, float(const[c]))
-            yield _chunk(cols, perm, fidelity, material, tol, escalate, failures, _pair_code(names, axes, idx, k))
+            code = _pair_code(names, axes, idx, k)
+            arr = _chunk(cols, perm, fidelity, material, tol, escalate, failures, code)
+            yield _with_spread(arr, cols, fidelity, material, tol, escalate, code) if spread else arr
             if progress is not None:
                 progress.update(k)
 
@@ -237,9 +251,26 @@ def _chunk(cols, perm, fidelity, material, tol, escalate, failures, code):
     return arr
 
 
+def _with_spread(arr, cols, fidelity, material, tol, escalate, code):
+    """``arr`` with the :data:`SPREAD_COLS` of its grid points: signed min and max of each of
+    SPREAD_KEYS over the three permittivity models, of the values the output shows (withheld
+    ones, NaN, left out as in ``estimate``'s model_spread; NaN where every model withholds)."""
+    runs = [withhold(arr) if m == arr["model"][0] else
+            withhold(_chunk(cols, get_model(m), fidelity, material, tol, escalate, None, code), copy=False)
+            for m in model_names()]
+    out = np.empty(arr.size, SPREAD_DTYPE)
+    for c in DTYPE.names:
+        out[c] = arr[c]
+    for c in SPREAD_KEYS:
+        vals = [r[c] for r in runs]
+        out[f"{c}_model_min"] = functools.reduce(np.fmin, vals)
+        out[f"{c}_model_max"] = functools.reduce(np.fmax, vals)
+    return out
+
+
 def sweep(vary: dict, model="constant", fidelity="quadrature", base: Strip | None = None,
           material: Material = NAFION_LI, tol=None, progress: bool | None = None, *,
-          escalate: bool = True, max_rows: int | None = None) -> np.ndarray:
+          escalate: bool = True, max_rows: int | None = None, spread: bool = False) -> np.ndarray:
     """Evaluate the strip on the grid spanned by ``vary`` (name -> 1-D values, SI), in memory.
 
     Parameters
@@ -258,6 +289,9 @@ def sweep(vary: dict, model="constant", fidelity="quadrature", base: Strip | Non
     max_rows : int, optional
         Refuse (one-line ``ValueError``) above this many rows (default ``settings.MAX_ROWS``);
         for more, stream with :func:`iter_sweep`.
+    spread : bool
+        Add, per row, the range of each model-dependent output over the three permittivity
+        models at that grid point (:data:`SPREAD_COLS`; the model-form spread).
 
     Returns
     -------
@@ -279,11 +313,12 @@ def sweep(vary: dict, model="constant", fidelity="quadrature", base: Strip | Non
     show = (n > 20000 or fidelity == "bvp") if progress is None else progress
     bar = progress_bar(n, "sweep", enabled=show, unit="row")
     try:
-        parts = list(iter_sweep(vary, model, fidelity, base, material, tol, escalate=escalate, progress=bar))
+        parts = list(iter_sweep(vary, model, fidelity, base, material, tol, escalate=escalate, progress=bar,
+                                spread=spread))
     finally:
         bar.close()
     # the outputs withheld where evaluate, scene and the CLI withhold them (NaN here, None there)
-    return withhold(np.concatenate(parts), copy=False) if parts else np.empty(0, DTYPE)
+    return withhold(np.concatenate(parts), copy=False) if parts else np.empty(0, SPREAD_DTYPE if spread else DTYPE)
 
 
 def withhold(arr: np.ndarray, copy: bool = True) -> np.ndarray:
@@ -305,10 +340,10 @@ def withhold(arr: np.ndarray, copy: bool = True) -> np.ndarray:
     return out
 
 
-def _row_format(names, sep, json_keys=False):
+def _row_format(names, sep, json_keys=False, dtype=SPREAD_DTYPE):
     parts = []
     for c in names:
-        kind = DTYPE[c].kind
+        kind = dtype[c].kind
         f = ("%s" if json_keys else "%.10g") if kind == "f" else "%s"  # JSON: shortest_text strings
         if json_keys:
             key = LABELS.get(c, c)
@@ -435,14 +470,15 @@ def _byte_writer(fh):
     return lambda b: fh.write(b.decode("utf-8"))
 
 
-def write_csv(arr, path, progress=None, workers: int = 1, comments=()):
+def write_csv(arr, path, progress=None, workers: int = 1, comments=(), names=DTYPE.names):
     """CSV with SI columns (header labels say units and TOTAL thickness/width).
 
     ``arr`` is a structured array or an iterable of chunks (streamed, memory independent of
     the number of rows); ``path`` ``None``/``"-"`` is stdout, otherwise written atomically.
     ``workers``: threads formatting pieces at once (the text is the same).  ``comments``:
-    lines written first, each after ``# `` (e.g. the material set and its sources).  Returns
-    the number of rows written.
+    lines written first, each after ``# `` (e.g. the material set and its sources).  ``names``:
+    the columns of the header (the chunks' fields; :data:`SPREAD_DTYPE` ``.names`` with the
+    spread).  Returns the number of rows written.
     """
     chunks = [arr] if isinstance(arr, np.ndarray) else arr
 
@@ -450,7 +486,7 @@ def write_csv(arr, path, progress=None, workers: int = 1, comments=()):
         put = _byte_writer(fh)
         for c in comments:
             put(("# " + " ".join(str(c).split()) + "\n").encode("utf-8"))
-        put((csv_header() + "\n").encode("ascii"))
+        put((csv_header(names) + "\n").encode("ascii"))
         n = 0
         for text, k in _texts(chunks, "csv", int(workers)):
             put(text)

@@ -84,10 +84,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ipmc_asym.base.registry import model_names
 from ipmc_asym.base.results import Panel, ResultMixin, ResultSpec
 from ipmc_asym.base.settings import CHUNK_ROWS
 from ipmc_asym.base.streamstats import SKETCH_K, Moments, QuantileSketch
 from ipmc_asym.base.units import parse_length, parse_voltage
+from ipmc_asym.forward.estimate import SPREAD_NOTE, spread_of
 from ipmc_asym.forward.model import CHECKS, SAMPLING_FIDELITIES, assumption_warnings, forward
 from ipmc_asym.io.datasets import VARIABLES
 from ipmc_asym.model.parameters import ALIASES, PARAMETERS, material_value, parse_value
@@ -96,7 +98,8 @@ from ipmc_asym.parallel.executors import chunk_slices, imap_chunks
 from ipmc_asym.studies.scene_schema import load_scene, parse_scene
 
 __all__ = ["UNCERTAIN", "DISTRIBUTIONS", "OUTPUT_UNITS", "UQResult", "parse_uncertain", "run_uq",
-           "evaluate_samples", "uq_chunk", "uq_stream_chunk", "QUANTILES", "STORE_SAMPLES", "UNCERTAIN_MATERIAL"]
+           "evaluate_samples", "uq_chunk", "uq_stream_chunk", "QUANTILES", "STORE_SAMPLES", "UNCERTAIN_MATERIAL",
+           "SPREAD_STATS", "model_spread"]
 
 #: uncertain names -> (unit, long name), as the datasets label them
 UNCERTAIN = {k: VARIABLES[k] for k in ("length", "width", "thickness", "voltage", "modulus", "c_moy")}
@@ -323,6 +326,10 @@ class UQResult(ResultMixin):
     checks : dict  check name (``forward.model.CHECKS``) -> bool array (n_stored,)
     valid : ndarray of bool (n_stored,)   every check passed
     n_stored : int  runs kept per sample (``n_samples`` when ``store_samples`` allows)
+    model_spread : dict or None
+        With ``run_uq(..., spread=True)``: the same study run with each of the three
+        permittivity models, and for each output and each of :data:`SPREAD_STATS` the range
+        over them (:func:`model_spread`); None otherwise (and absent from :meth:`as_dict`).
     outside_by_check : dict  check name -> samples (of all ``n_samples``) failing it
     n_outside : int   samples outside a model assumption (of all ``n_samples``)
     keep_invalid : bool   the statistics include the samples outside (else they are left out)
@@ -368,9 +375,10 @@ class UQResult(ResultMixin):
     seed: int = 0
     outside_by_check: dict = field(default_factory=dict)
     n_stored: int = 0
+    model_spread: dict = None
 
     def as_dict(self) -> dict:
-        return {"scene": self.scene, "model": self.model, "tolerance": self.tolerance,
+        out = {"scene": self.scene, "model": self.model, "tolerance": self.tolerance,
                 "n_samples": self.n_samples, "base_n": self.base_n, "fidelity": self.fidelity,
                 "n_outside_model": self.n_outside, "keep_invalid": self.keep_invalid, "n_used": self.n_used,
                 "n_sobol_base_points": self.n_sobol, "seed": self.seed,
@@ -381,6 +389,9 @@ class UQResult(ResultMixin):
                            for k, (d, p) in self.inputs.items()},
                 "summary": self.summary, "sobol": self.sobol, "seconds": self.seconds, "timings": self.timings,
                 "thickness_note": "thickness is the TOTAL thickness 2e"}
+        if self.model_spread is not None:
+            out["model_spread"] = self.model_spread
+        return out
 
 
 def _scene_parts(scene):
@@ -704,9 +715,30 @@ def uq_stream_chunk(task):
     return part
 
 
+#: the statistics of each output whose range over the permittivity models ``spread=True`` reports
+SPREAD_STATS = ("mean", "sd", "q2.5", "q50", "q97.5")
+
+
+def model_spread(results: dict, refused: dict | None = None) -> dict:
+    """The model-form spread of a study: ``results`` (model name -> :class:`UQResult` of the same
+    scene, seed and samples) -> ``{"over", "quantities": {output: {stat: spread_of(...)}},
+    "refused": {model: reason}, "note"}``; ``spread_of`` (forward.estimate) gives ``min``,
+    ``max``, ``ratio``, ``values`` per model (None for a model that refused the scene)."""
+    refused = dict(refused or {})
+    first = next(iter(results.values()))
+    labels = list(results) + [m for m in refused if m not in results]
+    q = {}
+    for o, s0 in first.summary.items():
+        q[o] = {"unit": s0["unit"]}
+        for st in SPREAD_STATS:
+            q[o][st] = spread_of({m: (results[m].summary[o][st] if m in results else None) for m in labels})
+    return {"over": "permittivity model: " + ", ".join(labels), "quantities": q, "refused": refused,
+            "note": SPREAD_NOTE}
+
+
 def run_uq(scene, samples: int = 10**6, *, seed: int = 0, fidelity: str | None = None, scheduler=None,
            chunk_rows: int | None = None, keep_invalid: bool = False, store_samples: int = STORE_SAMPLES,
-           sketch_k: int = SKETCH_K) -> UQResult:
+           sketch_k: int = SKETCH_K, spread: bool = False, _model: str | None = None) -> UQResult:
     """Quantiles, moments and Sobol' indices of a scene's outputs under its ``[uncertain]`` inputs.
 
     Streams: the design is generated, evaluated and reduced chunk by chunk (whole Saltelli
@@ -740,6 +772,11 @@ def run_uq(scene, samples: int = 10**6, *, seed: int = 0, fidelity: str | None =
         whole groups of the design; >= 0); the statistics use every run.
     sketch_k : int
         Items per level of the quantile sketch (:class:`ipmc_asym.base.streamstats.QuantileSketch`).
+    spread : bool
+        Also run the study (same design and seed) with the other two permittivity models and
+        report the range of each output's statistics over the three
+        (:attr:`UQResult.model_spread`): the model-form spread beside the sampling error.
+        Three times the work.
 
     Returns
     -------
@@ -766,6 +803,23 @@ def run_uq(scene, samples: int = 10**6, *, seed: int = 0, fidelity: str | None =
     if isinstance(sketch_k, bool) or not isinstance(sketch_k, (int, np.integer)) or sketch_k < 2:
         raise ValueError(f"sketch_k must be an integer >= 2; got {sketch_k!r}")
     name, model, material, base, unc, outputs, tol = _scene_parts(scene)
+    if _model is not None:  # one run of a spread: the scene with another permittivity model
+        model = _model
+    if spread:
+        kw = dict(samples=samples, seed=seed, fidelity=fidelity, scheduler=scheduler, chunk_rows=chunk_rows,
+                  keep_invalid=keep_invalid, store_samples=store_samples, sketch_k=sketch_k)
+        own = run_uq(scene, **kw, _model=model)
+        runs, refused = {}, {}
+        for m in model_names():
+            if m == own.model:
+                runs[m] = own
+                continue
+            try:
+                runs[m] = run_uq(scene, **kw, _model=m)
+            except ValueError as e:  # e.g. the nominal point past a quarter turn for this law
+                refused[m] = str(e)
+        own.model_spread = model_spread(runs, refused)
+        return own
     if not keep_invalid:  # minutes of sampling would end in a refusal: say so first
         check_nominal(model, material, base, unc, tol, fidelity)
     names = list(unc)

@@ -15,7 +15,7 @@ The paper's own permittivity values were adjusted to the deflection and force ra
 (its section 4), so those two rows are not independent of the paper's set: their gap measures
 how far the toolkit's reading of the paper's model is from the paper's stated fit.
 
-Layer rule: validation layer (imports forward, dynamics, model).
+Layer rule: validation layer (imports forward, dynamics, integral, model).
 """
 
 from __future__ import annotations
@@ -26,6 +26,7 @@ from dataclasses import dataclass
 from ipmc_asym.base.registry import MODELS
 from ipmc_asym.dynamics.electrode import time_constant
 from ipmc_asym.forward.model import forward
+from ipmc_asym.integral.charge import charge
 from ipmc_asym.model import groups
 from ipmc_asym.model.electrode import electrode_from_spec
 from ipmc_asym.model.params import NAFION_LI, NOMINAL_STRIP, Material, named_material
@@ -42,6 +43,10 @@ PAPER_INTRO = ("M. Tixier, J. Pouget (conference paper), section 1: tip displace
 YADAV = ("R. Yadav, P. S. Fedkiw, Analysis of EIS technique and Nafion 117 conductivity as a function of "
          "temperature and relative humidity, J. Electrochem. Soc. 159 (2012) B340-B346, abstract: four-probe "
          "82 mS/cm (two-probe 79 mS/cm) in room-temperature liquid water")
+AKLE = ("B. J. Akle, D. J. Leo, M. A. Hickner, J. E. McGrath, Correlation of capacitance and actuation in ionomeric "
+        "polymer transducers, J. Mater. Sci. 40 (2005) 3715-3724, abstract: 'All of the ionomers analyzed in this work "
+        "exhibited a strain-to-charge response between 9 and 15 ustrain/(C/m^2)' (Nafion-117, BPSH and PATS, "
+        "lithium form; strain responses quoted at 1 Hz)")
 DUPONT = ("DuPont, Nafion PFSA Membranes N-115, N-117, N-1110 product information, table B: Conductivity 0.10 S/cm "
           "min (membrane conditioned in 100 C water for 1 h, measured submersed in 25 C deionised water)")
 
@@ -74,6 +79,9 @@ MEASUREMENTS = (
                 "(the paper's nominal strip)", (0.6e-3, 1.3e-3), "N", PAPER),
     Measurement("time_constant", "step time constant", "Nafion IPMC, 2e = 200 um, a few cm, a few volts (stated "
                 "as 'about one second')", 1.0, "s", PAPER_INTRO),
+    Measurement("strain_per_charge", "face strain per unit charge (strain / (C/m^2))", "Nafion-117 IPMC (and two "
+                "other ionomers), Li+ form, plated electrodes; model: the paper's nominal strip, 1 V, the membrane's "
+                "face strain e kappa (magnitude) over the electrode charge sigma", (9e-6, 15e-6), "m^2/C", AKLE),
     Measurement("conductivity_yadav", "ionic conductivity of the membrane", "Nafion 117, H+ form, in liquid "
                 "water at room temperature", 8.2, "S/m", YADAV),
     Measurement("conductivity_dupont", "ionic conductivity of the membrane (a minimum)", "Nafion N-117, H+ form, "
@@ -86,12 +94,16 @@ def _mid(v):
 
 
 def _mechanics(material: Material):
-    """|w| and |F_block| of the nominal strip for each permittivity model (quadrature)."""
+    """|w|, |F_block| and the strain per unit charge of the nominal strip for each permittivity
+    model (quadrature): the membrane's face strain ``e|M_A|/EI`` (forward's ``max_strain``,
+    the composite EI with layers) over the electrode charge per area ``|sigma|`` (which the
+    layers do not change: the electrochemistry keeps the membrane)."""
     s = NOMINAL_STRIP
     out = {}
     for m in MODELS:
         r = forward(s.length, s.width, s.thickness, s.voltage, material=material, model=m, fidelity="quadrature")
-        out[m] = (abs(float(r.w)), abs(float(r.F_block)))
+        sigma = charge(s.thickness, s.voltage, m, "quadrature", width=s.width, length=s.length, material=material).sigma
+        out[m] = (abs(float(r.w)), abs(float(r.F_block)), float(r.max_strain) / abs(float(sigma)))
     return out
 
 
@@ -104,7 +116,8 @@ def diffusion_from_conductivity(kappa, material: Material) -> float:
 def compare() -> list[dict]:
     """Rows ``{key, quantity, strip, source, measured, unit, beam, model: {name: value}, ratio: {name: r}}``.
 
-    The mechanics for the bare membrane and each of :data:`LAYERS`; the time constant and the
+    The mechanics (deflection, force, strain per unit charge) for the bare membrane and each
+    of :data:`LAYERS`; the time constant and the
     conductivity with the values the toolkit ships (``nafion-li`` for the paper's strip,
     ``nafion-117-h`` with the default ``D`` for the conductivity).
     """
@@ -115,8 +128,8 @@ def compare() -> list[dict]:
     mech = {lab: _mechanics(mat) for lab, mat in beams}
     for meas in MEASUREMENTS:
         mid = _mid(meas.value)
-        if meas.key in ("tip_deflection", "blocking_force"):
-            j = 0 if meas.key == "tip_deflection" else 1
+        if meas.key in ("tip_deflection", "blocking_force", "strain_per_charge"):
+            j = ("tip_deflection", "blocking_force", "strain_per_charge").index(meas.key)
             for lab, _ in beams:
                 vals = {m: mech[lab][m][j] for m in MODELS}
                 rows.append(_row(meas, lab, vals, mid))

@@ -118,7 +118,7 @@ CHEAP = {
     "freq": {**STRIP, "--model": MODELS[:3], "--points": COUNTS, "--method": ["pnp-linear", "circuit", "x"],
              "--diffusion": ["1e-10m2/s", "1e-30", "1e10"], "--json": None},
     "sweep": {**STRIP, "--voltage": VOLTS, "--model": MODELS, "--fidelity": ["leading", "corrected"],
-              "--max-rows": COUNTS, "--json": None, "--no-progress": None},
+              "--max-rows": COUNTS, "--json": None, "--no-progress": None, "--spread": None},
     "materials": {"--json": None},
     "drive": {**STRIP, "--model": MODELS[:3], "--points": COUNTS, "--duration": TIMES,
               "--beam": ["quasi-static", "dynamic", "x"], "--json": None},

@@ -123,3 +123,38 @@ def test_prefetched_sweep_identical_to_serial():
     a = np.concatenate(list(iter_sweep(vary, "all", "leading", chunk_rows=10)))
     b = np.concatenate(list(prefetched(iter_sweep(vary, "all", "leading", chunk_rows=10))))
     assert a.tobytes() == b.tobytes()
+
+
+def test_spread_columns_are_the_range_of_the_three_models():
+    """--spread: per row, min/max over the permittivity models of each model-dependent output,
+    against one evaluate per model at that point (independent of the sweep's chunks)."""
+    from ipmc_asym.studies.sweeps import SPREAD_COLS
+
+    vary = {"length": [0.01, 0.03], "voltage": [0.5, 2.0]}
+    arr = sweep(vary, model="linear", spread=True)
+    plain = sweep(vary, model="linear")
+    assert arr.size == 4 and set(SPREAD_COLS) <= set(arr.dtype.names)
+    for c in plain.dtype.names:  # the row's own columns unchanged
+        assert np.array_equal(arr[c], plain[c]) or np.array_equal(arr[c], plain[c], equal_nan=True)
+    for rec in arr:
+        s = Strip(length=float(rec["length"]), voltage=float(rec["voltage"]))
+        for k in ("M_A", "theta", "w", "w_small", "F_block", "F_block_small"):
+            got = [v for v in (evaluate(s, m, on_invalid="nan")[k] for m in ("constant", "linear", "affine"))
+                   if v is not None]
+            rel = 1e-10 if k == "F_block" else 1e-12
+            assert rec[f"{k}_model_min"] == pytest.approx(min(got), rel=rel), k
+            assert rec[f"{k}_model_max"] == pytest.approx(max(got), rel=rel), k
+            assert rec[f"{k}_model_min"] <= rec[k] <= rec[f"{k}_model_max"] or not np.isfinite(rec[k])
+
+
+def test_cli_sweep_spread_csv_and_refusal(capsys):
+    from ipmc_asym.cli import main
+
+    assert main(["sweep", "--vary", "length=1cm:3cm:3", "--spread", "--no-progress"]) == 0
+    lines = [ln for ln in capsys.readouterr().out.splitlines() if not ln.startswith("#")]
+    head = lines[0].split(",")
+    assert head[-2:] == ["F_block_small_model_min", "F_block_small_model_max"] and len(lines) == 4
+    row = dict(zip(head, lines[1].split(",")))
+    assert float(row["w_model_min"]) <= float(row["w"]) <= float(row["w_model_max"])
+    assert main(["sweep", "--vary", "length=1cm:3cm:3", "--spread", "--scheduler", "local"]) == 2
+    assert "--spread" in capsys.readouterr().err

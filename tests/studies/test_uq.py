@@ -278,3 +278,41 @@ def test_nominal_point_outside_the_model_is_refused_before_sampling(monkeypatch)
     uqmod.check_nominal("constant", NAFION_LI, {"length": 0.02, "width": 5e-3, "thickness": 200e-6, "voltage": 1.0,
                                                 "modulus": NAFION_LI.E, "c_moy": NAFION_LI.C_moy},
                         parse_uncertain(inside["uncertain"]), 1e-2, "leading")
+
+
+def test_spread_is_the_range_of_the_runs_of_each_model():
+    """spread=True: each statistic's min/max over three separate runs, one per permittivity model
+    (same design and seed), and the scene's own model's statistics unchanged."""
+    sc = _scene({"modulus": {"dist": "lognormal", "median": "130MPa", "sigma": 0.1}}, ["rotation", "I"])
+    r = run_uq(sc, 64, fidelity="quadrature", keep_invalid=True, spread=True)
+    runs = {m: run_uq({**sc, "model": m}, 64, fidelity="quadrature", keep_invalid=True)
+            for m in ("constant", "linear", "affine")}
+    assert r.summary == runs["constant"].summary
+    sp = r.model_spread
+    assert sp["refused"] == {} and "model_spread" in r.as_dict()
+    for o in ("rotation", "I"):
+        for st in ("mean", "sd", "q2.5", "q50", "q97.5"):
+            vals = [runs[m].summary[o][st] for m in runs]
+            assert sp["quantities"][o][st]["min"] == min(vals) and sp["quantities"][o][st]["max"] == max(vals)
+    assert "model_spread" not in runs["linear"].as_dict()  # asked for only
+
+
+def test_cli_uq_spread_text_and_json(tmp_path, capsys):
+    """uq --spread: the text names the spread per output; the JSON's min/max bracket the scene's
+    own model's statistics (one of the three runs)."""
+    import json
+
+    from ipmc_asym.cli import main
+
+    sc = tmp_path / "u.toml"
+    sc.write_text('name = "n"\nmodel = "constant"\nvoltage = "1V"\noutputs = ["I"]\n[uncertain]\n'
+                  'thickness = {dist = "uniform", low = "180um", high = "220um"}\n')
+    base = ["uq", str(sc), "--samples", "128", "--fidelity", "quadrature", "--keep-invalid"]
+    assert main(base + ["--spread"]) == 0
+    assert "model-form spread" in capsys.readouterr().out
+    assert main(base + ["--spread", "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    q = d["model_spread"]["quantities"]["I"]["mean"]
+    assert q["min"] <= d["summary"]["I"]["mean"] <= q["max"] and set(q["values"]) == {"constant", "linear", "affine"}
+    assert main(base + ["--json"]) == 0
+    assert "model_spread" not in json.loads(capsys.readouterr().out)

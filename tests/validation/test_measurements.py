@@ -21,7 +21,9 @@ def rows():
 
 def test_five_measured_quantities_with_sources(rows):
     keys = {r["key"] for r in rows}
-    assert len(keys) >= 5 and keys == {m.key for m in MEASUREMENTS}
+    assert keys == {m.key for m in MEASUREMENTS}
+    # distinct measured quantities (the two conductivity sources count once)
+    assert len({k.split("_")[0] if k.startswith("conductivity") else k for k in keys}) >= 5
     for r in rows:
         assert r["source"] and r["strip"] and r["unit"]
         mid = math.sqrt(r["measured"][0] * r["measured"][1]) if isinstance(r["measured"], list) else r["measured"]
@@ -56,3 +58,17 @@ def test_docs_page_holds_the_current_table(rows):
     """docs/measurements.md shows what the code gives (regenerate with validate --measurements --out)."""
     page = (REPO / "docs" / "measurements.md").read_text(encoding="utf-8")
     assert to_markdown(rows) in page
+
+
+def test_strain_per_charge_is_face_strain_over_sigma(rows):
+    """e |M_A| / EI (the bare section written out here) over |sigma| from the charge integral."""
+    from ipmc_asym.integral.charge import charge
+
+    r = next(r for r in rows if r["key"] == "strain_per_charge" and r["beam"] == "bare membrane")
+    for m in ("constant", "affine"):
+        f = forward(0.02, 5e-3, 200e-6, 1.0, material=NAFION_LI, model=m, fidelity="quadrature")
+        EI = NAFION_LI.E * 5e-3 * (200e-6) ** 3 / 12
+        sigma = float(charge(200e-6, 1.0, m, "quadrature", material=NAFION_LI).sigma)
+        assert r["model"][m] == pytest.approx(100e-6 * abs(float(f.M_A)) / EI / abs(sigma), rel=1e-9)
+    layered = [x for x in rows if x["key"] == "strain_per_charge" and x["beam"] != "bare membrane"]
+    assert layered and all(x["model"]["constant"] < r["model"]["constant"] for x in layered)
