@@ -1,0 +1,70 @@
+"""``freq --export`` at its defaults meets its tolerance, and ``ia.load_export`` reads it back.
+
+The reference is :func:`ipmc_asym.transfer_function`'s full model (``frequency_response``, the
+exact linearised PNP) evaluated independently of the file: the loaded models, their state space
+and the python-control objects built from them must agree with it within the stated error.
+"""
+
+import json
+
+import numpy as np
+import pytest
+
+import ipmc_asym as ia
+from ipmc_asym.cli import main
+from ipmc_asym.model.params import Strip
+
+BAND = (0.01, 1000.0)
+
+
+@pytest.fixture(scope="module")
+def export(tmp_path_factory):
+    p = tmp_path_factory.mktemp("export") / "tf.json"
+    assert main(["freq", "--from", "0.01Hz", "--to", "1kHz", "--points", "5", "--export", str(p)]) == 0
+    return p
+
+
+def test_export_defaults_meet_their_tolerance(export, capsys):
+    doc = json.loads(export.read_text())
+    for o in ("w", "charge"):
+        m = doc["models"][o]
+        assert m["success"] and m["max_rel_error"] < 1e-4, m["message"]
+
+
+def test_load_export_against_the_full_model(export):
+    exp = ia.load_export(export)
+    assert set(exp.models) == {"w", "charge"}
+    assert exp.thickness_total == Strip().thickness
+    f = np.geomspace(*BAND, 37)
+    full = ia.frequency_response(f, strip=Strip())  # the model the export fitted, evaluated anew
+    s = 2j * np.pi * f
+    # charge per volt = current per volt / s = 1 / (s Z), Z of the whole strip (electrode area 2l L)
+    for o, H in (("w", full.H_w), ("charge", 1.0 / (s * full.Z))):
+        got = exp.frequency_response(f, o)
+        assert np.max(np.abs(got / H - 1)) < 1e-4
+        A, B, C, D = exp[o].state_space()
+        ss = np.array([(C @ np.linalg.solve(si * np.eye(A.shape[0]) - A, B) + D)[0, 0] for si in s])
+        assert np.max(np.abs(ss / H - 1)) < 1e-4
+
+
+def test_load_export_to_python_control(export):
+    control = pytest.importorskip("control")
+    exp = ia.load_export(export)
+    f = np.geomspace(*BAND, 11)
+    H = ia.frequency_response(f, strip=Strip()).H_w
+    sys_ss = exp.to_control("w")
+    sys_tf = exp.to_control("w", form="tf")
+    assert isinstance(sys_ss, control.StateSpace) and isinstance(sys_tf, control.TransferFunction)
+    for sys_ in (sys_ss, sys_tf):
+        got = np.array([complex(sys_(2j * np.pi * fi)) for fi in f])
+        assert np.max(np.abs(got / H - 1)) < 1e-4
+
+
+def test_load_export_bad_file_one_line(tmp_path):
+    bad = tmp_path / "bad.json"
+    bad.write_text("{not json")
+    with pytest.raises(ValueError, match="not a JSON file"):
+        ia.load_export(bad)
+    bad.write_text(json.dumps({"models": {"w": {"output": "w"}}}))
+    with pytest.raises(ValueError, match="no key 'poles'"):
+        ia.load_export(bad)
