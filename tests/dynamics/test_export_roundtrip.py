@@ -68,3 +68,18 @@ def test_load_export_bad_file_one_line(tmp_path):
     bad.write_text(json.dumps({"models": {"w": {"output": "w"}}}))
     with pytest.raises(ValueError, match="no key 'poles'"):
         ia.load_export(bad)
+
+
+def test_load_export_is_transfer_function_undamped_beam(tmp_path):
+    """With the undamped dynamic beam (resonances on the imaginary axis) the file still meets its
+    tolerance, and the loaded model is ``transfer_function``'s own (JSON keeps every digit)."""
+    p = tmp_path / "dyn.json"
+    assert main(["freq", "--from", "0.01Hz", "--to", "1kHz", "--points", "5", "--beam", "dynamic",
+                 "--export", str(p)]) == 0
+    exp = ia.load_export(p)
+    assert exp["w"].success and exp["w"].max_rel_error < 1e-4
+    tf = ia.transfer_function(*BAND, beam="dynamic", output="w")
+    f = np.geomspace(*BAND, 301)
+    assert np.array_equal(exp.frequency_response(f, "w"), tf(f))
+    H = ia.frequency_response(f, beam="dynamic").H_w
+    assert np.max(np.abs(exp.frequency_response(f, "w") / H - 1)) < 1e-4
