@@ -83,3 +83,16 @@ def test_load_export_is_transfer_function_undamped_beam(tmp_path):
     assert np.array_equal(exp.frequency_response(f, "w"), tf(f))
     H = ia.frequency_response(f, beam="dynamic").H_w
     assert np.max(np.abs(exp.frequency_response(f, "w") / H - 1)) < 1e-4
+
+
+def test_w_and_F_phases_one_convention():
+    """Quasi-static small displacements: ``w = -M L^2/(2 EI)``, ``F = 3 M/(2 L)`` (eqs (13), (14)), so
+    ``H_F/H_w = -3 EI/L^3`` at every frequency: both phases are ``arg H`` of the signed output, 180 deg
+    apart (the docs' convention), not of opposite sign conventions."""
+    s = Strip()
+    f = np.geomspace(0.1, 100.0, 7)
+    r = ia.frequency_response(f, strip=s)
+    EI = ia.NAFION_LI.E * s.width * s.thickness**3 / 12.0
+    assert np.allclose(r.H_F / r.H_w, -3.0 * EI / s.length**3, rtol=1e-9)
+    d = np.degrees(np.angle(r.H_F) - r.w_phase) % 360.0
+    assert np.allclose(d, 180.0, atol=1e-9)
