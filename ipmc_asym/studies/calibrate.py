@@ -624,27 +624,20 @@ def multistart_starts(x0, lo, hi, multistart, seed) -> list:
     return starts
 
 
-def fit(data, free, model="constant", material: Material = NAFION_LI,
+def fit(data: CalibrationData, free, model="constant", material: Material = NAFION_LI,
         fidelity: str | None = None, multistart: int = 0, seed: int = 0, scheduler=None,
-        progress: bool | None = False, *, strip: Strip | None = None, waveform=None, beam: str | None = None,
-        viscous_modulus: float = 0.0, time_fidelity: str | None = None) -> CalibrationResult:
+        progress: bool | None = False) -> CalibrationResult:
     """Weighted least squares of ``data`` over the ``free`` parameters, with profile intervals.
-
-    One entry for every kind of data, as ``ipmc-asym fit``: static rows are fitted here, time
-    series and impedance spectra (alone or with static rows) by
-    :func:`ipmc_asym.studies.calibrate_dynamic.fit_dynamic`, with the same result type.
 
     Parameters
     ----------
-    data : CalibrationData, TimeData, ImpedanceData, path, or a list of them
-        Data sets (:func:`read_data`, :func:`ipmc_asym.studies.calibrate_dynamic.read_file`) or
-        CSV paths (read by ``read_file`` with ``strip`` as the geometry and ``waveform`` as the
-        drive of a time series without a voltage column); several are fitted together.
+    data : CalibrationData
     free : str, list or dict
-        Names from :data:`FREE_PARAMETERS` (``modulus``, ``c_moy``, ``eps0``, ``deps``; with time
-        series or spectra also ``diffusion`` (alias ``D``), ``viscous_modulus``,
-        ``sheet_resistance``), or ``{name: (lo, hi)}`` bounds in SI (default bounds otherwise).
-        A parameter the data cannot see is refused naming the data that would identify it.
+        Names from :data:`FREE_PARAMETERS` (``modulus``, ``c_moy``, ``eps0``, ``deps``), or
+        ``{name: (lo, hi)}`` bounds in SI (default bounds otherwise).  ``diffusion``,
+        ``viscous_modulus`` and ``sheet_resistance`` are refused here (static rows do not
+        depend on them): time series and spectra go to
+        :func:`ipmc_asym.studies.calibrate_dynamic.fit_dynamic`.
     model : {"constant", "linear", "affine"}
         Permittivity model (its eps0/deps are the start/fixed values).
     material : Material
@@ -658,13 +651,6 @@ def fit(data, free, model="constant", material: Material = NAFION_LI,
     scheduler : None, "local" or "tcp://HOST:PORT"
     progress : bool or None
         A bar on stderr counting model evaluations (None: when stderr is a terminal).
-    strip : Strip, optional
-        Geometry of time series and spectra (TOTAL thickness 2e, TOTAL width 2l); static rows
-        take theirs from their columns.
-    waveform : str, optional
-        Drive of time series read from paths without a voltage column (``"step:0.5V"``).
-    beam, viscous_modulus, time_fidelity
-        Time series only: as :func:`ipmc_asym.studies.calibrate_dynamic.fit_dynamic`.
 
     Returns
     -------
@@ -674,8 +660,7 @@ def fit(data, free, model="constant", material: Material = NAFION_LI,
     ------
     ValueError
         One line: unknown parameter, too many free parameters for the data (the request is
-        refused before any work), a fidelity outside its validity at every rung, a time-series
-        option with static rows only.
+        refused before any work), a fidelity outside its validity at every rung.
 
     Examples
     --------
@@ -689,20 +674,6 @@ def fit(data, free, model="constant", material: Material = NAFION_LI,
     """
     from scipy import stats  # deferred: heavy import (start-up)
 
-    if not isinstance(data, CalibrationData):
-        # deferred: calibrate_dynamic imports this module (its reader and its fit build on the static ones)
-        from ipmc_asym.studies.calibrate_dynamic import fit_dynamic, read_file
-
-        parts = list(data) if isinstance(data, (list, tuple)) else [data]
-        parts = [read_file(d, strip, waveform=waveform) if isinstance(d, (str, os.PathLike)) else d for d in parts]
-        if not (len(parts) == 1 and isinstance(parts[0], CalibrationData)):
-            return fit_dynamic(parts, free, model=model, material=material, strip=strip, beam=beam,
-                               viscous_modulus=viscous_modulus, fidelity=fidelity, time_fidelity=time_fidelity,
-                               multistart=multistart, seed=seed, scheduler=scheduler, progress=progress)
-        data = parts[0]
-    for opt, val in (("beam", beam), ("time_fidelity", time_fidelity), ("waveform", waveform)):
-        if val is not None:
-            raise ValueError(f"{opt}: only for time series (a file with a t column); {data.source} holds static rows")
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
         raise ValueError(f"seed must be an integer >= 0; got {seed!r}")
     bounds = parse_free(free)

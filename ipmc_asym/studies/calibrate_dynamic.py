@@ -97,8 +97,11 @@ from ipmc_asym.studies.calibrate import (
     read_rows,
     static_ladder,
 )
+from ipmc_asym.studies.calibrate import (
+    fit as fit_static,
+)
 
-__all__ = ["TIME_MEASURED", "IMPEDANCE_MEASURED", "TimeData", "ImpedanceData", "read_file", "fit_dynamic",
+__all__ = ["TIME_MEASURED", "IMPEDANCE_MEASURED", "TimeData", "ImpedanceData", "read_file", "fit_dynamic", "fit",
            "predict_time", "predict_impedance", "TIME_FIDELITIES"]
 
 #: measured columns of a time series -> unit (signed values)
@@ -731,6 +734,76 @@ def fit_dynamic(datasets, free, model="constant", material: Material = NAFION_LI
                           time_fidelity)
     finally:
         bar.close()
+
+
+def fit(data, free, model="constant", material: Material = NAFION_LI, fidelity: str | None = None,
+        multistart: int = 0, seed: int = 0, scheduler=None, progress: bool | None = False, *,
+        strip: Strip | None = None, waveform=None, beam: str | None = None, viscous_modulus: float = 0.0,
+        time_fidelity: str | None = None) -> CalibrationResult:
+    """Weighted least squares of any data over the ``free`` parameters, with profile intervals.
+
+    One entry for every kind of data, as ``ipmc-asym fit``: static rows alone are fitted by
+    :func:`ipmc_asym.studies.calibrate.fit`, time series and impedance spectra (alone or with
+    static rows) by :func:`fit_dynamic`; the same :class:`~ipmc_asym.studies.calibrate.CalibrationResult`.
+
+    Parameters
+    ----------
+    data : CalibrationData, TimeData, ImpedanceData, path, or a list of them
+        Data sets (:func:`ipmc_asym.studies.calibrate.read_data`, :func:`read_file`) or CSV paths
+        (read by :func:`read_file` with ``strip`` as the geometry and ``waveform`` as the drive of a
+        time series without a voltage column); several are fitted together.
+    free : str, list or dict
+        Names of :data:`ipmc_asym.studies.calibrate.FREE_PARAMETERS` (``modulus``, ``c_moy``,
+        ``eps0``, ``deps``; with time series or spectra also ``diffusion`` (alias ``D``),
+        ``viscous_modulus``, ``sheet_resistance``), with optional bounds
+        (``"diffusion=1e-11m2/s:1e-9m2/s"``) or ``{name: (lo, hi)}`` in SI.  A parameter the data
+        cannot see is refused naming the data that would identify it.
+    model : {"constant", "linear", "affine"}
+    material : Material
+        Fixed values and start values.
+    fidelity : str, optional
+        Force the static rows' rung.
+    multistart, seed, scheduler, progress
+        As :func:`ipmc_asym.studies.calibrate.fit`.
+    strip : Strip, optional
+        Geometry of time series and spectra (TOTAL thickness 2e, TOTAL width 2l; the electrode
+        area 2l L of a ``step``/``drive --out`` file's per-area columns).
+    waveform : str, optional
+        Drive of time series read from paths without a voltage column (``"step:0.5V"``).
+    beam, viscous_modulus, time_fidelity
+        Time series only: as :func:`fit_dynamic`.
+
+    Returns
+    -------
+    CalibrationResult
+
+    Raises
+    ------
+    ValueError
+        One line: as the two fits, and a time-series option given with static rows only.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> path = os.path.join(tempfile.mkdtemp(), "data.csv")
+    >>> with open(path, "w") as fh:
+    ...     _ = fh.write("voltage,deflection\\n0.5V,1.0mm\\n1V,2.1mm\\n1.5V,2.9mm\\n")
+    >>> res = fit(path, "modulus", fidelity="corrected")
+    >>> res.success, res.parameters["modulus"]["identifiable"]
+    (True, True)
+    """
+    parts = list(data) if isinstance(data, (list, tuple)) else [data]
+    parts = [read_file(d, strip, waveform=waveform) if isinstance(d, (str, os.PathLike)) else d for d in parts]
+    if not (len(parts) == 1 and isinstance(parts[0], CalibrationData)):
+        return fit_dynamic(parts, free, model=model, material=material, strip=strip, beam=beam,
+                           viscous_modulus=viscous_modulus, fidelity=fidelity, time_fidelity=time_fidelity,
+                           multistart=multistart, seed=seed, scheduler=scheduler, progress=progress)
+    for opt, val in (("beam", beam), ("time_fidelity", time_fidelity), ("waveform", waveform)):
+        if val is not None:
+            raise ValueError(f"{opt}: only for time series (a file with a t column); {parts[0].source} holds static "
+                             f"rows")
+    return fit_static(parts[0], free, model=model, material=material, fidelity=fidelity, multistart=multistart,
+                      seed=seed, scheduler=scheduler, progress=progress)
 
 
 def _fit_joint(parts, names, bounds, lo, hi, starts, s_ladder, t_ladder, has_static, has_time, has_sigma, n, model,
