@@ -52,8 +52,9 @@ _LAZY = {
     "parse_waveform": ("ipmc_asym.dynamics.waveforms", "parse_waveform"),
     "line_response": ("ipmc_asym.dynamics.line", "line_response"),
     "transfer_function": ("ipmc_asym.dynamics.reduction", "transfer_function"),
+    "load_export": ("ipmc_asym.dynamics.reduction", "load_export"),
     # studies (fit, uq, design, profiles, validate, laws, figures)
-    "fit": ("ipmc_asym.studies.calibrate", "fit"),
+    "fit": ("ipmc_asym.studies.calibrate_dynamic", "fit"),
     "read_fit_data": ("ipmc_asym.studies.calibrate", "read_data"),
     "uq": ("ipmc_asym.studies.uq", "run_uq"),
     "design": ("ipmc_asym.studies.design", "design"),

@@ -135,7 +135,7 @@ def run(args):
             head["beam_error_max"] = float(np.max(r.beam_error)) if r.beam_error.size else 0.0
     if args.export is not None:
         fits = {o: transfer_function(args.f1, args.f2, strip=strip, model=args.model, material=material, output=o,
-                                     method=args.method, tol=args.export_tol, beam=args.beam,
+                                     method=r.method, tol=args.export_tol, beam=args.beam,
                                      viscous_modulus=args.viscous_modulus, voltage=args.voltage,
                                      **({} if args.sheet_resistance is None else
                                         {"sheet_resistance": args.sheet_resistance}))

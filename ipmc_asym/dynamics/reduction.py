@@ -16,18 +16,21 @@ the smooth remainder).  Outside the band nothing is claimed.
 
 from __future__ import annotations
 
+import json
 import math
+import os
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from ipmc_asym.base.inputs import read_input_text
 from ipmc_asym.base.results import Panel, ResultMixin, ResultSpec
 from ipmc_asym.beam.dynamics import DEFAULT_MODES, natural_frequencies, transfer
 from ipmc_asym.dynamics.circuit import frequency_response, strip_beam
 from ipmc_asym.dynamics.line import line_response
 from ipmc_asym.model.params import NAFION_LI, Material, Strip
 
-__all__ = ["RationalModel", "transfer_function", "vector_fit", "OUTPUTS", "MAX_ORDER"]
+__all__ = ["RationalModel", "ExportedModels", "load_export", "transfer_function", "vector_fit", "OUTPUTS", "MAX_ORDER"]
 
 #: the transfer functions :func:`transfer_function` exports: name -> (meaning, unit)
 OUTPUTS = {"w": ("tip deflection per volt (small displacements)", "m/V"),
@@ -118,13 +121,65 @@ class RationalModel(ResultMixin):
             i += m
         return Am, np.concatenate(B)[:, None], np.concatenate(C)[None, :], np.array([[self.d]])
 
-    def to_control(self):
-        """The model as a ``control.StateSpace`` (the optional python-control package)."""
+    def to_control(self, form="ss"):
+        """The model for the optional python-control package.
+
+        Parameters
+        ----------
+        form : {"ss", "tf"}
+            ``"ss"``: a ``control.StateSpace`` (the real realisation of :meth:`state_space`);
+            ``"tf"``: a ``control.TransferFunction`` (numerator/denominator polynomials in ``s``,
+            rad/s; of an order-n model a ratio of degree-n polynomials, ill-conditioned past
+            order ~20: prefer ``"ss"`` there).
+        """
+        if form not in ("ss", "tf"):
+            raise ValueError(f"form must be 'ss' or 'tf'; got {form!r}")
         try:
             import control  # deferred: optional dependency (pip install ".[control]")
         except ImportError:
             raise ValueError("to_control needs the python-control package: pip install \"ipmc_asym[control]\"") from None
-        return control.ss(*self.state_space())
+        sys_ = control.ss(*self.state_space())
+        return sys_ if form == "ss" else control.ss2tf(sys_)
+
+    @classmethod
+    def from_dict(cls, d: dict, where: str = "model") -> RationalModel:
+        """The model of :meth:`to_dict` (a ``freq --export`` file's ``models[output]``).
+
+        Raises
+        ------
+        ValueError
+            One line naming the missing or malformed key.
+        """
+        def get(k):
+            if not isinstance(d, dict) or k not in d:
+                raise ValueError(f"{where}: no key {k!r} (a model written by freq --export / RationalModel.to_dict)")
+            return d[k]
+
+        def pairs(k):
+            v = get(k)
+            try:
+                a = np.asarray(v, dtype=float).reshape(-1, 2)
+            except (TypeError, ValueError):
+                raise ValueError(f"{where}: {k!r} must be a list of [re, im] pairs") from None
+            if not np.all(np.isfinite(a)):
+                raise ValueError(f"{where}: {k!r} must be finite")
+            return a[:, 0] + 1j * a[:, 1]
+
+        poles, residues = pairs("poles"), pairs("residues")
+        if poles.size != residues.size:
+            raise ValueError(f"{where}: {poles.size} poles but {residues.size} residues")
+        output = get("output")
+        if output not in OUTPUTS:
+            raise ValueError(f"{where}: output must be one of {', '.join(OUTPUTS)}; got {output!r}")
+        try:
+            band = tuple(float(x) for x in get("band_Hz"))
+            num = {k: float(get(k)) for k in ("d", "d1", "max_rel_error")}
+        except (TypeError, ValueError):
+            raise ValueError(f"{where}: band_Hz, d, d1 and max_rel_error must be numbers") from None
+        return cls(poles=poles, residues=residues, d=num["d"], band=band, max_rel_error=num["max_rel_error"],
+                   output=output, unit=str(get("unit")), model=str(get("model")), method=str(get("method")),
+                   success=bool(get("success")), message=str(get("message")), notes=list(d.get("notes", [])),
+                   d1=num["d1"])
 
     def to_dict(self) -> dict:
         """JSON-ready: poles and residues as [re, im] pairs, the state space, the stated error."""
@@ -396,3 +451,94 @@ def transfer_function(f_min, f_max, *, strip: Strip | None = None, model="consta
     fit.message = (f"order {fit.order}: max relative error {err:.2e} on {f_chk.size} check frequencies in the band"
                    + ("" if fit.success else f" (> tol {tol:g})"))
     return fit
+
+
+@dataclass(repr=False)
+class ExportedModels:
+    """The reduced-order models of a ``freq --export`` file (:func:`load_export`).
+
+    Attributes
+    ----------
+    models : dict
+        Output (``"w"``: tip deflection per volt, m/V; ``"charge"``: electrode charge per volt,
+        C/V) -> :class:`RationalModel`, each with its band and stated error.
+    thickness_total : float       TOTAL thickness 2e of the strip (m)
+    electrode_area : float        2l L (m^2)
+    diffusion_coefficient : float D (m^2/s)
+    notes : list of str
+    """
+
+    models: dict
+    thickness_total: float
+    electrode_area: float
+    diffusion_coefficient: float
+    notes: list = field(default_factory=list)
+
+    def __getitem__(self, output) -> RationalModel:
+        try:
+            return self.models[output]
+        except KeyError:
+            raise KeyError(f"no exported model {output!r}; the file holds {', '.join(self.models)}") from None
+
+    def __repr__(self):
+        parts = [f"{o}: order {m.order}, band {m.band[0]:g}-{m.band[1]:g} Hz, max rel. error {m.max_rel_error:.2g} "
+                 f"({m.unit})" for o, m in self.models.items()]
+        return "ExportedModels(" + "; ".join(parts) + ")"
+
+    def frequency_response(self, f, output="w"):
+        """``H(2 pi i f)`` of one exported model (complex, shape of ``f``; the stated error holds in its band)."""
+        return self[output](f)
+
+    def to_control(self, output="w", form="ss"):
+        """A ``control.StateSpace`` (``form="ss"``) or ``control.TransferFunction`` (``"tf"``) of one model."""
+        return self[output].to_control(form)
+
+
+def load_export(path) -> ExportedModels:
+    """Read a ``freq --export`` JSON file back into its models.
+
+    Parameters
+    ----------
+    path : str or path
+        The file ``ipmc-asym freq --export F.json`` wrote (read through the bounded input reader).
+
+    Returns
+    -------
+    ExportedModels
+        ``[output]`` a :class:`RationalModel` (``"w"`` m/V, ``"charge"`` C/V; ``current = s x
+        charge``), ``.frequency_response(f, output)``, ``.to_control(output, form)`` (python-control,
+        the optional ``control`` extra).
+
+    Raises
+    ------
+    ValueError
+        One line: not JSON, or a key missing or malformed (named).
+
+    Examples
+    --------
+    >>> import os, tempfile, json
+    >>> import ipmc_asym as ia
+    >>> tf = ia.transfer_function(0.01, 100.0)
+    >>> path = os.path.join(tempfile.mkdtemp(), "tf.json")
+    >>> with open(path, "w") as fh:
+    ...     _ = fh.write(json.dumps({"models": {"w": tf.to_dict()}, "thickness_total": 2e-4,
+    ...                              "electrode_area": 1e-4, "diffusion_coefficient": 1e-10}))
+    >>> m = ia.load_export(path)
+    >>> bool(m.frequency_response(1.0) == tf(1.0))
+    True
+    """
+    name = os.path.basename(os.fspath(path))
+    try:
+        doc = json.loads(read_input_text(path, "export file"))
+    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise ValueError(f"{name}: not a JSON file written by freq --export ({exc.__class__.__name__})") from None
+    if not isinstance(doc, dict) or not isinstance(doc.get("models"), dict) or not doc["models"]:
+        raise ValueError(f"{name}: no 'models' object (a file written by freq --export)")
+    models = {o: RationalModel.from_dict(m, f"{name} models[{o!r}]") for o, m in doc["models"].items()}
+    try:
+        geo = {k: float(doc[k]) for k in ("thickness_total", "electrode_area", "diffusion_coefficient")}
+    except KeyError as exc:
+        raise ValueError(f"{name}: no key {exc.args[0]!r}") from None
+    except (TypeError, ValueError):
+        raise ValueError(f"{name}: thickness_total, electrode_area, diffusion_coefficient must be numbers") from None
+    return ExportedModels(models=models, notes=list(doc.get("notes", [])), **geo)

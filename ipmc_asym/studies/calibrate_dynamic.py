@@ -68,7 +68,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ipmc_asym.base.units import parse_force, parse_length, parse_quantity, parse_time, parse_voltage
-from ipmc_asym.beam.dynamics import Beam, natural_frequencies, viscous_modulus_from_damping_ratio
+from ipmc_asym.beam.dynamics import CLAMPED_OUTPUTS, Beam, natural_frequencies, viscous_modulus_from_damping_ratio
 from ipmc_asym.dynamics.circuit import WATER_NOTE, step_response
 from ipmc_asym.dynamics.line import line_response
 from ipmc_asym.dynamics.waveforms import parse_waveform
@@ -97,14 +97,25 @@ from ipmc_asym.studies.calibrate import (
     read_rows,
     static_ladder,
 )
+from ipmc_asym.studies.calibrate import (
+    fit as fit_static,
+)
 
-__all__ = ["TIME_MEASURED", "IMPEDANCE_MEASURED", "TimeData", "ImpedanceData", "read_file", "fit_dynamic",
+__all__ = ["TIME_MEASURED", "IMPEDANCE_MEASURED", "TimeData", "ImpedanceData", "read_file", "fit_dynamic", "fit",
            "predict_time", "predict_impedance", "TIME_FIDELITIES"]
 
 #: measured columns of a time series -> unit (signed values)
 TIME_MEASURED = {"current": "A", "charge": "C", "deflection": "m", "blocking_force": "N"}
 #: measured columns of an impedance spectrum -> unit (pairs: Z_re with Z_im, Z_abs with Z_phase)
 IMPEDANCE_MEASURED = {"Z_re": "Ohm", "Z_im": "Ohm", "Z_abs": "Ohm", "Z_phase": "deg"}
+#: columns of a ``step --out`` / ``drive --out`` CSV -> (the fit's column, factor): read as they are
+#: (``"area"``: per electrode area, multiplied by the strip's ``2l L``; ``w`` is the paper's signed
+#: deflection, negative where a positive voltage bends the strip, the fit's ``deflection`` its opposite)
+STEP_FILE_COLUMNS = {"phi0": ("voltage", 1.0), "sigma": ("charge", "area"), "current_density": ("current", "area"),
+                     "w": ("deflection", -1.0), "F_block": ("blocking_force", 1.0)}
+#: columns of those files that are the model's own (stated errors, internal state, checks): not data
+STEP_FILE_IGNORED = ("M_A", "theta", "layer_voltage", "sigma_error", "current_error", "w_error", "valid",
+                     *CLAMPED_OUTPUTS)
 #: the time-domain rungs, cheapest first (dynamics.circuit.STEP_FIDELITIES)
 TIME_FIDELITIES = ("circuit", "pnp")
 
@@ -140,6 +151,8 @@ class TimeData(MeasuredColumns):
     measured : dict            column -> array (n,), NaN where not measured (signed)
     sigma : dict               column -> array (n,) or None
     source : str
+    area : float or None       electrode area 2l L (m^2) that turned a ``step``/``drive --out`` file's
+                               per-area columns into totals (None: the file gave totals)
     """
 
     t: np.ndarray
@@ -148,6 +161,7 @@ class TimeData(MeasuredColumns):
     measured: dict
     sigma: dict
     source: str = "time series"
+    area: float | None = None
     kind = "time"
 
     @property
@@ -243,7 +257,46 @@ def _need(name, cols, col, what):
         raise ValueError(f"{name} row {i + 2}, column {col!r}: empty ({what} needs a value in every row)")
 
 
-def _read_time(name, rows, header, waveform):
+def _step_columns(name, rows, base):
+    """A CSV of ``step --out`` / ``drive --out`` read as it is: its columns renamed to the fit's
+    (:data:`STEP_FILE_COLUMNS`), the per-area ones multiplied by the electrode area ``2l L`` of
+    ``base``, ``w`` negated (the fit's deflection is positive where a positive voltage bends the
+    strip), the model's own columns (:data:`STEP_FILE_IGNORED`) dropped.  Returns the rows and
+    the area used (None: not such a file)."""
+    header = [h.strip() for h in rows[0]]
+    low = [h.lower() for h in header]
+    if not set(low) & {k.lower() for k in STEP_FILE_COLUMNS}:
+        return rows, None
+    if "model" in low:
+        raise ValueError(f"{name}: column 'model': a file of several models (step --model all); write one model "
+                         f"per file (--model NAME)")
+    base = Strip() if base is None else base
+    area = base.width * base.length
+    renamed = {k.lower(): v for k, v in STEP_FILE_COLUMNS.items()}
+    drop = {k.lower() for k in STEP_FILE_IGNORED}
+    keep = [j for j, h in enumerate(low) if h not in drop and not h.startswith("check_")]
+    new_header = [renamed.get(low[j], (header[j], 1.0))[0] for j in keep]
+    factor = [renamed.get(low[j], (header[j], 1.0))[1] for j in keep]
+    out = [new_header]
+    for r in rows[1:]:
+        row = []
+        for j, f in zip(keep, factor):
+            cell = r[j].strip() if j < len(r) else ""
+            if f != 1.0 and cell != "":
+                try:
+                    cell = repr(float(cell) * (area if f == "area" else f))
+                except ValueError:
+                    raise ValueError(f"{name} row {len(out) + 1}, column {header[j]!r}: a number in SI units (as "
+                                     f"step/drive --out write it); got {cell!r}") from None
+            row.append(cell)
+        if len(r) != len(header):
+            raise ValueError(f"{name} row {len(out) + 1}: {len(r)} fields, header has {len(header)}")
+        out.append(row)
+    return out, area
+
+
+def _read_time(name, rows, header, waveform, base=None):
+    rows, area = _step_columns(name, rows, base)
     allowed = ["t", "voltage"] + list(TIME_MEASURED) + [f"sigma_{m}" for m in TIME_MEASURED]
     header = _columns(name, rows, allowed)
     unit = {"current": lambda c, x: parse_quantity(c, x, _CURRENT, "current"),
@@ -281,7 +334,8 @@ def _read_time(name, rows, header, waveform):
     if peak == 0.0:
         raise ValueError(f"{name}: the drive is 0 V at every time: nothing charges or bends")
     sigma = _sigmas(name, cols, meas)
-    return TimeData(t=t, drive=drive, drive_spec=spec, measured={m: cols[m] for m in meas}, sigma=sigma, source=name)
+    return TimeData(t=t, drive=drive, drive_spec=spec, measured={m: cols[m] for m in meas}, sigma=sigma, source=name,
+                    area=area)
 
 
 def _read_impedance(name, rows, header):
@@ -351,7 +405,7 @@ def read_file(path, base: Strip | None = None, *, waveform=None, max_rows: int |
     if "t" in header and "f" in header:
         raise ValueError(f"{name}: both t and f columns; a file holds a time series (t) or a spectrum (f), not both")
     if "t" in header:
-        return _read_time(name, rows, header, waveform)
+        return _read_time(name, rows, header, waveform, base)
     if "f" in header:
         return _read_impedance(name, rows, header)
     return read_data(p, base, max_rows)
@@ -648,6 +702,12 @@ def fit_dynamic(datasets, free, model="constant", material: Material = NAFION_LI
     if "viscous_modulus" in names and beam != "dynamic":
         raise ValueError("--free viscous_modulus: the quasi-static beam has no damping; use --beam dynamic")
     has_time = any(isinstance(d, TimeData) for d in parts)
+    for d in parts:
+        # a step/drive file's per-area columns were made totals with the area of the strip it was read with
+        if isinstance(d, TimeData) and d.area is not None and not math.isclose(
+                d.area, strip.width * strip.length, rel_tol=1e-9):
+            raise ValueError(f"{d.source}: its per-area columns were read with an electrode area {d.area:.6g} m^2, "
+                             f"the fit's strip has {strip.width * strip.length:.6g} m^2; read it with the same strip")
     has_static = any(isinstance(d, CalibrationData) for d in parts)
     if has_time and ("sheet_resistance" in names or material.sheet_resistance > 0):
         raise ValueError("time series with an electrode sheet resistance: the time-domain model has ideal electrodes "
@@ -674,6 +734,76 @@ def fit_dynamic(datasets, free, model="constant", material: Material = NAFION_LI
                           time_fidelity)
     finally:
         bar.close()
+
+
+def fit(data, free, model="constant", material: Material = NAFION_LI, fidelity: str | None = None,
+        multistart: int = 0, seed: int = 0, scheduler=None, progress: bool | None = False, *,
+        strip: Strip | None = None, waveform=None, beam: str | None = None, viscous_modulus: float = 0.0,
+        time_fidelity: str | None = None) -> CalibrationResult:
+    """Weighted least squares of any data over the ``free`` parameters, with profile intervals.
+
+    One entry for every kind of data, as ``ipmc-asym fit``: static rows alone are fitted by
+    :func:`ipmc_asym.studies.calibrate.fit`, time series and impedance spectra (alone or with
+    static rows) by :func:`fit_dynamic`; the same :class:`~ipmc_asym.studies.calibrate.CalibrationResult`.
+
+    Parameters
+    ----------
+    data : CalibrationData, TimeData, ImpedanceData, path, or a list of them
+        Data sets (:func:`ipmc_asym.studies.calibrate.read_data`, :func:`read_file`) or CSV paths
+        (read by :func:`read_file` with ``strip`` as the geometry and ``waveform`` as the drive of a
+        time series without a voltage column); several are fitted together.
+    free : str, list or dict
+        Names of :data:`ipmc_asym.studies.calibrate.FREE_PARAMETERS` (``modulus``, ``c_moy``,
+        ``eps0``, ``deps``; with time series or spectra also ``diffusion`` (alias ``D``),
+        ``viscous_modulus``, ``sheet_resistance``), with optional bounds
+        (``"diffusion=1e-11m2/s:1e-9m2/s"``) or ``{name: (lo, hi)}`` in SI.  A parameter the data
+        cannot see is refused naming the data that would identify it.
+    model : {"constant", "linear", "affine"}
+    material : Material
+        Fixed values and start values.
+    fidelity : str, optional
+        Force the static rows' rung.
+    multistart, seed, scheduler, progress
+        As :func:`ipmc_asym.studies.calibrate.fit`.
+    strip : Strip, optional
+        Geometry of time series and spectra (TOTAL thickness 2e, TOTAL width 2l; the electrode
+        area 2l L of a ``step``/``drive --out`` file's per-area columns).
+    waveform : str, optional
+        Drive of time series read from paths without a voltage column (``"step:0.5V"``).
+    beam, viscous_modulus, time_fidelity
+        Time series only: as :func:`fit_dynamic`.
+
+    Returns
+    -------
+    CalibrationResult
+
+    Raises
+    ------
+    ValueError
+        One line: as the two fits, and a time-series option given with static rows only.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> path = os.path.join(tempfile.mkdtemp(), "data.csv")
+    >>> with open(path, "w") as fh:
+    ...     _ = fh.write("voltage,deflection\\n0.5V,1.0mm\\n1V,2.1mm\\n1.5V,2.9mm\\n")
+    >>> res = fit(path, "modulus", fidelity="corrected")
+    >>> res.success, res.parameters["modulus"]["identifiable"]
+    (True, True)
+    """
+    parts = list(data) if isinstance(data, (list, tuple)) else [data]
+    parts = [read_file(d, strip, waveform=waveform) if isinstance(d, (str, os.PathLike)) else d for d in parts]
+    if not (len(parts) == 1 and isinstance(parts[0], CalibrationData)):
+        return fit_dynamic(parts, free, model=model, material=material, strip=strip, beam=beam,
+                           viscous_modulus=viscous_modulus, fidelity=fidelity, time_fidelity=time_fidelity,
+                           multistart=multistart, seed=seed, scheduler=scheduler, progress=progress)
+    for opt, val in (("beam", beam), ("time_fidelity", time_fidelity), ("waveform", waveform)):
+        if val is not None:
+            raise ValueError(f"{opt}: only for time series (a file with a t column); {parts[0].source} holds static "
+                             f"rows")
+    return fit_static(parts[0], free, model=model, material=material, fidelity=fidelity, multistart=multistart,
+                      seed=seed, scheduler=scheduler, progress=progress)
 
 
 def _fit_joint(parts, names, bounds, lo, hi, starts, s_ladder, t_ladder, has_static, has_time, has_sigma, n, model,

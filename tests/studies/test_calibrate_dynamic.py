@@ -317,3 +317,21 @@ def test_two_static_files_equal_the_static_fit_of_their_rows(tmp_path):
     for k in ("modulus", "c_moy"):
         assert two.parameters[k]["value"] == pytest.approx(one.parameters[k]["value"], rel=1e-6)
         assert two.parameters[k]["ci95"] == pytest.approx(one.parameters[k]["ci95"], rel=1e-6)
+
+
+def test_public_fit_takes_every_kind_of_data(tmp_path):
+    """``ia.fit`` is one entry: a spectrum's path goes to the dynamic fit (D recovered against the
+    independent closed form), static rows stay static, a time-series option on static rows is refused."""
+    import ipmc_asym as ia
+
+    Z = z_exact(FREQ, MAT, get_model("constant").eps_moy)
+    path = _spectrum_csv(tmp_path / "imp.csv", Z, seed=1)
+    r = ia.fit(path, "D,c_moy", strip=STRIP)
+    _inside(r, TRUE, 0.03)
+    assert "spectra pnp-linear" in r.fidelity
+    static = tmp_path / "static.csv"
+    static.write_text("voltage,deflection\n0.5V,1.0mm\n1V,2.1mm\n1.5V,2.9mm\n")
+    with pytest.raises(ValueError, match="diffusion"):
+        ia.fit(str(static), "diffusion")
+    with pytest.raises(ValueError, match="beam: only for time series"):
+        ia.fit(read_data(static), "modulus", beam="dynamic")
