@@ -814,7 +814,7 @@ def design(spec, *, pareto: bool = True) -> DesignResult:
     ...                "objective": {"maximize": "blocking_force"},
     ...                "constraints": {"tip_deflection": {"min": "2mm"}}})
     >>> [a["name"] for a in r.active_constraints]
-    ['tip_deflection']
+    ['tip_deflection', 'thickness']
     """
     t0 = time.perf_counter()
     if isinstance(spec, DesignSpec):
