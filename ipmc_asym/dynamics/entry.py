@@ -207,7 +207,10 @@ def time_response(strip: Strip | None = None, drive=None, *, duration=None, poin
     duration : float, optional
         End time, s; default ``5 tau`` (``tau = R C_d(0)``).
     points : int
-        Output times, equally spaced in ``[0, duration]``.
+        Output times, equally spaced in ``[0, duration]``; without ``duration``, on the in-memory
+        path, 0 then log-spaced from ``1e-4 tau`` to ``5 tau``
+        (:func:`ipmc_asym.dynamics.circuit.default_times`: the nonlinear charging ends well before
+        ``tau``).
     model, material :
         As in :func:`ipmc_asym.dynamics.circuit.step_response`.
     fidelity : {"circuit", "pnp"} ; tol : float, optional
