@@ -514,9 +514,9 @@ def step_response(voltage=1.0, duration=None, *, strip: Strip | None = None, mod
     voltage : float
         Amplitude (V) of the step / ramp plateau / sine (ignored for a callable waveform).
     duration : float, optional
-        End time (s) of ``points`` equally spaced output times.  Default: ``5 tau`` with the times
-        :func:`default_times` (0, then log-spaced from ``1e-4 tau``: the nonlinear charging of a large
-        step ends well before ``tau``).  Ignored when ``t`` is given.
+        End time (s) of ``points`` equally spaced output times.  Default: ``5 tau``; for a step,
+        with the times :func:`default_times` (0, then log-spaced from ``1e-4 tau``: the nonlinear
+        charging of a large step ends well before ``tau``).  Ignored when ``t`` is given.
     strip : Strip, optional
         Geometry (``thickness`` TOTAL 2e, ``width`` TOTAL 2l, ``length``); its voltage is unused.
     model : {"constant", "linear", "affine"} or Permittivity
@@ -564,10 +564,10 @@ def step_response(voltage=1.0, duration=None, *, strip: Strip | None = None, mod
                          "Permittivity); a custom eps(C) callable is not supported")
     fun = waveform(waveform_kind, voltage, ramp_time=ramp_time, frequency=frequency)
     tau = float(time_constant(s.thickness, perm, m))
-    if duration is None and t is None:
+    if duration is None and t is None and isinstance(waveform_kind, str) and waveform_kind == "step":
         tgrid = default_times(tau, points)
     else:
-        tgrid = _time_grid(duration, t, points)
+        tgrid = _time_grid(5.0 * tau if duration is None and t is None else duration, t, points)
     R = float(core_resistance(s.thickness, m))
     notes = dynamic_notes(beam, viscous_modulus, m)
     extra = {}
