@@ -6,7 +6,7 @@ from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import add_output_option
 from ipmc_asym.io.fileio import atomic_write, check_output_path
 from ipmc_asym.io.jsonio import dumps
-from ipmc_asym.validation.validate import VERDICTS, claims, to_markdown
+from ipmc_asym.validation.validate import claims, tally_text, to_markdown
 
 
 def register(sub):
@@ -39,13 +39,13 @@ def run(args) -> int:
                   f"{pad}ours:      {r['ours']}\n{pad}criterion: {r['criterion']} ({r['reason']})")
             for k, a in r["alternatives"].items():
                 print(f"{pad}alternative ({k}): {a['verdict']}")
-        n = {v: sum(r["verdict"] == v for r in rows) for v in VERDICTS}
-        print("summary: " + ", ".join(f"{k} {v}" for k, v in n.items()))
+        print("summary: " + tally_text(rows))
     return 0
 
 
 #: the keys of a JSON claim row
-JSON_KEYS = ("claim", "section", "paper", "ours", "verdict", "key", "criterion", "reason", "value", "alternatives")
+JSON_KEYS = ("claim", "section", "paper", "ours", "verdict", "key", "kind", "criterion", "reason", "value",
+             "alternatives")
 
 
 def _measurements(args) -> int:

@@ -362,6 +362,21 @@ def quasi_static_mechanics(u, strip: Strip, perm: Permittivity, material: Materi
 MAX_STEP_POINTS = 10**6
 
 
+#: the default output window, in units of the small-signal time tau: t = 0, then log-spaced from
+#: DEFAULT_FIRST to DEFAULT_SPAN.  The nonlinear charging of a large step ends long before tau (affine
+#: 2 V: 90 % at 0.03 tau; linear 0.5 V: at 0.09 tau), so an equally spaced grid over 5 tau would put
+#: a handful of outputs in it; log spacing gives every decade from 1e-4 tau the same number of them
+DEFAULT_FIRST = 1e-4
+DEFAULT_SPAN = 5.0
+
+
+def default_times(tau: float, points: int) -> np.ndarray:
+    """The default output times of a step (s), shape (points,): 0, then log-spaced over
+    ``[DEFAULT_FIRST tau, DEFAULT_SPAN tau]`` (see :data:`DEFAULT_FIRST`)."""
+    _time_grid(1.0, None, points)  # the same refusal of a bad ``points``
+    return np.concatenate([[0.0], np.geomspace(DEFAULT_FIRST * tau, DEFAULT_SPAN * tau, int(points) - 1)])
+
+
 def _time_grid(duration, t, points):
     if t is not None:
         t = np.asarray(t, dtype=float).reshape(-1)
@@ -499,7 +514,9 @@ def step_response(voltage=1.0, duration=None, *, strip: Strip | None = None, mod
     voltage : float
         Amplitude (V) of the step / ramp plateau / sine (ignored for a callable waveform).
     duration : float, optional
-        End time (s); default ``5 tau``.  Ignored when ``t`` is given.
+        End time (s) of ``points`` equally spaced output times.  Default: ``5 tau``; for a step,
+        with the times :func:`default_times` (0, then log-spaced from ``1e-4 tau``: the nonlinear
+        charging of a large step ends well before ``tau``).  Ignored when ``t`` is given.
     strip : Strip, optional
         Geometry (``thickness`` TOTAL 2e, ``width`` TOTAL 2l, ``length``); its voltage is unused.
     model : {"constant", "linear", "affine"} or Permittivity
@@ -547,7 +564,10 @@ def step_response(voltage=1.0, duration=None, *, strip: Strip | None = None, mod
                          "Permittivity); a custom eps(C) callable is not supported")
     fun = waveform(waveform_kind, voltage, ramp_time=ramp_time, frequency=frequency)
     tau = float(time_constant(s.thickness, perm, m))
-    tgrid = _time_grid(5.0 * tau if duration is None and t is None else duration, t, points)
+    if duration is None and t is None and isinstance(waveform_kind, str) and waveform_kind == "step":
+        tgrid = default_times(tau, points)
+    else:
+        tgrid = _time_grid(5.0 * tau if duration is None and t is None else duration, t, points)
     R = float(core_resistance(s.thickness, m))
     notes = dynamic_notes(beam, viscous_modulus, m)
     extra = {}

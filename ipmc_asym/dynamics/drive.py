@@ -142,7 +142,8 @@ def drive_info(strip: Strip, model, material: Material, beam=DEFAULT_BEAM, visco
 
 def drive_chunks(wave, duration, points, *, strip: Strip | None = None, model="constant",
                  material: Material | None = None, beam=DEFAULT_BEAM, viscous_modulus=0.0, n_modes=TIME_MODES,
-                 chunk=20_000, sheet_resistance=0.0, line_segments=DEFAULT_SEGMENTS, support=None, electrode=None):
+                 chunk=20_000, sheet_resistance=0.0, line_segments=DEFAULT_SEGMENTS, support=None, electrode=None,
+                 times=None):
     """Yield dicts of column arrays (:data:`DRIVE_COLUMNS`) over ``points`` equally spaced times in [0, duration].
 
     Parameters
@@ -156,6 +157,10 @@ def drive_chunks(wave, duration, points, *, strip: Strip | None = None, model="c
         Default :data:`~ipmc_asym.dynamics.circuit.DEFAULT_BEAM` (quasi-static).
     viscous_modulus : float (Pa s) ; n_modes : int
     chunk : int        rows per chunk (memory ~ chunk, not points)
+    times : callable or None
+        ``times(idx)`` -> the output times (s) of row indices ``idx`` (increasing, ``times(0) = 0``,
+        ``times(points - 1) = duration``) instead of equal spacing (a step's default window,
+        :func:`ipmc_asym.dynamics.circuit.default_times`).
     sheet_resistance : float
         ``R_s`` of each electrode (Ohm/sq, default 0: the uniform strip, exactly).  > 0: the
         discretised RC line (:class:`ipmc_asym.dynamics.line_time.LineStepper`, ``2 line_segments``
@@ -197,6 +202,8 @@ def drive_chunks(wave, duration, points, *, strip: Strip | None = None, model="c
     dyn = BeamDynamics(s, m, viscous_modulus, n_modes, el, clamped) if beam == "dynamic" else None
     lb = strip_beam(s, m, viscous_modulus, el)
     h = d / (n - 1)
+    if times is not None:  # the largest output interval is the one the modes must resolve
+        h = float(np.max(np.diff(times(np.arange(n)))))
     if dyn is not None and h > dyn.period / 40.0:
         need = int(math.ceil(40.0 * d / dyn.period)) + 1
         raise ValueError(f"points: the beam dynamics need >= 40 points per period of the first mode "
@@ -221,7 +228,7 @@ def drive_chunks(wave, duration, points, *, strip: Strip | None = None, model="c
     while start < n - 1 or held is None:
         stop = min(start + chunk, n - 1)
         idx = np.arange(start, stop + 1)
-        t = idx * h
+        t = idx * h if times is None else np.asarray(times(idx), dtype=float)
         t[-1] = d if stop == n - 1 else t[-1]
         lc = {}
         if line is None:

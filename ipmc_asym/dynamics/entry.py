@@ -21,10 +21,12 @@ from ipmc_asym.base.results import Panel, ResultMixin, ResultSpec
 from ipmc_asym.dynamics.circuit import (
     BEAM_CHOICES,
     DEFAULT_BEAM,
+    DEFAULT_SPAN,
     FREQ_METHODS,
     STEP_FIDELITIES,
     TIME_MODES,
     StepResult,
+    default_times,
     frequency_response,
     step_response,
     waveform,
@@ -207,7 +209,10 @@ def time_response(strip: Strip | None = None, drive=None, *, duration=None, poin
     duration : float, optional
         End time, s; default ``5 tau`` (``tau = R C_d(0)``).
     points : int
-        Output times, equally spaced in ``[0, duration]``.
+        Output times, equally spaced in ``[0, duration]``; without ``duration``, on the in-memory
+        path, 0 then log-spaced from ``1e-4 tau`` to ``5 tau``
+        (:func:`ipmc_asym.dynamics.circuit.default_times`: the nonlinear charging ends well before
+        ``tau``).
     model, material :
         As in :func:`ipmc_asym.dynamics.circuit.step_response`.
     fidelity : {"circuit", "pnp"} ; tol : float, optional
@@ -251,8 +256,11 @@ def time_response(strip: Strip | None = None, drive=None, *, duration=None, poin
     line = dict(sheet_resistance=sheet_resistance, line_segments=line_segments)
     where = {} if support is None and electrode is None else {"support": support, "electrode": electrode}
     info = drive_info(s, model, m, beam, vm, **line, **where)
-    dur = float(duration) if duration is not None else 5.0 * info["tau"]
+    dur = float(duration) if duration is not None else DEFAULT_SPAN * info["tau"]
     kw = dict(strip=s, model=model, material=m, beam=beam, viscous_modulus=vm, n_modes=n_modes, **line, **where)
+    if duration is None and d.kind == "step":  # the in-memory step's default window (circuit.default_times)
+        grid = default_times(info["tau"], points)
+        kw["times"] = grid.__getitem__
     if stream:
         return TimeResponse(path, d, dur, info=info, chunks=drive_chunks(d.function, dur, points, **kw))
     return TimeResponse(path, d, dur, info=info, columns=drive_response(d.function, dur, points, **kw))

@@ -14,6 +14,7 @@ Spec file (TOML; units as everywhere, thickness and width TOTAL)::
     thickness = ["100um", "400um"]   #  {choices = [a, b]} for two choices, {range = [a, b], log = true})
     [objective]
     maximize = "blocking_force"      # or minimize = ...
+    near_tie = 0.01                  # optional: report designs within this relative objective of the optimum
     [constraints]                    # magnitudes; min and/or max
     tip_deflection = {min = "2mm"}
     voltage = {max = "2V"}
@@ -89,6 +90,11 @@ CONSTRAINABLE = {**OUTPUTS, "length": "m", "width": "m", "thickness": "m", "volt
 STEP_MIN = 1e-11
 #: a constraint is reported active when its relative slack is below this
 ACTIVE_RTOL = 1e-4
+#: default relative tolerance of the objective within which another design is a near-tie (1 %: below
+#: what the model's data pin down; an assumption, set per spec with ``[objective] near_tie``)
+NEAR_TIE_RTOL = 0.01
+#: levels of each continuous variable at which the near-tie profile is optimised
+NEAR_TIE_LEVELS = 33
 #: caps (size-like inputs): choice combinations, Pareto points, robust samples
 MAX_COMBOS = 512
 MAX_PARETO_POINTS = 1000
@@ -139,6 +145,7 @@ class DesignSpec:
     confidence : float       robust: confidence of ``probability`` (independent samples; a constraint
                              holds at all but ``failures`` of them, the binomial tail bound)
     failures : int           robust: samples a constraint may miss (from ``samples``, ``confidence``)
+    near_tie : float         relative objective tolerance of a near-tie (``[objective] near_tie``)
     """
 
     name: str
@@ -158,6 +165,7 @@ class DesignSpec:
     notes: list = field(default_factory=list)
     confidence: float = 0.95
     failures: int = 0
+    near_tie: float = NEAR_TIE_RTOL
 
 
 def _check_keys(where, d, allowed):
@@ -264,7 +272,11 @@ def parse_spec(spec: dict, name: str = "design") -> DesignSpec:
     if ncomb > MAX_COMBOS:
         raise ValueError(f"[vary]: {ncomb} combinations of choices; at most {MAX_COMBOS}")
     obj = spec.get("objective")
-    _check_keys("[objective]", obj if obj is not None else {}, {"maximize", "minimize"})
+    _check_keys("[objective]", obj if obj is not None else {}, {"maximize", "minimize", "near_tie"})
+    obj = dict(obj or {})
+    near_tie = obj.pop("near_tie", NEAR_TIE_RTOL)
+    if isinstance(near_tie, bool) or not isinstance(near_tie, (int, float)) or not 0 < near_tie < 1:
+        raise ValueError(f"objective.near_tie must be a relative tolerance in (0, 1); got {near_tie!r}")
     if not obj or len(obj) != 1:
         raise ValueError("[objective] must hold exactly one of maximize = OUTPUT or minimize = OUTPUT")
     sense, out = next(iter(obj.items()))
@@ -323,7 +335,7 @@ def parse_spec(spec: dict, name: str = "design") -> DesignSpec:
     return DesignSpec(name=spec.get("name", name), model=model, material=material, fidelity=fidelity, tol=tol,
                       fixed=fixed, ranges=ranges, choices=choices, objective=(out, sense), constraints=cons,
                       pareto=pareto, uncertain=unc, probability=float(prob), samples=samples, notes=notes,
-                      confidence=float(conf), failures=fails)
+                      confidence=float(conf), failures=fails, near_tie=float(near_tie))
 
 
 def load_spec(path) -> dict:
@@ -555,6 +567,74 @@ def _polish_bounds(problem, u, c, s, step, near=0.02, n=512):
     return u, s
 
 
+class _PinnedRows:
+    """The problem with continuous coordinate ``j`` held at a level per row: the search's
+    "combination index" of a row is its row number, mapped to the level and the real combination."""
+
+    def __init__(self, problem, j, levels, combos):
+        self.problem, self.j, self.levels, self.real = problem, j, np.asarray(levels), np.asarray(combos)
+
+    def inputs(self, u, combo_idx):
+        u = np.array(u, dtype=float)
+        u[:, self.j] = self.levels[combo_idx]
+        return self.problem.inputs(u, self.real[combo_idx])
+
+    def __getattr__(self, name):
+        return getattr(self.problem, name)
+
+
+def _near_ties(problem, ub, cb, sb, grid, rtol, n=NEAR_TIE_LEVELS):
+    """Designs whose objective is within ``rtol`` of the optimum's, along each continuous variable.
+
+    For each continuous variable: at ``n`` levels across its range, the best objective with the
+    variable held there and the others re-optimised (the same pattern search, from the optimum and
+    from the best grid point of that level's column, whichever is better); the near-tie span is
+    the range of levels whose best is within ``rtol`` of the optimum (a flat ridge shows as a wide
+    span).  ``grid`` is the first grid's ``(u, c, score)``.
+
+    Returns
+    -------
+    dict
+        ``{"rtol", "levels", "variables": {name: {"low", "high", "objective_low", "objective_high",
+        "profile": [[value, objective or None], ...]}}}`` (SI); the objective as reported (a
+        magnitude; ``None`` where no feasible design has that level).
+    """
+    spec = problem.spec
+    out_name, sense = spec.objective
+    u_g, c_g, s_g = grid
+    sgn = 1.0 if sense == "maximize" else -1.0
+    thr = sb - rtol * abs(sb)
+    res = {"rtol": rtol, "levels": n, "variables": {}}
+    for j, name in enumerate(problem.cont):
+        lv = np.linspace(0.0, 1.0, n)
+        starts = np.tile(ub, (2 * n, 1))
+        for i, t in enumerate(lv):  # the best grid point of the nearest column, as the second start
+            col = np.abs(u_g[:, j] - t) <= 0.5 / (n - 1) + 1e-12
+            col &= c_g == cb
+            if col.any() and np.isfinite(s_g[col]).any():
+                starts[n + i] = u_g[col][int(np.argmax(s_g[col]))]
+        levels = np.concatenate([lv, lv])
+        pin = _PinnedRows(problem, j, levels, np.full(2 * n, cb))
+        rows = np.arange(2 * n)
+        vals, feas, _ = problem.evaluate(pin.inputs(starts, rows))
+        s0 = problem.score(vals, feas)
+        uu, ss = _search(pin, starts, rows, s0, 0.05, step_min=1e-7)
+        best = np.maximum(ss[:n], ss[n:])
+        x = problem.inputs(np.column_stack([lv] * len(problem.cont)), np.full(n, cb))[name]
+        tie = best >= thr
+        prof = [[float(x[i]), float(sgn * best[i]) if np.isfinite(best[i]) else None] for i in range(n)]
+        if tie.any():
+            k = np.flatnonzero(tie)
+            lo, hi = int(k[0]), int(k[-1])
+            res["variables"][name] = {"low": float(x[lo]), "high": float(x[hi]),
+                                      "objective_low": float(sgn * best[lo]), "objective_high": float(sgn * best[hi]),
+                                      "profile": prof}
+        else:
+            res["variables"][name] = {"low": None, "high": None, "objective_low": None, "objective_high": None,
+                                      "profile": prof}
+    return res
+
+
 @dataclass(repr=False)
 class DesignResult(ResultMixin):
     """The answer of :func:`design` (``as_dict()`` is the ``--json`` object).
@@ -565,6 +645,9 @@ class DesignResult(ResultMixin):
                      the forward model gives them, scene-file names)
     active_constraints : list of dict   {"name", "bound", "limit", "value"} at the optimum
     pareto : list of dict   {"inputs", "outputs"} along the front (empty without [pareto])
+    near_ties : dict   designs within ``rtol`` of the optimum's objective along each continuous
+                       variable (:func:`_near_ties`: ``{"rtol", "levels", "variables": {name: {"low",
+                       "high", "objective_low", "objective_high", "profile"}}}``, SI)
     objective : dict, material : str, sources : list, evaluations : int, seconds : float
     """
 
@@ -590,6 +673,7 @@ class DesignResult(ResultMixin):
     seconds: float
     robust: dict | None = None
     notes: list = field(default_factory=list)
+    near_ties: dict | None = None
 
     def as_dict(self) -> dict:
         m = self.spec.material
@@ -602,6 +686,8 @@ class DesignResult(ResultMixin):
              "units": {**CONSTRAINABLE}, "thickness_is": "TOTAL 2e", "width_is": "TOTAL 2l"}
         if self.robust is not None:
             d["robust"] = self.robust
+        if self.near_ties is not None:
+            d["near_ties"] = self.near_ties
         if m.electrode.present:  # the composite beam (the bare membrane is the paper's)
             d["beam"] = beam_label(m.electrode)
         return d
@@ -710,7 +796,9 @@ def design(spec, *, pareto: bool = True) -> DesignResult:
     -------
     DesignResult
         ``as_dict()``: ``{"optimum": {"inputs", "outputs", "checks"}, "active_constraints",
-        "pareto", ...}`` (SI; thickness and width TOTAL).
+        "pareto", "near_ties", ...}`` (SI; thickness and width TOTAL); ``near_ties``: along each
+        continuous variable, the span over which the objective stays within ``[objective] near_tie``
+        (default :data:`NEAR_TIE_RTOL`) of the optimum, the other variables re-optimised.
 
     Raises
     ------
@@ -793,9 +881,17 @@ def design(spec, *, pareto: bool = True) -> DesignResult:
                            f">= {sp.probability:g} with confidence {sp.confidence:g} (binomial tail, distribution-free); "
                            "objective = median; optimum.outputs are at the nominal material")}
     front = _pareto(problem, *sp.pareto[:2], sp.pareto[2]) if (pareto and sp.pareto) else []
+    ties = _near_ties(problem, ub, cb, sb, (u, c, s), sp.near_tie) if sp.ranges else None
+    tie_notes = []
+    for name, t in (ties or {"variables": {}})["variables"].items():
+        lo, hi, _log = sp.ranges[name]
+        if t["low"] is not None and t["high"] - t["low"] > 0.05 * (hi - lo):  # a ridge, not the optimum's neighbourhood
+            tie_notes.append(f"near-tie: {name} from {t['low']:.4g} to {t['high']:.4g} {CONSTRAINABLE[name]} keeps the "
+                             f"objective within {sp.near_tie:.0%} of the optimum (the other variables re-optimised)")
     res = DesignResult(optimum={"inputs": inputs, "outputs": outputs, "checks": checks},
                        active_constraints=active, pareto=front,
                        objective={"name": out, "sense": sense, "value": float(vb[out][0]), "unit": OUTPUTS[out]},
-                       spec=sp, evaluations=problem.evaluations, seconds=0.0, robust=robust, notes=list(sp.notes))
+                       spec=sp, evaluations=problem.evaluations, seconds=0.0, robust=robust,
+                       notes=list(sp.notes) + tie_notes, near_ties=ties)
     res.seconds = time.perf_counter() - t0
     return res

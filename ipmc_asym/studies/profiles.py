@@ -50,7 +50,8 @@ from ipmc_asym.base.settings import (
 from ipmc_asym.io.fileio import atomic_write
 from ipmc_asym.model.params import NAFION_LI, Material, Strip
 
-__all__ = ["QUANTITIES", "profile", "layer_widths", "profile_summary", "write_csv",
+__all__ = ["QUANTITIES", "profile", "layer_widths", "profile_summary", "transition_width", "TRANSITION_LEVELS",
+           "write_csv",
            "compute_all", "PAPER_LAYERS", "LAYER_WIDTHS"]
 
 #: quantity key -> (BVPResult attribute, axis label)
@@ -133,6 +134,61 @@ def layer_widths(res, e: float) -> dict:
             "accumulation_um": _crossing(dc, Cc, ACCUMULATION_FRACTION * B1m1),
             "accumulation_half_um": _crossing(dc, Cc, ACCUMULATION_HALF_FRACTION * B1m1),
             "accumulation_1pct_um": _crossing(dc, Cc, DEVOID_LEVEL)}
+
+
+#: the levels of :func:`transition_width`: the 90-10 % width of a face layer
+TRANSITION_LEVELS = (0.9, 0.1)
+
+
+def transition_width(res, e: float, quantity: str = "D", face: str = "anode",
+                     levels=TRANSITION_LEVELS) -> float:
+    """Width (µm) over which a profile falls from ``levels[0]`` to ``levels[1]`` of its face layer.
+
+    The face layer of ``quantity`` is its change from the core value (at ``z_bar = 0``) to the
+    face value; the width is the distance between the first crossings, from the face, of the
+    two levels of that change (a rise time's 90-10 % reading of "how steep", which does not
+    depend on the mesh as a face derivative of a steep profile does).
+
+    Parameters
+    ----------
+    res : BVPResult (or anything with ``z`` and ``quantity`` arrays of shape (n,) on [-1, 1])
+    e : float
+        HALF thickness (m).
+    quantity : str
+        ``"C"``, ``"phi"``, ``"D"``, ``"E"``, ``"p"`` or ``"rhoZ"``.
+    face : str
+        ``"anode"`` (``z_bar = -1`` for a positive voltage) or ``"cathode"`` (``+1``).
+    levels : (float, float)
+        Fractions of the face layer's change, first the one nearer the face.
+
+    Returns
+    -------
+    float
+        Width in µm (NaN where a level is never crossed or the layer has no change).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from types import SimpleNamespace
+    >>> z = np.linspace(-1, 1, 200001)
+    >>> r = SimpleNamespace(z=z, D=np.exp(-(z + 1) / 0.01))
+    >>> round(transition_width(r, 1e-6, "D", "anode") / (0.01 * np.log(9)), 4)
+    1.0
+    """
+    if face not in ("anode", "cathode"):
+        raise ValueError(f"face must be 'anode' or 'cathode'; got {face!r}")
+    z, f = np.asarray(res.z, dtype=float), np.asarray(getattr(res, quantity), dtype=float)
+    if getattr(getattr(res, "groups", None), "sign", 1.0) < 0:
+        z, f = -z[::-1], f[::-1]
+    if face == "cathode":
+        z, f = -z[::-1], f[::-1]
+    d = (z + 1.0) * e * 1e6
+    core = float(np.interp(0.0, z, f))
+    change = f[0] - core
+    if change == 0.0 or not np.isfinite(change):
+        return float("nan")
+    g = (f - core) / change
+    return _crossing(d, g, levels[1]) - _crossing(d, g, levels[0])
 
 
 def profile_summary(model="constant", strip: Strip | None = None, material: Material = NAFION_LI,

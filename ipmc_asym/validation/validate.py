@@ -73,13 +73,16 @@ from ipmc_asym.studies.charge_studies import (
 )
 from ipmc_asym.studies.fits import fit_power_law, linear_r, scaling_fits, variation_table
 from ipmc_asym.studies.laws import law_ranges
-from ipmc_asym.studies.profiles import LAYER_WIDTHS, profile_summary
+from ipmc_asym.studies.profiles import LAYER_WIDTHS, TRANSITION_LEVELS, profile, profile_summary, transition_width
 from ipmc_asym.studies.sweeps import sweep
 
-__all__ = ["Criterion", "Claim", "Ours", "CLAIMS", "VERDICTS", "PHI0_RANGES", "judge", "claims",
-           "to_markdown"]
+__all__ = ["Criterion", "Claim", "Ours", "Alt", "CLAIMS", "VERDICTS", "KINDS", "PHI0_RANGES", "judge", "claims",
+           "tally", "to_markdown"]
 
 VERDICTS = ("reproduced", "partly", "differs", "not-reproducible")
+#: what a row is: a claim of the paper, a datum the paper states (an input, checked for consistency), or
+#: the toolkit's own finding (not a statement of the paper); the tally counts each kind apart
+KINDS = ("claim", "input", "finding")
 
 #: phi0 fit ranges (V): the paper does not state the range of its Fig. 10 fits
 PHI0_RANGES = ((0.1, 1.0), (0.1, 3.0), (0.5, 5.0))
@@ -91,6 +94,8 @@ THICKNESS_RANGE = (100e-6, 400e-6, 16)
 #: the thickness ranges the paper's Fig. 9 plausibly spans (TOTAL 2e, m; the nominal 200 um inside,
 #: the range not stated): the w ~ e^a fits and the I ~ 1/e local exponents are judged on each
 THICKNESS_RANGES = ((100e-6, 400e-6, 16), (200e-6, 800e-6, 16))
+#: the w ~ e^a fit judged: the span of THICKNESS_RANGES (the I ~ 1/e row's range), each sub-range beside it
+W_E_RANGE = (100e-6, 800e-6, 16)
 #: a coarser sampling of each phi0 range, reported beside PHI0_POINTS (a fit depends on it)
 PHI0_POINTS_COARSE = 10
 WIDTH_RANGE = (2e-3, 10e-3, 5)
@@ -232,6 +237,14 @@ class Ours(NamedTuple):
     alternatives: dict | None = None
 
 
+class Alt(NamedTuple):
+    """An alternative judged by another criterion than the row's (a one-sided reading of a
+    symmetric claim, say): ``value`` judged by ``criterion``; its text is reported with it."""
+
+    value: object
+    criterion: Criterion
+
+
 @dataclass(frozen=True)
 class Claim:
     """One claim of the paper.
@@ -256,6 +269,9 @@ class Claim:
         What the labels of a dict value are ("model", "phi0 range", ...).
     extra : dict or None
         Other numbers of the paper quoted in ``statement`` but not judged.
+    kind : str
+        One of :data:`KINDS`: ``claim`` (a statement of the paper), ``input`` (a datum or group
+        the paper states, checked) or ``finding`` (the toolkit's own, not the paper's).
     """
 
     key: str
@@ -267,6 +283,7 @@ class Claim:
     unit: str = ""
     over: str | None = None
     extra: dict | None = None
+    kind: str = "claim"
 
     def paper_text(self) -> str:
         def one(p):
@@ -302,8 +319,12 @@ class Context:
         return {mm: evaluate(self.s, mm, "quadrature", self.m) for mm in self.models}
 
     @cached_property
+    def profiles(self) -> dict:
+        return {mm: profile(mm, self.s, self.m) for mm in self.models}
+
+    @cached_property
     def summaries(self) -> dict:
-        return {mm: profile_summary(mm, self.s, self.m) for mm in self.models}
+        return {mm: profile_summary(mm, self.s, self.m, res=self.profiles[mm]) for mm in self.models}
 
     def sweep1(self, var, a, b, n):
         return _sweep_cache(self, var, a, b, n)
@@ -421,12 +442,55 @@ def _accumulation(model):
     return f
 
 
+def _widths(ctx, quantity, face):
+    return {mm: transition_width(ctx.profiles[mm], ctx.s.e, quantity, face) for mm in ctx.models}
+
+
+_LEVELS = f"{TRANSITION_LEVELS[0]:.0%}-{TRANSITION_LEVELS[1]:.0%}"
+
+
 def _anode_slopes(ctx):
-    """dD_bar/dz_bar = C_bar - 1 at the anode face (eq. (20)), constant over affine."""
-    sl = {mm: ctx.summaries[mm]["C_anode"] - 1.0 for mm in ("constant", "affine")}
-    ratio = sl["constant"] / sl["affine"]
-    return Ours(ratio, "'steepness' is not defined: the slope dD/dz = C - 1 at the anode face is "
-                + ", ".join(f"{mm} {v:.4g}" for mm, v in sl.items()) + f" (ratio {ratio:.4g})")
+    """Affine over constant 90-10 % width of D_bar at the anode; the face slopes as the alternative."""
+    w = _widths(ctx, "D", "anode")
+    ratio = w["affine"] / w["constant"]
+    sl = {mm: ctx.summaries[mm]["C_anode"] - 1.0 for mm in ("constant", "affine")}  # dD/dz = C - 1, eq. (20)
+    sratio = sl["constant"] / sl["affine"]
+    return Ours(ratio, f"{_LEVELS} width of D_bar from the anode face: constant {w['constant']:.4g} um, affine "
+                       f"{w['affine']:.4g} um (ratio {ratio:.3g}); the slope dD/dz = C - 1 at the face is "
+                + ", ".join(f"{mm} {v:.4g}" for mm, v in sl.items()) + f" (ratio {sratio:.4g})",
+                {"slope at the face": sratio})
+
+
+def _anode_D_values(ctx):
+    """D_bar at the anode face, affine over constant."""
+    d = {mm: float(ctx.profiles[mm].D[0]) for mm in ctx.models}
+    ratio = d["affine"] / d["constant"]
+    return Ours(ratio, "D_bar at the anode face: " + ", ".join(f"{mm} {v:.4g}" for mm, v in d.items())
+                + f" (affine/constant {ratio:.3g})")
+
+
+_STEEP_Q = (("D", "induction"), ("phi", "potential"), ("p", "pressure"))
+
+
+def _cathode_steeper(ctx):
+    """Other model over constant 90-10 % width of D, phi, p at the cathode; face slopes as the alternative."""
+    val, slope, txt = {}, {}, []
+    for q, name in _STEEP_Q:
+        w = _widths(ctx, q, "cathode")
+        txt.append(f"{name} " + ", ".join(f"{mm} {v:.3g}" for mm, v in w.items()))
+        for mm in ctx.models:
+            if mm != "constant":
+                val[f"{name}: {mm}"] = w[mm] / w["constant"]
+    for mm in ctx.models:  # exact face slopes: dD/dz = C - 1 (eq. (20)), dphi/dz = -E
+        if mm != "constant":
+            for q, name in _STEEP_Q[:2]:
+                f = {m: (ctx.profiles[m].C[-1] - 1.0) if q == "D" else -ctx.profiles[m].E[-1]
+                     for m in ("constant", mm)}
+                slope[f"{name}: {mm}"] = float(f["constant"] / f[mm])
+    return Ours(val, f"{_LEVELS} widths from the cathode face (um): " + "; ".join(txt) + " -> width ratios "
+                + ", ".join(f"{k} {v:.3g}" for k, v in val.items()) + "; ratios of the face slopes "
+                + ", ".join(f"{k} {v:.3g}" for k, v in slope.items()),
+                {"slope at the face": slope})
 
 
 def _cathode_ratio(ctx):
@@ -568,9 +632,10 @@ def _block_1pct(ctx):
 
 
 # --- §6.3 influence of phi0 -----------------------------------------------------------------
-def _phi_fit(model, quantity, what="exponent"):
+def _phi_fit(model, quantity, what="exponent", one_sided=None):
     """Fitted exponent (or linear r) vs phi0 on each of PHI0_RANGES, PHI0_POINTS points; the
-    PHI0_POINTS_COARSE sampling as the alternative (a fit over a curved range depends on it)."""
+    PHI0_POINTS_COARSE sampling as the alternative (a fit over a curved range depends on it), and,
+    given a ``one_sided`` criterion, the PHI0_POINTS values judged by it as a second alternative."""
 
     def one(ctx, n):
         val, txt = {}, []
@@ -589,11 +654,24 @@ def _phi_fit(model, quantity, what="exponent"):
         val, txt = one(ctx, PHI0_POINTS)
         coarse, ctxt = one(ctx, PHI0_POINTS_COARSE)
         what_ = {"theta": "theta (exact; theta and F^p both go as M_A)", "w": "large-displacement w"}
+        alts = {f"{PHI0_POINTS_COARSE} points per range": coarse}
+        if one_sided is not None:
+            alts[ONE_SIDED_LABEL] = Alt(val, one_sided)
         return Ours(val, f"{model} model, {what_.get(quantity, quantity)} vs phi0, {PHI0_POINTS} points per range: "
-                    + "; ".join(txt) + f" | {PHI0_POINTS_COARSE} points per range: " + "; ".join(ctxt),
-                    {f"{PHI0_POINTS_COARSE} points per range": coarse})
+                    + "; ".join(txt) + f" | {PHI0_POINTS_COARSE} points per range: " + "; ".join(ctxt), alts)
     f.__name__ = f"_phi_{model}_{quantity}_{what}"
     return f
+
+
+def _w_e(ctx):
+    """w ~ e^a fitted on W_E_RANGE (judged) and on each of THICKNESS_RANGES (alternatives)."""
+    main = _fit_models("thickness", (W_E_RANGE,), "w")(ctx)
+    alts, txt = {}, [main.text]
+    for rng in THICKNESS_RANGES:
+        o = _fit_models("thickness", (rng,), "w")(ctx)
+        alts[f"2e = {rng[0] * 1e6:g}-{rng[1] * 1e6:g} um"] = o.value
+        txt.append(o.text)
+    return Ours(main.value, " | ".join(txt), alts)
 
 
 def _linear_M(ctx):
@@ -724,10 +802,18 @@ _ACCUMULATION = Criterion(
     "one digit where the 1/e decay lengths do not (alternatives): the paper used a level, not a decay rate",
     "width = distance from the cathode face to where C_bar - 1 falls through 0.01 (the 1 % level of the anode's "
     "devoid zone); alternative reported: the 1/e decay length of C_bar - 1")
-_LINEAR_R = Criterion("at_least", None, "the paper claims the curve is roughly linear, its correlation with a "
-                      "straight line being that value: a larger r is a more linear curve and supports the claim",
+_LINEAR_R = Criterion("rounds", None, "the paper quotes the correlation it found ('environ lineaire', with the "
+                      "curvature its figure shows): a number, matched both ways to its last digit; nothing in its "
+                      "words makes a larger r support the claim (a straight line is not its point)",
                       "r = Pearson correlation with phi0 on each fit range (the paper does not give its range), "
-                      "points past the free strip's quarter turn left out for w")
+                      "points past the free strip's quarter turn left out for w; alternative reported: the one-sided "
+                      "reading r >= the paper's")
+#: the alternative of a symmetric correlation row judged one-sided
+ONE_SIDED_LABEL = "r >= paper (one-sided)"
+_LINEAR_R_ONE_SIDED = Criterion("at_least", None, "one-sided reading: a larger r is a more linear curve",
+                                "r >= the paper's r")
+#: 'N fois' (N times) in the paper: one significant figure
+_TIMES = Criterion("rel", 0.25, "'N fois': one significant figure")
 _LIT = Criterion("inside", None, "the literature range the paper says its data were adjusted to",
                  "assumes the literature ranges apply at the nominal geometry (L = 2 cm, 2l = 5 mm, 2e = 200 um, "
                  "1 V): the paper does not say on which strips they were measured")
@@ -735,12 +821,12 @@ _LIT = Criterion("inside", None, "the literature range the paper says its data w
 CLAIMS = (
     # §4: data, groups and the slips (docs/design.md, "Slips")
     Claim("slip1_cmoy", "§4 (design: slip 1)", "C_moy = -(1-phi4) rho3 Z3/(phi4 F) = {} mol/m^3", "3082",
-          _c_moy, _DIGITS, " mol/m^3"),
-    Claim("A2", "§4", "A2 = F phi0/(R T) ~ {}", "38.7", _group("A2"), _DIGITS),
-    Claim("A3", "§4", "A3 = -rho2 Z3/(C_moy F) ~ {}", "0.303", _group("A3"), _DIGITS),
-    Claim("A5", "§4", "A5 = 6 l e^2 F phi0 C_moy ~ {} N m", "0.045", _group("A5"), _DIGITS, " N m"),
+          _c_moy, _DIGITS, " mol/m^3", kind="input"),
+    Claim("A2", "§4", "A2 = F phi0/(R T) ~ {}", "38.7", _group("A2"), _DIGITS, kind="input"),
+    Claim("A3", "§4", "A3 = -rho2 Z3/(C_moy F) ~ {}", "0.303", _group("A3"), _DIGITS, kind="input"),
+    Claim("A5", "§4", "A5 = 6 l e^2 F phi0 C_moy ~ {} N m", "0.045", _group("A5"), _DIGITS, " N m", kind="input"),
     Claim("alpha_reading", "§5 (design: slip 4)", "linear model: z0 = sqrt(A0/A2) ~ {} (fixes how alpha is read)",
-          "4.8e-3", _alpha_reading, _DIGITS),
+          "4.8e-3", _alpha_reading, _DIGITS, kind="input"),
     Claim("slip2_prefactor", "§6.2 (design: slip 2)",
           "theta = -{theta:g} (F C_moy/E) phi0 (L/e) I, w_p = -{w_p:g} (F C_moy/E) phi0 (L^2/e) I, "
           "F^p = {F^p:g} F C_moy phi0 l e^2 I/L", {"theta": 1.5, "w_p": 0.75, "F^p": 3.0}, _prefactors,
@@ -781,10 +867,24 @@ CLAIMS = (
           Criterion("at_most", None, "dphi4 = (1 - phi4) e |M_A|/(E I_p), from the neutral axis to a face (the "
                     "paper's dphi4 = phi3 dz/|R^p| with dz = e); face to face is twice it (reported)"),
           " %", over="model"),
+    Claim("anode_D_values", "§6.1", "near -1 the induction values of the constant and affine models are very "
+          "close", 1.0, _anode_D_values,
+          Criterion("rel", 0.1, "'tres proches' gives no number: read as the same value to 10 % (an assumption: "
+                    "points a figure shows as nearly coincident)", "value = D_bar(-1) affine over constant")),
     Claim("anode_D_steepness", "§6.1", "near -1 the affine D curve is {} times less steep than the constant one",
-          5, _anode_slopes, Criterion("none", None, "no definition of steepness to compute",
-                                      "value = the constant model's slope dD/dz = C - 1 at the anode face over the "
-                                      "affine model's (one reading of 'steepness', not judged)")),
+          5, _anode_slopes, _TIMES._replace(
+              reason="'5 fois moins raide': one significant figure; 'raideur' read as the width of the face layer "
+                     "(a steeper curve changes over a shorter distance)",
+              condition=f"value = affine over constant {TRANSITION_LEVELS[0]:.0%}-{TRANSITION_LEVELS[1]:.0%} "
+                        "width of D_bar from the anode face (studies.profiles.transition_width); alternative "
+                        "reported: the ratio of the slopes dD/dz = C - 1 at the face")),
+    Claim("cathode_steeper_20x", "§6.1", "near +1 the constant model's induction, potential and pressure profiles "
+          "are about {:g} times steeper than the other two models'", 20.0, _cathode_steeper, _TIMES._replace(
+              reason="'20 fois plus raides environ': one significant figure; 'raideur' read as the width of the "
+                     "face layer",
+              condition=f"value = other model over constant {TRANSITION_LEVELS[0]:.0%}-{TRANSITION_LEVELS[1]:.0%} "
+                        "width from the cathode face, for D_bar, phi_bar and p_bar; alternative reported: the "
+                        "ratio of the face slopes of D_bar and phi_bar"), over="profile and model"),
     # §6.2 scaling laws
     Claim("I_e", "§6.2", "I ~ e^{:g} (first approximation)", -1.0, _I_e,
           Criterion("abs", LAW_HOLD_TOL, "'en premiere approximation': the local exponent within the tolerance of "
@@ -802,12 +902,12 @@ CLAIMS = (
                     "least-squares power law over L = 1-4 cm (the paper's range not stated), points past the free "
                     "strip's quarter turn left out"), over="model",
           extra={"r": 0.999}),
-    Claim("w_e", "§6.2", "w ~ e^a with a in {} .. {}, r > {r}", (-1.95, -1.9),
-          _fit_models("thickness", THICKNESS_RANGES, "w"),
+    Claim("w_e", "§6.2", "w ~ e^a with a in {} .. {}, r > {r}", (-1.95, -1.9), _w_e,
           Criterion("inside", None, "the paper's range of exponents over the three models",
-                    "least-squares power law on each of 2e = 100-400 and 200-800 um (the paper's range not stated; "
-                    "both contain the nominal 200 um), points past the free strip's quarter turn left out"),
-          over="fit range and model",
+                    "least-squares power law on 2e = 100-800 um (the paper's range not stated: the span the I ~ 1/e "
+                    "row uses, containing the nominal 200 um), points past the free strip's quarter turn left out; "
+                    "alternatives reported: 2e = 100-400 and 200-800 um"),
+          over="model",
           extra={"r": 0.998}),
     Claim("table", "§6.2", "table of variations of theta, F^p, w with L, l, e (exponents)",
           {"theta L": 1, "theta l": 0, "theta e": -2, "F_block L": -1, "F_block l": 1, "F_block e": 1,
@@ -824,12 +924,12 @@ CLAIMS = (
     # §6.3 influence of phi0 (fit ranges not stated: each of PHI0_RANGES)
     Claim("w_phi_const", "§6.3", "constant model: w ~ phi0^{} (r = {r})", 1.15, _phi_fit("constant", "w"),
           _EXP_PHI, over="phi0 range", extra={"r": 0.999}),
-    Claim("w_phi_const_linear_r", "§6.3", "constant model: w vs phi0 roughly linear, correlation {}", 0.99,
-          _phi_fit("constant", "w", "linear_r"), _LINEAR_R, over="phi0 range"),
+    Claim("w_phi_const_linear_r", "§6.3", "constant model: w vs phi0 roughly linear, correlation {}", "0.99",
+          _phi_fit("constant", "w", "linear_r", _LINEAR_R_ONE_SIDED), _LINEAR_R, over="phi0 range"),
     Claim("F_phi_const", "§6.3", "constant model: F^p, theta ~ phi0^{} (r = {r})", 1.26,
           _phi_fit("constant", "theta"), _EXP_PHI, over="phi0 range", extra={"r": 0.998}),
-    Claim("F_phi_const_linear_r", "§6.3", "constant model: F^p, theta vs phi0 linear correlation {}", 0.955,
-          _phi_fit("constant", "theta", "linear_r"), _LINEAR_R, over="phi0 range"),
+    Claim("F_phi_const_linear_r", "§6.3", "constant model: F^p, theta vs phi0 linear correlation {}", "0.955",
+          _phi_fit("constant", "theta", "linear_r", _LINEAR_R_ONE_SIDED), _LINEAR_R, over="phi0 range"),
     Claim("linear_M", "§6.3", "linear model: the moment is independent of phi0", None, _linear_M,
           Criterion("at_most", 1e-3, "'independent': constant to a small relative spread"), over="phi0 range"),
     Claim("affine_linear_r", "§6.3", "affine model: w vs phi0 linear correlation {} (poor)", 0.97,
@@ -855,7 +955,8 @@ CLAIMS = (
           Criterion("factor", ORDER_FACTOR, "not a statement of the paper: what its model predicts for the measurement "
                     "it quotes; eps_app(0 V) = eps_core e/lambda_D is the double layers' capacitance times 2e, not the "
                     "bulk permittivity",
-                    "ours = eps_app = C_d 2e, small signal at 0 V, nominal strip, each model"), " F/m", over="model"),
+                    "ours = eps_app = C_d 2e, small signal at 0 V, nominal strip, each model"), " F/m", over="model",
+          kind="finding"),
     Claim("characteristic_time", "introduction", "characteristic time of about one second (read as {:.3g} .. {:g} s)",
           ABOUT_ONE_SECOND,
           _charge_claim("characteristic_time"),
@@ -877,7 +978,9 @@ def claims(material: Material = NAFION_LI, strip: Strip | None = None, table=CLA
         :func:`judge`), ``key``, ``criterion`` (the test applied, with the definitions and
         exclusions it depends on), ``reason`` (why), ``value`` (the number(s) judged; None where
         the paper gives no number to compare) and ``alternatives`` (label -> ``value`` and
-        ``verdict`` under the other readings of the paper's words, see :class:`Ours`).
+        ``verdict`` under the other readings of the paper's words, see :class:`Ours`; with the
+        ``criterion`` applied where it is not the row's, see :class:`Alt`) and ``kind``
+        (:data:`KINDS`).
 
     Examples
     --------
@@ -889,10 +992,17 @@ def claims(material: Material = NAFION_LI, strip: Strip | None = None, table=CLA
     rows = []
     for c in table:
         o = c.compute(ctx)
-        alt = {k: {"value": v, "verdict": judge(c.criterion, c.paper, v)} for k, v in (o.alternatives or {}).items()}
+        alt = {}
+        for k, v in (o.alternatives or {}).items():
+            if isinstance(v, Alt):
+                alt[k] = {"value": v.value, "verdict": judge(v.criterion, c.paper, v.value),
+                          "criterion": criterion_text(v.criterion, c.paper, c.over if isinstance(v.value, dict)
+                                                      else None)}
+            else:
+                alt[k] = {"value": v, "verdict": judge(c.criterion, c.paper, v)}
         rows.append({"claim": c.statement_text(), "section": c.section, "paper": c.paper_text(),
                      "ours": o.text, "verdict": judge(c.criterion, c.paper, o.value), "key": c.key,
-                     "value": o.value, "alternatives": alt,
+                     "kind": c.kind, "value": o.value, "alternatives": alt,
                      "criterion": criterion_text(c.criterion, c.paper,
                                                  c.over if isinstance(o.value, dict) else None),
                      "reason": c.criterion.reason})
@@ -913,6 +1023,22 @@ def to_markdown(rows, material: Material = NAFION_LI, strip: Strip | None = None
         cells = [str(i)] + [str(r[k]).replace("|", "\\|") for k in
                             ("claim", "section", "paper", "ours", "criterion")] + [verdict]
         out.append("| " + " | ".join(cells) + " |")
-    n = {v: sum(r["verdict"] == v for r in rows) for v in VERDICTS}
-    out += ["", "Summary: " + ", ".join(f"{k}: {v}" for k, v in n.items())]
+    out += ["", "Summary: " + tally_text(rows)]
     return "\n".join(out) + "\n"
+
+
+def tally(rows) -> dict:
+    """Verdict counts for each kind of row (:data:`KINDS`): ``{kind: {verdict: n}}``.
+
+    The paper's claims are counted apart from the data it states (inputs) and the toolkit's own
+    findings, so that the count of claims is a count of what the paper claims.
+    """
+    return {k: {v: sum(r["verdict"] == v and r.get("kind", "claim") == k for r in rows) for v in VERDICTS}
+            for k in KINDS}
+
+
+def tally_text(rows) -> str:
+    """:func:`tally` as one line (the summary of the report and of the command)."""
+    names = {"claim": "the paper's claims", "input": "its stated data (inputs)", "finding": "the toolkit's findings"}
+    return "; ".join(f"{names[k]} ({sum(n.values())}): " + ", ".join(f"{v} {c}" for v, c in n.items())
+                     for k, n in tally(rows).items() if sum(n.values()))

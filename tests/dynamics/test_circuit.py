@@ -134,3 +134,24 @@ def test_frequency_response_partial_electrode_resonance():
 def test_frequency_response_support_refusals(kw, word):
     with pytest.raises(ValueError, match=word):
         frequency_response([1.0], **kw)
+
+
+@pytest.mark.parametrize("model, voltage", [("affine", 2.0), ("linear", 0.5)])
+def test_default_window_resolves_the_nonlinear_rise(model, voltage):
+    # independent: the 50 % and 90 % times of sigma from a dense explicit grid over 0.5 tau (4001 times);
+    # the default window must put outputs inside the rise, and still end at 5 tau
+    from ipmc_asym.dynamics.circuit import step_response
+    from ipmc_asym.model.params import Strip
+
+    s = Strip(voltage=voltage)
+    r = step_response(voltage, strip=s, model=model)
+    dense = step_response(voltage, strip=s, model=model, t=np.linspace(0.0, 0.5 * r.tau, 4001))
+    sig, final = np.abs(dense.sigma), abs(float(r.sigma[-1]))
+    t50, t90 = (float(dense.t[np.argmax(sig >= q * final)]) for q in (0.5, 0.9))
+    assert 0.0 < t50 < t90 < 0.25 * r.tau  # the case: charged before an equally spaced grid's early rows
+    assert np.count_nonzero((r.t > t50) & (r.t < t90)) >= 20
+    assert np.count_nonzero((r.t > 0) & (r.t < t50)) >= 20  # the start of the rise too
+    assert r.t[0] == 0.0 and r.t[-1] == pytest.approx(5 * r.tau, rel=1e-12)
+    # and the printed table (11 rows evenly spread over the outputs) shows it: rows inside the rise
+    idx = np.unique(np.linspace(0, r.t.size - 1, 11).astype(int))
+    assert np.count_nonzero(r.t[idx] < t90) >= 3

@@ -101,8 +101,12 @@ def test_spectrum_picks_the_line_with_a_sheet_resistance():
     rl = spectrum(f, Strip(), sheet_resistance=2.5)
     lref = line_response(f, strip=Strip(), sheet_resistance=2.5, beam="quasi-static")
     assert np.array_equal(rl.Z, lref.Z) and np.array_equal(rl.w_amp, lref.w_amp)
+    # a bias without a method: the method that supports it (the circuit), as freq --voltage does
+    rb = spectrum(f, Strip(), voltage=0.5)
+    bref = frequency_response(f, strip=Strip(), beam="quasi-static", method="circuit", voltage=0.5)
+    assert rb.method == "circuit" and np.array_equal(rb.Z, bref.Z)
     with pytest.raises(ValueError, match="circuit"):
-        spectrum(f, Strip(), voltage=0.5)
+        spectrum(f, Strip(), voltage=0.5, method="pnp-linear")
     with pytest.raises(ValueError, match="sheet_resistance"):
         spectrum(f, Strip(), sheet_resistance=1.0, support="clamped-clamped")
 

@@ -404,11 +404,12 @@ def test_circuit_current_is_the_models_not_a_difference_over_the_output_times():
     the same current at their shared times, and after t = 0 it is within 1e-3 of J(0) of the PNP's
     (the charging is over by 0.25 tau; a difference over the output times printed -0.1 J(0))."""
     s = Strip(thickness=20e-6)
-    a = step_response(2.0, strip=s, model="linear", points=21)
-    b = step_response(2.0, strip=s, model="linear", points=2001)
+    dur = 5 * step_response(2.0, strip=s, model="linear", points=2).tau  # equally spaced, 0.25 tau apart
+    a = step_response(2.0, dur, strip=s, model="linear", points=21)
+    b = step_response(2.0, dur, strip=s, model="linear", points=2001)
     j0 = abs(a.current_density[0])
     assert np.max(np.abs(a.current_density - b.current_density[::100])) <= 1e-9 * j0
-    p = step_response(2.0, strip=s, model="linear", points=21, fidelity="pnp", tol=1e-4)
+    p = step_response(2.0, dur, strip=s, model="linear", points=21, fidelity="pnp", tol=1e-4)
     assert np.max(np.abs(a.current_density[1:] - p.current_density[1:])) <= 1e-3 * j0
 
 

@@ -180,3 +180,24 @@ def test_exact_against_bvp_as_stated():
         assert r[m]["bvp_failed"] == [], m  # the design says the BVP converges everywhere there
         assert r[m]["max"] <= bound, (m, r[m]["max"])
     assert math.isfinite(bound)
+
+
+# --- docs/design.md: the validate criteria paragraph --------------------------------------------
+def test_design_steepness_and_w_e_numbers_are_the_validate_rows():
+    # the sentence's numbers against a fresh run of the rows they quote, each to the digits written
+    from ipmc_asym.validation.validate import CLAIMS, claims
+
+    keys = {"anode_D_steepness", "anode_D_values", "cathode_steeper_20x", "w_e"}
+    rows = {r["key"]: r for r in claims(table=tuple(c for c in CLAIMS if c.key in keys))}
+    anode, = _find(r"affine `D` is (\d\.\d) times less steep", DESIGN)
+    assert abs(rows["anode_D_steepness"]["value"] - anode) <= 0.05
+    pot, ind, pre = _find(r"potential is (\d+) times steeper than the others' but its induction (\d+) and its "
+                          r"pressure (\d+) times", DESIGN)
+    v = rows["cathode_steeper_20x"]["value"]
+    for stated, name in ((pot, "potential"), (ind, "induction"), (pre, "pressure")):
+        assert all(abs(v[f"{name}: {m}"] - stated) <= 1.0 for m in ("linear", "affine")), (name, v)
+    factor, = _find(r"differ by a factor (\d\.\d)", DESIGN)
+    assert abs(rows["anode_D_values"]["value"] - factor) <= 0.05
+    ex = _find(r"alternatives: −(\d\.\d+) / −(\d\.\d+) / −(\d\.\d+) against", DESIGN)
+    for stated, m in zip(ex, MODELS):
+        assert abs(-rows["w_e"]["value"][m] - stated) <= 5e-4, m

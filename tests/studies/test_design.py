@@ -256,3 +256,50 @@ def test_optimum_on_a_variable_bound_is_reported_there():
     assert res.optimum["inputs"]["thickness"] == pytest.approx(400e-6, rel=1e-12)
     assert res.objective["value"] >= F * (1 - 1e-5)
     assert {(a["name"], a["bound"]) for a in res.active_constraints} >= {("thickness", "max"), ("tip_deflection", "min")}
+
+
+def test_near_ties_span_the_ridge_an_independent_grid_finds():
+    """examples/design_blocking_force.toml: along the deflection ridge the force is nearly flat in the
+    thickness.  Independent reference: at each of 241 thicknesses the best force is at the length where
+    |w| = 2 mm (w rises, F falls with the length; bisection straight through the forward model); the
+    near-tie span is where that ridge force is within 1 % of the optimum."""
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[2] / "examples" / "design_blocking_force.toml"
+    res = design(path, pareto=False)
+    ties = res.near_ties
+    assert ties["rtol"] == 0.01 and res.as_dict()["near_ties"] == ties
+
+    T = np.linspace(100e-6, 400e-6, 241)
+
+    def run(L):
+        r = forward(L, 5e-3, T, 1.0, fidelity="corrected").withhold()
+        return np.abs(np.asarray(r.w, float)), np.abs(np.asarray(r.F_block, float))
+
+    lo, hi = np.full_like(T, 0.01), np.full_like(T, 0.04)
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        w, _ = run(mid)
+        short = ~(w >= 2e-3)
+        lo, hi = np.where(short, mid, lo), np.where(short, hi, mid)
+    w1, _ = run(np.full_like(T, 0.01))
+    L_best = np.where(w1 >= 2e-3, 0.01, hi)
+    _, F = run(L_best)
+    F_opt = res.objective["value"]
+    assert np.nanmax(F) <= F_opt * (1 + 1e-6)
+    tie = T[F >= (1 - 0.01) * F_opt]
+    t = ties["variables"]["thickness"]
+    spacing = 300e-6 / (ties["levels"] - 1)
+    # the reported span is the levels inside the reference span (levels are spacing apart)
+    assert tie.min() - 1.5e-6 <= t["low"] <= tie.min() + spacing + 1.5e-6
+    assert t["high"] == pytest.approx(400e-6, rel=1e-12) and tie.max() == pytest.approx(400e-6, rel=1e-12)
+    assert t["objective_low"] >= (1 - 0.01) * F_opt
+    assert any("near-tie: thickness" in n for n in res.notes)
+
+
+def test_near_tie_tolerance_is_a_spec_key():
+    spec = {**SPEC, "objective": {"maximize": "blocking_force", "near_tie": 0.05}}
+    assert parse_spec(spec).near_tie == 0.05
+    with pytest.raises(ValueError, match="objective.near_tie") as e:
+        parse_spec({**SPEC, "objective": {"maximize": "blocking_force", "near_tie": 2}})
+    assert "\n" not in str(e.value)

@@ -46,3 +46,18 @@ def test_linear_accumulation_is_z0():
     assert s["B1"] == pytest.approx(2.0, rel=1e-6)
     z0_um = s["debye_um"]
     assert s["accumulation_um"] == pytest.approx(z0_um, rel=0.02)
+
+
+def test_transition_width_of_an_exponential_layer_is_its_length_times_ln_9():
+    # exact: f = exp(-x/l) falls from 0.9 to 0.1 of its face value between x = l ln(1/0.9) and l ln 10
+    from types import SimpleNamespace
+
+    from ipmc_asym.studies.profiles import transition_width
+
+    z = np.linspace(-1.0, 1.0, 400001)
+    lam, e = 0.02, 50e-6
+    r = SimpleNamespace(z=z, D=1.0 + np.exp(-(z + 1) / lam) + 3.0 * np.exp(-(1 - z) / (2 * lam)))
+    assert transition_width(r, e, "D", "anode") == pytest.approx(lam * math.log(9) * e * 1e6, rel=1e-6)
+    assert transition_width(r, e, "D", "cathode") == pytest.approx(2 * lam * math.log(9) * e * 1e6, rel=1e-6)
+    with pytest.raises(ValueError, match="face"):
+        transition_width(r, e, "D", "middle")

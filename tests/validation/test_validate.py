@@ -116,7 +116,7 @@ def test_accumulation_widths_are_the_linear_exact_solution(rows):
 
 def test_every_exclusion_is_stated_in_the_criterion(rows):
     # the rows whose numbers leave points out or pick a definition say so in the criterion itself
-    for key, words in {"block_1pct": "quarter turn", "w_L": "quarter turn", "w_e": "200-800",
+    for key, words in {"block_1pct": "quarter turn", "w_L": "quarter turn", "w_e": "200-800", "anode_D_steepness": "90%-10%",
                        "I_e": "local exponent", "lit_w_constant": "nominal geometry",
                        "w_phi_const_linear_r": "Pearson", "F_phi_const": "10 points",
                        "capacitance_permittivity": "eps_moy", "characteristic_time": "Li+"}.items():
@@ -253,3 +253,93 @@ def test_neglected_terms_rows_against_the_bvp(rows):
         EI = m.E * s.I_p
         assert por[mm] == pytest.approx(100 * (1 - m.phi4) * s.e * abs(M_A) / EI, rel=1e-8)
     assert rows["pressure_term"]["verdict"] == "differs"
+
+
+# --- symmetric criteria, rows kinds, the section 6.1 steepness rows -------------------------
+def test_correlation_rows_are_symmetric_with_the_one_sided_reading_beside_them(rows):
+    # independent: Pearson r of the rows' own value against the paper's digits, both ways
+    for key, paper in (("w_phi_const_linear_r", 0.99), ("F_phi_const_linear_r", 0.955)):
+        r = rows[key]
+        half = 0.005 if paper == 0.99 else 0.0005
+        ok = [abs(v - paper) <= half for v in r["value"].values()]
+        assert r["verdict"] == ("reproduced" if all(ok) else "partly" if any(ok) else "differs"), key
+        alt = r["alternatives"]["r >= paper (one-sided)"]
+        assert alt["criterion"].startswith("ours >= paper"), alt
+        assert alt["verdict"] == ("reproduced" if all(v >= paper for v in r["value"].values()) else "partly"
+                                  if any(v >= paper for v in r["value"].values()) else "differs")
+        assert "one-sided" in r["criterion"]
+
+
+def test_the_tally_counts_claims_apart_from_inputs_and_findings(rows):
+    from ipmc_asym.validation.validate import tally
+
+    t = tally(list(rows.values()))
+    kinds = {r["kind"] for r in rows.values()}
+    assert kinds == {"claim", "input", "finding"}
+    for k in ("A2", "A3", "A5", "slip1_cmoy", "alpha_reading"):
+        assert rows[k]["kind"] == "input", k
+    assert rows["capacitance_apparent"]["kind"] == "finding"
+    assert sum(t["claim"].values()) == sum(r["kind"] == "claim" for r in rows.values())
+    assert sum(sum(n.values()) for n in t.values()) == len(rows)
+
+
+def test_w_e_is_judged_on_the_span_of_the_I_e_row_with_each_sub_range_beside_it(rows):
+    # independent: a least-squares line through ln|w| against ln e on 2e = 100-800 um, straight from sweep
+    import numpy as np
+
+    from ipmc_asym.base.settings import OUTSIDE_REGIMES
+    from ipmc_asym.studies.sweeps import sweep
+
+    arr = sweep({"thickness": np.linspace(100e-6, 800e-6, 16)}, ["linear"], "quadrature")
+    ok = ~np.isin(arr["regime"], OUTSIDE_REGIMES)
+    slope = np.polyfit(np.log(arr["thickness"][ok]), np.log(np.abs(arr["w"][ok])), 1)[0]
+    r = rows["w_e"]
+    assert r["value"]["linear"] == pytest.approx(slope, abs=1e-9)
+    assert set(r["alternatives"]) == {"2e = 100-400 um", "2e = 200-800 um"}
+    assert "100-800" in r["criterion"]
+
+
+def test_anode_and_cathode_steepness_rows_read_the_90_10_width(rows):
+    # independent: the 90-10 % width of D_bar from each face, found by bisection on a cubic interpolant of
+    # the BVP profile (not transition_width's piecewise-linear first crossing)
+    import numpy as np
+    from scipy.interpolate import PchipInterpolator
+
+    from ipmc_asym.model.params import Strip
+    from ipmc_asym.studies.profiles import profile
+
+    s = Strip()
+
+    def width(res, face):
+        z, f = (res.z, res.D) if face == "anode" else (-res.z[::-1], res.D[::-1])
+        core = float(np.interp(0.0, z, f))
+        with np.errstate(over="ignore"):  # PCHIP's harmonic mean of slopes overflows at the steep face
+            g = PchipInterpolator(z, (f - core) / (f[0] - core))
+        lv = [_bisect(lambda x: g(x) - lev, -1.0, 0.0) for lev in (0.9, 0.1)]  # noqa: B023
+        return (lv[1] - lv[0]) * s.e * 1e6
+
+    res = {m: profile(m, s) for m in ("constant", "affine")}
+    assert rows["anode_D_steepness"]["value"] == pytest.approx(
+        width(res["affine"], "anode") / width(res["constant"], "anode"), rel=2e-2)
+    assert rows["cathode_steeper_20x"]["value"]["induction: affine"] == pytest.approx(
+        width(res["affine"], "cathode") / width(res["constant"], "cathode"), rel=2e-2)
+    # the slope reading (alternative): dD/dz = C - 1 = -1 at a devoid anode face for both models
+    assert rows["anode_D_steepness"]["alternatives"]["slope at the face"]["value"] == pytest.approx(1.0, abs=1e-3)
+    assert rows["anode_D_values"]["value"] == pytest.approx(float(res["affine"].D[0] / res["constant"].D[0]))
+
+
+def _bisect(f, a, b):
+    """First root of ``f`` on [a, b] by a fine scan then bisection (f changes sign once near the face)."""
+    import numpy as np
+
+    x = np.linspace(a, b, 400001)
+    y = f(x)
+    k = int(np.nonzero(np.sign(y[:-1]) != np.sign(y[1:]))[0][0])
+    lo, hi = x[k], x[k + 1]
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        if np.sign(f(mid)) == np.sign(f(lo)):
+            lo = mid
+        else:
+            hi = mid
+    return 0.5 * (lo + hi)
