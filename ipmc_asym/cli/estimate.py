@@ -14,7 +14,7 @@ from ipmc_asym.cli.common import (
     strip_from_args,
     tol_type,
 )
-from ipmc_asym.forward.estimate import SPREAD_NOTE, estimate_rows, model_list, model_spread
+from ipmc_asym.forward.estimate import SPREAD_NOTE, estimate_report, model_list
 from ipmc_asym.integral.api import interpret_small
 from ipmc_asym.io.jsonio import dumps
 from ipmc_asym.model.electrode import beam_label
@@ -63,8 +63,9 @@ def run(args):
             first_run_notice()
     else:
         interpret_small()
-    rows = estimate_rows(strip, model_list(args.model), args.fidelity, material, args.tol,
-                         escalate=not args.no_escalate, on_invalid="nan", pressure_term=args.pressure_term)
+    # the rows and the model-form spread from one checked request (forward.estimate.estimate_report)
+    rows, spread = estimate_report(strip, model_list(args.model), args.fidelity, material, args.tol,
+                                   escalate=not args.no_escalate, on_invalid="nan", pressure_term=args.pressure_term)
     for r in rows:
         if r["I"] is None:  # no rung valid: refuse the whole command, one line
             raise ValueError(r["warnings"][-1])
@@ -82,8 +83,6 @@ def run(args):
     note = getattr(args, "thickness_note", "")
     if note:
         inputs["thickness_source"] = note
-    spread = model_spread(strip, material, args.fidelity, args.tol, rows, escalate=not args.no_escalate,
-                          pressure_term=args.pressure_term)
     if args.json:
         print(dumps({"inputs": inputs, "results": rows, "model_spread": spread}, indent=2))
         return 0

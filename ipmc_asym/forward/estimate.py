@@ -23,10 +23,10 @@ from ipmc_asym.forward.escalation import Escalated, check_tol, moment_escalating
 from ipmc_asym.forward.model import CHECKS, FREE_STRIP_KEYS, MECHANICAL_KEYS, _forward, assumption_warnings
 from ipmc_asym.model.groups import pressure_beta
 from ipmc_asym.model.params import _PAPER_SETS, NAFION_LI, Material, Strip, as_material, as_strip, debye_length
-from ipmc_asym.model.permittivity import MODELS
+from ipmc_asym.model.permittivity import MODELS, get_model
 from ipmc_asym.model.request import Request
 
-__all__ = ["evaluate", "estimate_rows", "model_spread", "spread_of", "spread_variants", "SPREAD_KEYS",
+__all__ = ["evaluate", "estimate_rows", "estimate_report", "model_spread", "spread_of", "spread_variants", "SPREAD_KEYS",
            "RESULT_KEYS", "CHECKS", "moment_escalating", "Escalated",
            "check_tol", "FREE_STRIP_KEYS", "MECHANICAL_KEYS"]
 
@@ -81,9 +81,12 @@ def evaluate(strip: Strip, model="constant", fidelity="quadrature", material: Ma
     """
     req = Request(model, fidelity, tol, escalate, pressure_term)
     check_choice("on_invalid", on_invalid, ("raise", "nan"))
-    strip = as_strip(strip)
-    material = as_material(material)
-    perm = req.model
+    return _evaluate(as_strip(strip), req, as_material(material), on_invalid)
+
+
+def _evaluate(strip: Strip, req: Request, material: Material, on_invalid: str) -> dict:
+    """:func:`evaluate` of checked inputs (a built ``Strip``, ``Request`` and ``Material``)."""
+    perm, fidelity, pressure_term = req.model, req.fidelity, req.pressure_term
     t0 = time.perf_counter()
     # the Strip holds its checks (the thickness floor: no 1e-300 m strip reaches the groups)
     g = perm.groups(strip, material)
@@ -151,6 +154,24 @@ def estimate_rows(strip: Strip, models=("constant", "linear", "affine"), fidelit
                      pressure_term=pressure_term) for m in models]
 
 
+def estimate_report(strip: Strip, models, fidelity="quadrature", material: Material = NAFION_LI, tol=None, *,
+                    escalate: bool = True, on_invalid: str = "raise", pressure_term: bool = False,
+                    spread: bool = True) -> tuple:
+    """``(rows, model_spread)`` of ``estimate``: the rows of ``models`` and the model-form spread,
+    from ONE checked request (the model, fidelity and tolerance checked once; the spread's other
+    models are the paper's, already resolved).  ``strip`` and ``material`` are built objects.
+
+    Returns
+    -------
+    rows : list of dict   as :func:`estimate_rows`
+    spread : dict or None   as :func:`model_spread` (None with ``spread=False``)
+    """
+    base = Request(models[0], fidelity, tol, escalate, pressure_term)
+    reqs = [base] + [base.with_model(get_model(m)) for m in models[1:]]
+    rows = [_evaluate(strip, r, material, on_invalid) for r in reqs]
+    return rows, (_model_spread(strip, material, base, rows) if spread else None)
+
+
 def model_list(name: str) -> list:
     """The models ``name`` stands for: the paper's three for ``"all"``, else ``[name]`` (checked
     when its request is built)."""
@@ -216,15 +237,21 @@ def model_spread(strip: Strip, material: Material = NAFION_LI, fidelity="quadrat
         ``note`` (numerical error vs model-form spread).  Values withheld by a row (no valid
         rung) are None and left out of min/max.
     """
+    req = Request(MODELS[next(iter(MODELS))], fidelity, tol, escalate, pressure_term)
+    return _model_spread(as_strip(strip), as_material(material), req, rows)
+
+
+def _model_spread(strip: Strip, material: Material, req: Request, rows=None) -> dict:
+    """:func:`model_spread` of checked inputs: ``req`` evaluated for each paper model (its
+    ``with_model``) and each ``C_moy`` variant; ``rows`` already computed are reused."""
     done = {r["model"]: r for r in rows or ()}
     variants = spread_variants(material)
     out_rows = {}
     for cm, mat in variants:
-        for m in MODELS:
+        for m, perm in MODELS.items():
             r = done.get(m) if mat.c_moy == material.c_moy else None
             if r is None:
-                r = evaluate(strip, m, fidelity, mat, tol, escalate=escalate, on_invalid="nan",
-                             pressure_term=pressure_term)
+                r = _evaluate(strip, req.with_model(perm), mat, "nan")
             out_rows[m if cm is None else f"{m}/{cm}"] = r
     err = [r["error_estimate"] for r in out_rows.values() if r["error_estimate"] is not None]
     q = {k: spread_of({lab: r.get(k) for lab, r in out_rows.items()}, max(err) if err else None)

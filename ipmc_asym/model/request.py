@@ -68,6 +68,16 @@ class Request:
         object.__setattr__(self, "escalate", bool(self.escalate))
         object.__setattr__(self, "pressure_term", bool(self.pressure_term))
 
+    def with_model(self, model: Permittivity) -> "Request":
+        """This request for another, already resolved model (a :class:`Permittivity`): the rest
+        was checked when this one was built, so nothing is checked again (the model-form spread
+        evaluates one request over the paper's models)."""
+        new = object.__new__(Request)
+        for k in ("fidelity", "tol", "escalate", "pressure_term"):
+            object.__setattr__(new, k, getattr(self, k))
+        object.__setattr__(new, "model", model)
+        return new
+
     @property
     def limit(self) -> float:
         """The error bound a rung must meet: ``min(tol, settings.VALIDITY_LIMIT)``."""

@@ -76,7 +76,7 @@ def test_figures_measures_through_the_plugin_or_skips(plugin, monkeypatch, tmp_p
     request.getfixturevalue("with_bench" if plugin else "without_plugins")
     seen = {}
 
-    def make_all(out, dpi, quick, bench, log):
+    def make_all(out, dpi, quick, bench, log, fmt="png"):
         seen["bench"] = bench
         notes = [] if bench is not None else ["speed_accuracy.png skipped: no bench result"]
         return {"files": [], "notes": notes}
