@@ -235,9 +235,9 @@ def test_kappa_spans_thousands_of_decades():
     assert abs(2 * math.log(lam) - math.log(2) - 2 * ell) < 10
 
 
-#: ``I`` of the previous core nodes (``1 - e^{-2v}`` by ``expm1`` at every node, commit c417e53),
-#: 1 um - 10 mm x 1e-4 - 20 V: the direct subtraction where ``e^{-2v} <= 1/2`` moves the node
-#: positions by a few ulp, far inside the stated error
+#: ``I`` of the previous nodes (commit c417e53: ``1 - e^{-2v}``, ``ehat`` and ``e^y - 1`` at the
+#: outer nodes by ``expm1``), 1 um - 10 mm x 1e-4 - 20 V: ``exp`` and a direct subtraction where
+#: they do not cancel move the nodes and integrands by a few ulp, far inside the stated error
 PREVIOUS_NODES = [
     ("constant", 1e-06, 0.0001, 0.08213310301427224), ("constant", 1e-06, 20.0, 0.1032448091344227),
     ("constant", 3e-06, 0.5, 0.02485974895381561), ("constant", 1e-05, 2.0, 0.009910114214522259),
