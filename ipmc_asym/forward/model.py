@@ -45,7 +45,7 @@ from ipmc_asym.forward.escalation import (
     where_point,
 )
 from ipmc_asym.forward.pressure import pressure_ladder
-from ipmc_asym.integral.api import check_min_thickness, closed_model_id, validity_limit
+from ipmc_asym.integral.api import COMPILED_S, check_min_thickness, closed_model_id, run_parallel, validity_limit
 from ipmc_asym.integral.samples import moment_samples
 from ipmc_asym.model import groups
 from ipmc_asym.model.electrode import composite_stiffness
@@ -375,8 +375,9 @@ def _moment_per_point_material(th, v, perm, fidelity, material, c_moy, tol, esca
 
     def evaluate(f, idx):
         Ii, ei, ci = np.empty(idx.size), np.empty(idx.size), np.empty(idx.size)
-        moment_samples(lam[idx], A2[idx], A3[idx], rho, closed_model_id(perm, f), _FIDELITY_SPECS[f].kernel_code,
-                       sign[idx], Ii, ei, ci)
+        run_parallel(moment_samples, idx.size * COMPILED_S.get(f, 0.0),
+                     (lam[idx], A2[idx], A3[idx], rho, closed_model_id(perm, f), _FIDELITY_SPECS[f].kernel_code,
+                      sign[idx], Ii, ei, ci))
         return Ii, ei, ci
 
     def checks(f, r, idx):

@@ -72,7 +72,8 @@ from ipmc_asym.model.permittivity import MODELS, Permittivity, get_model
 from ipmc_asym.model.request import check_fidelity
 
 __all__ = ["FIDELITIES", "MomentResult", "moment_integral", "moment", "groups_arrays", "check_fidelity",
-           "check_min_thickness", "invalid_message", "validity_limit", "interpret_small", "paper_model_id"]
+           "check_min_thickness", "invalid_message", "validity_limit", "interpret_small", "paper_model_id",
+           "run_parallel", "COMPILED_S", "PARALLEL_MIN_S"]
 
 #: the rung names, cheapest first (tuple; the specs: ``registry.FIDELITIES``)
 FIDELITIES = fidelity_names()
@@ -522,7 +523,21 @@ def _run_driver(driver, n: int, fidelity: str, args, parallel: bool = False):
                 return interpreted(driver)(*args)
         except (ArithmeticError, ValueError):  # the compiled code returns inf/NaN there
             pass
-    if parallel and n * COMPILED_S.get(fidelity, 0.0) < PARALLEL_MIN_S:
+    if parallel:
+        return run_parallel(driver, n * COMPILED_S.get(fidelity, 0.0), args)
+    return driver(*args)
+
+
+def run_parallel(driver, work_s: float, args):
+    """``driver(*args)`` for a ``prange`` driver, on one Numba thread where ``work_s`` (its
+    single-thread seconds, from a per-point cost such as :data:`COMPILED_S`) is below
+    :data:`PARALLEL_MIN_S`, on the caller's thread count above.
+
+    The one thread rule of every parallel driver (moment, charge, per-sample moment): a parallel
+    launch there costs more than it saves, and the thread count changes no bit (the points are
+    independent).  The caller's setting is restored.
+    """
+    if work_s < PARALLEL_MIN_S:
         old = numba.get_num_threads()
         if old > 1:
             numba.set_num_threads(1)

@@ -38,7 +38,7 @@ import numpy as np
 from ipmc_asym.base.registry import FIDELITIES as _FIDELITY_SPECS
 from ipmc_asym.base.results import Panel, ResultMixin, ResultSpec
 from ipmc_asym.base.settings import BVP_STATED_ERROR, VALIDATED_VOLTAGE, VALIDITY_LIMIT
-from ipmc_asym.integral.api import check_fidelity, check_min_thickness, paper_model_id
+from ipmc_asym.integral.api import check_fidelity, check_min_thickness, paper_model_id, run_parallel
 from ipmc_asym.kernels.charge import GL_W, GL_X, charge_sweep
 from ipmc_asym.model import groups
 from ipmc_asym.model.params import NAFION_LI, Material, Strip, check_positive
@@ -142,6 +142,13 @@ def charge_inputs(thickness, voltage, model="constant", width=5.0e-3, length=0.0
     return th, v, perm, w, L, mat
 
 
+#: compiled seconds per point of :func:`ipmc_asym.kernels.charge.charge_sweep`, one thread (order
+#: of magnitude, measured on 1-10^4 points of 1e-4 < lam < 0.1, 1e-3 < A2 < 100: the closed forms
+#: carry their error estimates and, near overlap, an exact point): with
+#: :data:`ipmc_asym.integral.api.PARALLEL_MIN_S`, the work below which one thread runs
+CHARGE_COMPILED_S = {"leading": 8e-7, "corrected": 1e-6, "quadrature": 2e-6, "exact": 2e-5}
+
+
 def charge_at(th, v, perm: Permittivity, w: float, L: float, mat: Material, fidelity: str) -> ChargeResult:
     """:func:`charge` on the checked arguments of :func:`charge_inputs` at the rung ``fidelity``."""
     if perm.is_custom and fidelity != "bvp":
@@ -153,8 +160,9 @@ def charge_at(th, v, perm: Permittivity, w: float, L: float, mat: Material, fide
         lam = np.asarray(groups.debye_length(th, perm.eps_moy, mat), dtype=float).reshape(-1)
         rho = perm.eps0 / perm.eps_moy
         outs = [np.empty(A2.size) for _ in range(5)]
-        charge_sweep(np.ascontiguousarray(A2), np.ascontiguousarray(lam), rho, paper_model_id(perm),
-                     _FIDELITY_SPECS[fidelity].kernel_code, GL_X, GL_W, *outs)
+        run_parallel(charge_sweep, A2.size * CHARGE_COMPILED_S.get(fidelity, 0.0),
+                     (np.ascontiguousarray(A2), np.ascontiguousarray(lam), rho, paper_model_id(perm),
+                      _FIDELITY_SPECS[fidelity].kernel_code, GL_X, GL_W, *outs))
         g, cdh, err, errc, core = (o.reshape(th.shape) for o in outs)
         # sigma = (S F/RT) (sigma_hat/A2) phi0: odd in phi0, -> C_d(0) phi0, no A2^2 formed
         sig = capacitance_scale(perm, mat) * g * v

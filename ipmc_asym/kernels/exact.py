@@ -141,7 +141,8 @@ def make_exact_driver(core_point, outer_point):
         double precision (no kappa dependence left).
         """
         n = X.shape[0]
-        em2V1 = math.expm1(-2.0 * V1)
+        # y = ysw e^{-d} (1 - e^{-2v})/(1 - e^{-2 V1}): the point-independent factor once
+        scale = sgn * ysw / -math.expm1(-2.0 * V1)
         p = 0
         for j in range(m, 0, -1):  # panel j spans d in [d_{j-1}, d_j]
             d_lo = 0.0 if j == 1 else (1.0 if j == 2 else 2.0 ** (j - 2))
@@ -160,11 +161,15 @@ def make_exact_driver(core_point, outer_point):
                     else:
                         vv = V1 - dd
                         e2v = math.exp(-2.0 * vv)
-                        em = -math.expm1(-2.0 * vv)
-                        y = sgn * ysw * math.exp(-dd) * (em / -em2V1)
-                        th = em / (1.0 + e2v)
+                        # 1 - e^{-2v}: subtracted directly where e^{-2v} <= 1/2 (the difference is
+                        # >= 1/2, so exp's rounding reaches it at most once: <= 2 ulp), expm1 only
+                        # near v = 0 where the subtraction would cancel
+                        em = 1.0 - e2v if e2v <= 0.5 else -math.expm1(-2.0 * vv)
+                        y = scale * math.exp(-dd) * em
+                        r = 1.0 / (1.0 + e2v)
+                        th = em * r
                         t2 = th * th
-                        sech2 = 4.0 * e2v / ((1.0 + e2v) * (1.0 + e2v))
+                        sech2 = 4.0 * e2v * r * r
                     f, g, w = core_point(y, t2, par)
                     F[p * n + i] = f
                     # dF/dell ~ sech^2 v where y is tiny: integrate sech^2 exactly (tanh V1) and

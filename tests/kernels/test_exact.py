@@ -233,3 +233,30 @@ def test_kappa_spans_thousands_of_decades():
     lam, A2, A3, rho, _ = _groups("constant", 1e-6, 20.0)
     _, _, ell, _, _ = moment_exact(lam, A2, A3, rho)
     assert abs(2 * math.log(lam) - math.log(2) - 2 * ell) < 10
+
+
+#: ``I`` of the previous nodes (commit c417e53: ``1 - e^{-2v}``, ``ehat`` and ``e^y - 1`` at the
+#: outer nodes by ``expm1``), 1 um - 10 mm x 1e-4 - 20 V: ``exp`` and a direct subtraction where
+#: they do not cancel move the nodes and integrands by a few ulp, far inside the stated error
+PREVIOUS_NODES = [
+    ("constant", 1e-06, 0.0001, 0.08213310301427224), ("constant", 1e-06, 20.0, 0.1032448091344227),
+    ("constant", 3e-06, 0.5, 0.02485974895381561), ("constant", 1e-05, 2.0, 0.009910114214522259),
+    ("constant", 0.0001, 0.001, 0.0008803002934900316), ("constant", 0.0002, 5.0, 0.000717275491504149),
+    ("constant", 0.001, 0.1, 8.442502355579271e-05), ("constant", 0.01, 20.0, 2.7241380134053272e-05),
+    ("linear", 1e-06, 0.0001, 0.4055366898128944), ("linear", 1e-06, 20.0, 0.001155673436986563),
+    ("linear", 3e-06, 0.5, 0.03155103104884831), ("linear", 1e-05, 2.0, 0.003082048188163485),
+    ("linear", 0.0001, 0.001, 0.012337260393438208), ("linear", 0.0002, 5.0, 6.756010647232046e-05),
+    ("linear", 0.001, 0.1, 0.0006427397640471126), ("linear", 0.01, 20.0, 3.3932704813746524e-07),
+    ("affine", 1e-06, 0.0001, 0.4056661090307971), ("affine", 1e-06, 20.0, 0.09624917459421159),
+    ("affine", 3e-06, 0.5, 0.03738901070718519), ("affine", 1e-05, 2.0, 0.00830624588690687),
+    ("affine", 0.0001, 0.001, 0.012367779992557486), ("affine", 0.0002, 5.0, 0.000572873710359619),
+    ("affine", 0.001, 0.1, 0.0006507839372051443), ("affine", 0.01, 20.0, 2.4464857666847853e-05),
+]
+
+
+def test_core_nodes_match_previous_values():
+    for model, th, v, ref in PREVIOUS_NODES:
+        lam, A2, A3, rho, _ = _groups(model, th, v)
+        I, _, _, _, niter = moment_exact(lam, A2, A3, rho)
+        assert niter > 0
+        assert abs(I / ref - 1.0) <= 1e-14, (model, th, v, I, ref)
