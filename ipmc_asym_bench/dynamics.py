@@ -12,7 +12,7 @@ from ipmc_asym_bench.timing import cpu_best, load, threads
 
 __all__ = ["section", "TARGETS"]
 
-#: seconds (the issue's targets)
+#: seconds (the project's goals)
 TARGETS = {"freq_1000_s": 0.05, "freq_1000_line_s": 0.05, "sine_1e5_quasi_static_s": 0.5, "sine_1e5_dynamic_s": 0.5}
 
 

@@ -19,7 +19,7 @@ from ipmc_asym.model.params import FALLBACK_DEFAULTS, NAFION_LI, Material, named
 
 __all__ = ["names", "get", "info", "citations", "bibliography", "describe", "NOT_OFFERED", "MaterialSets", "MATERIAL_SETS"]
 
-#: sets the issue asks for that are not offered, and why (no source read for them here)
+#: membranes asked for that are not offered, and why (no source read for them here)
 NOT_OFFERED = (
     "Flemion, Aquivion, and Nafion 115/117/NRE-211/NRE-212 in the Li+, Na+, K+ forms: not offered -- no source "
     "read gives their Z3 (or IEC), rho3, phi4 and hydrated E; the H+ sets take phi4 from the paper. "

@@ -73,7 +73,7 @@ def test_model_spread_spans_models_and_c_moy(capsys):
         vals = [v for v in q["values"].values() if v is not None]
         assert q["min"] == min(vals) and q["max"] == max(vals)
         assert q["numerical_error"] >= max(r["error_estimate"] for r in out["results"])
-    # the spread is far wider than the numerical error (issue: 2.32 / 0.77 / 2.00 mN at 2 V)
+    # the spread is far wider than the numerical error (measured: 2.32 / 0.77 / 2.00 mN at 2 V)
     q = sp["quantities"]["w_small"]
     width = (q["max"] - q["min"]) / max(abs(q["max"]), abs(q["min"]))
     assert q["ratio"] > 1.2 and width > 1e3 * q["numerical_error"]

@@ -1,6 +1,6 @@
 """Never a wrong number as a result, one-line failures, bounded memory, atomic output.
 
-Each reproducer of the issue has a test here; references are independent of the code path
+Each reproducer of a refusal has a test here; references are independent of the code path
 under test (the BVP, the quadrature, an independent solver's number, exact limits).
 """
 

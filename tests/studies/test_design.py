@@ -9,7 +9,7 @@ import ipmc_asym as ia
 from ipmc_asym.forward.model import forward
 from ipmc_asym.studies.design import design, parse_spec
 
-# 3 variables, 2 constraints (the target)
+# 3 variables, 2 constraints (the design example's size)
 SPEC = {"model": "constant",
         "strip": {"width": "5mm"},
         "vary": {"length": ["1cm", "4cm"], "thickness": ["100um", "400um"], "voltage": ["0.5V", "2V"]},
