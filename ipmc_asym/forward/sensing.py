@@ -70,7 +70,9 @@ class SenseResult(ResultMixin):
     strain_parameter : ndarray   b = (1 - 2 nu) kappa e/phi4 at the clamp
     max_strain : ndarray   face strain e|kappa| at the clamp
     check_strain : ndarray of bool   max_strain <= material.strain_limit (small strain; values kept)
-    valid : ndarray of bool   a rung met the tolerance and check_strain holds
+    check_beam_regime : ndarray of bool   the strip turns less than a quarter turn, |kappa0| L <= pi/2
+        (the small-displacement beam relating w and kappa; values kept)
+    valid : ndarray of bool   a rung met the tolerance and both checks hold
     fidelity_used : ndarray of str   the rung kept at each point
     model, support, load, fidelity : str
     nu : float
@@ -78,8 +80,8 @@ class SenseResult(ResultMixin):
     """
 
     _result = ResultSpec("point", None, ("curvature", "tip_displacement", "sigma", "Q", "V_oc", "Q_per_w", "error",
-                                         "error_V_oc", "strain_parameter", "max_strain", "check_strain", "valid",
-                                         "fidelity_used"),
+                                         "error_V_oc", "strain_parameter", "max_strain", "check_strain", "check_beam_regime",
+                                         "valid", "fidelity_used"),
                          (Panel("tip_displacement", ("Q",)), Panel("tip_displacement", ("V_oc",))),
                          scalars=("nu",), names={"error": "error_sigma"})
     _HEADLINE = ("model", "fidelity", "support", "load")
@@ -95,6 +97,7 @@ class SenseResult(ResultMixin):
     strain_parameter: np.ndarray
     max_strain: np.ndarray
     check_strain: np.ndarray
+    check_beam_regime: np.ndarray
     valid: np.ndarray
     fidelity_used: np.ndarray
     model: str
@@ -188,14 +191,16 @@ def sense(strip: Strip | None = None, curvature=None, tip_displacement=None, sup
     used = hat.used.reshape(b0.size, u.size)[:, 0]
     strain = np.abs(kap) * strip.e
     strain_ok = strain <= mat.strain_limit
+    # the small-displacement beam (eq (13)) of the w <-> kappa relation: flagged past a quarter turn
+    beam_ok = np.abs(kap) * L <= 0.5 * math.pi
     # Q/w; at w = 0 the linear sensitivity (closed form, derivations.sensing:reciprocity_ratio)
     s_lin = _linear_q_per_w(strip, lam, perm, mat, support, nu, g0)
     with np.errstate(divide="ignore", invalid="ignore"):
         qpw = np.where(w != 0.0, Q / np.where(w != 0.0, w, 1.0), s_lin)
     return SenseResult(curvature=kap, tip_displacement=w, sigma=sig, Q=Q, V_oc=V, Q_per_w=qpw, error=err,
                        error_V_oc=errv, strain_parameter=b0, max_strain=strain, check_strain=strain_ok,
-                       valid=ok & strain_ok, fidelity_used=used, model=perm.name, support=support, load=load,
-                       fidelity=req.fidelity, nu=nu, message=hat.message)
+                       check_beam_regime=beam_ok, valid=ok & strain_ok & beam_ok, fidelity_used=used,
+                       model=perm.name, support=support, load=load, fidelity=req.fidelity, nu=nu, message=hat.message)
 
 
 def _root_sigma(b0, lam, perm, mat, req, g0):
