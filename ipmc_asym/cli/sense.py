@@ -23,7 +23,8 @@ from ipmc_asym.io.fileio import atomic_write
 from ipmc_asym.io.jsonio import dumps
 
 #: curvature units (1/m); a bare number is 1/m
-_CURVATURE = {"1/m": 1.0, "m^-1": 1.0, "/m": 1.0, "1/mm": 1e3, "mm^-1": 1e3, "1/cm": 1e2, "cm^-1": 1e2}
+_CURVATURE = {"1/m": 1.0, "m^-1": 1.0, "/m": 1.0, "1/mm": 1e3, "mm^-1": 1e3, "/mm": 1e3, "1/cm": 1e2, "cm^-1": 1e2,
+              "/cm": 1e2}
 #: the per-point columns of --out, in order
 COLUMNS = ("curvature", "tip_displacement", "sigma", "Q", "V_oc", "Q_per_w", "error", "error_V_oc",
            "strain_parameter", "max_strain", "check_strain", "check_beam_regime", "valid", "fidelity_used")
