@@ -15,9 +15,9 @@ actuation's electrode charge), ``V_oc = (R T/F) v_hat``; ``b = (1 - 2 nu) kappa 
   ``coth(1/lam) - lam`` of the linear solution multiplies it.  Error bound: the cross term of
   finite ``lam`` and nonlinearity, ``CROSS lam`` times the balance's own departure from
   linearity (``|sigma_nc/(-b) - 1|``; for ``V_oc`` that of the Donnan law), plus rounding.
-  ``CROSS`` is measured, not derived: the BVP gives at most 3.2 (linear, affine) and 2.1
-  (constant) on 20 um - 2 mm x b = 1e-5 - 0.13 (tests/integral/test_sensing.py); 8 keeps a
-  factor 2.5 over that.
+  ``CROSS`` is measured, not derived: against the BVP the coefficient is at most 3.7 (linear,
+  affine) and 2.1 (constant) on 2e = 20 um - 2 mm x face strains 1e-3 - 3e-2 (docs/sensing.md;
+  the grid of tests/integral/test_sensing.py); 8 keeps a factor 2 over that.
 """
 
 from __future__ import annotations
@@ -34,7 +34,7 @@ __all__ = ["sense_point", "balance_hat", "SENSE_ROUNDING", "CROSS"]
 #: relative rounding of the closed forms and of the Newton solution (measured <= 1e-15 against
 #: 40-digit evaluations in tests/kernels/test_sensing.py)
 SENSE_ROUNDING = 1e-13
-#: coefficient of the exact rung's cross term (measured <= 3.2 against the BVP, module docstring)
+#: coefficient of the exact rung's cross term (measured <= 3.7 against the BVP, module docstring)
 CROSS = 8.0
 
 
