@@ -150,7 +150,7 @@ def _write(path, results, rows):
     if str(path).lower().endswith(".nc"):
         import xarray as xr  # deferred: xarray is heavy (start-up)
 
-        from ipmc_asym.io.datasets import write_netcdf
+        from ipmc_asym.io.datasets import write_netcdf  # deferred: loads xarray (start-up)
 
         ds = xr.concat([r.to_xarray() for r in results.values()], dim="model")
         ds = ds.assign_coords(model=list(results))
