@@ -27,7 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ipmc_asym.base.ladder import SkipRung, climb, rungs_from
+from ipmc_asym.base.ladder import climb, rungs_from
 from ipmc_asym.base.settings import VALIDITY_LIMIT
 from ipmc_asym.kernels.sensing import sense_point
 from ipmc_asym.model import groups
@@ -95,8 +95,6 @@ def sense_hat(b, lam, perm: Permittivity, material: Material, fidelity: str = "l
                     s, v, es, ev = sense_point(b[i], lb, rho0, material.phi4, 1)
                     out[:, k] = (s / math.sqrt(g0), v / g0, es, ev)
             return out
-        if g0 is not None:
-            raise SkipRung("the pressure term is held at linear order only (rung leading)")
         if rung == "exact":
             for k, i in enumerate(idx):
                 out[:, k] = sense_point(b[i], lam[i], rho0, material.phi4, 3)
@@ -117,7 +115,9 @@ def sense_hat(b, lam, perm: Permittivity, material: Material, fidelity: str = "l
         j = int(np.argmin(ok))
         return ok, f"error estimate {max(res[2, j], res[3, j]):.2g} > {limit:.2g} at b = {b[idx[j]]:.3g}"
 
-    rungs = rungs_from(SENSE_RUNGS, _first_rung(fidelity), escalate)
+    # the pressure term is held at linear order only: its one rung whatever was requested (the
+    # cheaper rung is the only one there is; its error bound says how far it holds)
+    rungs = ("leading",) if g0 is not None else rungs_from(SENSE_RUNGS, _first_rung(fidelity), escalate)
     lad = climb(rungs, evaluate, checks, n)
     sig = np.full(n, np.nan)
     v = np.full(n, np.nan)
