@@ -28,6 +28,8 @@ import numpy as np
 
 from ipmc_asym.base.registry import check_choice
 from ipmc_asym.base.results import Panel, ResultMixin, ResultSpec
+from ipmc_asym.base.settings import VALIDITY_LIMIT
+from ipmc_asym.integral.charge import _subnormal_rounding
 from ipmc_asym.integral.sensing import B_LIMIT, charge_scale_sensing, debye_length, sense_hat, strain_parameter
 from ipmc_asym.model import groups
 from ipmc_asym.model.params import NAFION_LI, NOMINAL_STRIP, Material, Strip
@@ -187,7 +189,11 @@ def sense(strip: Strip | None = None, curvature=None, tip_displacement=None, sup
     errv = hat.error_v.reshape(b0.size, u.size).max(axis=1)
     if support == "tip-force":  # the length average of V_oc(kappa(x)) is exact at linear order only
         errv = errv + 2.0 * np.abs(np.where(b0 != 0, np.arctanh(b0) / np.where(b0 != 0, b0, 1.0) - 1.0, 0.0))
-    ok = hat.valid.reshape(b0.size, u.size).all(axis=1)
+    # a curvature so small that the response underflows: the rounding of a subnormal (1 where it
+    # rounded to 0), as for the electrode charge
+    err = err + _subnormal_rounding(Q, kap)
+    errv = errv + _subnormal_rounding(V, kap)
+    ok = hat.valid.reshape(b0.size, u.size).all(axis=1) & (err < VALIDITY_LIMIT) & (errv < VALIDITY_LIMIT)
     used = hat.used.reshape(b0.size, u.size)[:, 0]
     strain = np.abs(kap) * strip.e
     strain_ok = strain <= mat.strain_limit

@@ -140,3 +140,9 @@ def test_ladder_escalates_to_meet_tol():
     h = sense_hat(b, lam, p, MAT, "leading", tol=1e-6, escalate=False)
     assert list(h.valid) == [True, False] and np.all(np.isfinite(h.sigma_hat))
     assert "no valid fidelity at b = 0.05" in h.message
+
+
+def test_underflowing_response_is_flagged_not_silent():
+    r = ia.sense(ia.Strip(thickness=1e-6), curvature=[5e-324, 1e-300], model="linear")
+    assert r.Q[0] == 0.0 and r.error[0] == 1.0 and not bool(r.valid[0])
+    assert r.Q[1] < 0.0 and r.error[1] < 1e-12 and bool(r.valid[1])
