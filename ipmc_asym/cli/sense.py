@@ -92,8 +92,6 @@ def register(sub):
 def run(args):
     material = material_from_args(args)
     strip = strip_from_args(args)
-    if args.strain_limit is not None:
-        material = material.with_(strain_limit=args.strain_limit)
     first_run_notice()
     kw = {"curvature": args.curvature} if args.curvature is not None else {"tip_displacement": args.tip_displacement}
     results = {m: sense(strip, support=args.support, load=args.load, model=m, fidelity=args.fidelity, tol=args.tol,
