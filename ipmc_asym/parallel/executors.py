@@ -170,6 +170,11 @@ def worker_setup(threads: int = 1, fidelities=COMPILED) -> dict:
         os.environ.setdefault(k, v)
     import numba  # deferred: after the thread environment above is set
 
+    # Numba re-reads the environment at every compilation and refuses a NUMBA_NUM_THREADS that
+    # differs from the pool it already launched (a worker of the user's own cluster, or one
+    # whose environment changed since Numba was imported): keep the variable at the value
+    # Numba runs with; the count actually used is set just below
+    os.environ["NUMBA_NUM_THREADS"] = str(numba.config.NUMBA_NUM_THREADS)
     numba.set_num_threads(max(1, min(int(threads), numba.config.NUMBA_NUM_THREADS)))
     from ipmc_asym.kernels.jit import CACHE_DIR  # deferred: loads Numba: after the thread environment is set
 
