@@ -39,6 +39,13 @@ MIN_THICKNESS = 100e-9
 #: (IPMCs are driven at a few volts): above this voltage every result carries a warning
 VALIDATED_VOLTAGE = 20.0
 
+#: largest |phi0| (V) a time-domain drive (``step``, ``drive``, ``Drive``) accepts: a numerical
+#: guard, not a physical limit.  The charge kernels' closed forms lose finite values somewhere
+#: above ~1e100 V (measured: NaN charge at a 1e200 V step); 50x the validated range is far past
+#: any use and keeps every output finite (tests/dynamics/test_waveforms.py); beyond
+#: VALIDATED_VOLTAGE results still carry the warning
+MAX_DRIVE_VOLTAGE = 1e3
+
 #: relative rounding floor of the error estimate of corrected / quadrature (the two terms are
 #: assembled with cancellations; measured <= 2.3e-12 against the BVP on 1 um - 10 mm x 0.1 mV - 20 V)
 ROUNDING_ERROR = 1e-11

@@ -168,8 +168,12 @@ def run(args):
           f"{'theta':>9s} {'w [mm]':>9s} {'F_block [mN]':>12s}")
     for r in shown:
         r = {k: v + 0.0 for k, v in r.items()}  # no "-0" in the table
+        # w and F_block are undefined past a quarter turn / on the multi-turn branch (the forward
+        # model's beam regime, as `estimate` prints it): n/a, never a bare nan
+        w = f"{r['w'] * 1e3:9.4g}" if np.isfinite(r["w"]) else f"{'n/a':>9s}"
+        fb = f"{r['F_block'] * 1e3:12.4g}" if np.isfinite(r["F_block"]) else f"{'n/a':>12s}"
         print(f"{r['t']:11.4g} {r['phi0']:9.4g} {r['sigma']:14.6g} {r['current_density']:11.4g} {r['M_A']:11.4g} "
-              f"{r['theta']:9.4g} {r['w'] * 1e3:9.4g} {r['F_block'] * 1e3:12.4g}")
+              f"{r['theta']:9.4g} {w} {fb}")
     if clamped:
         print_clamped("t [s]", [r["t"] for r in shown], {c: [r[c] for r in shown] for c in CLAMPED_COLUMNS})
     for n in info["notes"]:

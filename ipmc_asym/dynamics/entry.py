@@ -34,7 +34,7 @@ from ipmc_asym.dynamics.circuit import (
 from ipmc_asym.dynamics.drive import drive_chunks, drive_info, drive_response
 from ipmc_asym.dynamics.line import line_response
 from ipmc_asym.dynamics.line_time import DEFAULT_SEGMENTS
-from ipmc_asym.dynamics.waveforms import Waveform, parse_waveform
+from ipmc_asym.dynamics.waveforms import Waveform, check_drive_voltage, parse_waveform
 from ipmc_asym.model.params import NAFION_LI, Material, Strip, check_finite
 
 __all__ = ["DEFAULT_BEAM", "TIME_PATHS", "Drive", "TimeResponse", "time_path", "time_response", "spectrum"]
@@ -81,7 +81,8 @@ class Drive:
             raise ValueError(f"drive must be a voltage (V), a waveform SPEC such as 'sine:1V@10Hz' or a callable "
                              f"phi0(t) in volts; got {drive!r}")
         if isinstance(drive, (int, float, np.floating, np.integer)):
-            self.kind, self.voltage, self.spec = "step", check_finite("drive", drive, "a finite number of volts"), "step"
+            self.kind, self.spec = "step", "step"
+            self.voltage = check_drive_voltage("drive", check_finite("drive", drive, "a finite number of volts"))
             self.function = self.source = waveform("step", self.voltage)
         elif isinstance(drive, str):
             wave = parse_waveform(drive)

@@ -27,6 +27,7 @@ import re
 import numpy as np
 
 from ipmc_asym.base.inputs import read_input_text
+from ipmc_asym.base.settings import MAX_DRIVE_VOLTAGE, VALIDATED_VOLTAGE
 from ipmc_asym.base.units import parse_quantity, parse_time, parse_voltage
 
 __all__ = ["Waveform", "parse_waveform", "WAVEFORM_KINDS", "MAX_CSV_ROWS"]
@@ -187,4 +188,17 @@ def parse_waveform(spec) -> Waveform:
         except ValueError as exc:
             msg = str(exc)
             raise ValueError(msg if msg.startswith("waveform") else f"{name}: {msg}") from None
+    peak = sum(abs(p["V"]) if "V" in p else float(np.max(np.abs(p["v"]), initial=0.0)) for _, p in terms)
+    check_drive_voltage("waveform", peak)
     return Waveform(spec, terms)
+
+
+def check_drive_voltage(name, volts) -> float:
+    """``volts`` (the largest |phi0| a drive reaches) within :data:`MAX_DRIVE_VOLTAGE`, else a
+    one-line ``ValueError`` naming ``name``."""
+    v = abs(float(volts))
+    if not v <= MAX_DRIVE_VOLTAGE:
+        raise ValueError(f"{name}: |phi0| up to {MAX_DRIVE_VOLTAGE:g} V allowed (the time-domain kernels are "
+                         f"checked finite up to there; the model is validated to {VALIDATED_VOLTAGE:g} V); "
+                         f"got {v:.3g} V")
+    return float(volts)

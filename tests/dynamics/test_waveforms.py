@@ -43,3 +43,22 @@ def test_bad_specs_one_line(spec, word):
     with pytest.raises(ValueError, match=word) as ei:
         parse_waveform(spec)
     assert "\n" not in str(ei.value)
+
+
+def test_drive_voltage_cap_refuses_by_name_and_is_finite_at_the_cap():
+    """Beyond MAX_DRIVE_VOLTAGE a drive is refused in one line naming it; at the cap (both signs)
+    the step's charge and moment are finite (the guard's claim)."""
+    import ipmc_asym as ia
+    from ipmc_asym.base.settings import MAX_DRIVE_VOLTAGE
+
+    for bad in (1e300, -2 * MAX_DRIVE_VOLTAGE):
+        with pytest.raises(ValueError, match=r"drive: \|phi0\| up to"):
+            ia.Drive(bad)
+    with pytest.raises(ValueError, match=r"waveform: \|phi0\| up to"):
+        parse_waveform(f"dc:{0.6 * MAX_DRIVE_VOLTAGE}V+sine:{0.6 * MAX_DRIVE_VOLTAGE}V@1Hz")
+    for v in (MAX_DRIVE_VOLTAGE, -MAX_DRIVE_VOLTAGE):
+        r = ia.time_response(ia.Strip(), ia.Drive(v), duration=0.1, points=3)
+        rows = r.result if r.result is not None else r.columns
+        sigma, M = np.asarray(rows["sigma"] if isinstance(rows, dict) else rows.sigma), \
+            np.asarray(rows["M_A"] if isinstance(rows, dict) else rows.M_A)
+        assert np.all(np.isfinite(sigma)) and np.all(np.isfinite(M)), (v, sigma, M)

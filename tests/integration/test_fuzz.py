@@ -75,6 +75,18 @@ def _peak_bytes() -> int:
     return r if sys.platform == "darwin" else r * 1024  # Linux: kB
 
 
+def run_cli(argv):
+    """``main(argv)`` in this process: (status, stdout, stderr); argparse's SystemExit is a status."""
+    _reset_peak()
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        try:
+            rc = main(list(argv))
+        except SystemExit as exc:
+            rc = exc.code if isinstance(exc.code, int) else 2
+    return rc, out.getvalue(), err.getvalue()
+
+
 def check_outcome(argv, rc, out, err, peak=None):
     assert "Traceback" not in err and "Traceback" not in out, (argv, err[-2000:])
     assert rc in (0, 2), (argv, rc, err[-2000:])
