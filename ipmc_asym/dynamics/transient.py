@@ -689,8 +689,8 @@ def _bordered_bdf(problem, n_extra):
 
 
 def solve_transient(t, phi0_fun, strip: Strip, model="constant", material: Material = NAFION_LI, *,
-                    cells_per_debye: float = 4.0, ratio: float = 1.08, h_core: float = 0.02, refine: float = 1.0,
-                    rtol: float = 1e-8, atol: float = 1e-12, method: str = "BDF", energy: bool = False,
+                    cells_per_debye: float = 4.0, ratio: float = 1.08, h_core: float = 0.02, refine: float | None = None,
+                    rtol: float | None = None, atol: float = 1e-12, method: str = "BDF", energy: bool = False,
                     profiles: bool = False, moment: bool = True, tol: float | None = 1e-6,
                     max_cells: int = 20000) -> TransientResult:
     """Integrate the transient Nernst-Planck/Gauss problem from the uncharged state at ``t = 0``.
@@ -704,9 +704,11 @@ def solve_transient(t, phi0_fun, strip: Strip, model="constant", material: Mater
     strip : Strip ; model : "constant" / "linear" / "affine" or Permittivity ; material : Material
     cells_per_debye, ratio, h_core : float
         Mesh (:func:`make_fv_mesh`); the layer zone is sized for ``max |phi0|`` on ``t``.
-    refine : float
+    refine : float or None
         Refines the whole mesh: ``cells_per_debye * refine``, ``(ratio - 1)/refine``,
-        ``h_core/refine`` (the first level when ``tol`` is set).
+        ``h_core/refine`` (the first level when ``tol`` is set).  Default: 1 without a
+        tolerance; with one, ``sqrt(1e-6/tol)`` clipped to [1/4, 1] (a looser tolerance starts on
+        a coarser mesh).
     tol : float or None
         Relative tolerance on ``sigma`` (default 1e-6, relative to ``max |sigma|`` over ``t``).
         The mesh is refined by 2 (``refine``, ``2 refine``, ``4 refine``, ...) until the
@@ -716,7 +718,7 @@ def solve_transient(t, phi0_fun, strip: Strip, model="constant", material: Mater
         Cap on the cells of the finest mesh; the solver fails (``success = False``, one-line
         message) when the tolerance needs more.
     rtol, atol : float
-        solve_ivp tolerances (``atol`` on ``S``, in units of ``e``; no looser than ``rtol`` times the
+        solve_ivp tolerances (``rtol`` default: ``tol/100`` with a tolerance, 1e-8 without one) (``atol`` on ``S``, in units of ``e``; no looser than ``rtol`` times the
         small-signal charge ``lambda max|psi0|/2``, so that the time error stays relative at small signal).
     method : {"BDF", "Radau"}
     energy : bool
@@ -750,7 +752,8 @@ def solve_transient(t, phi0_fun, strip: Strip, model="constant", material: Mater
     """
     if tol is None:
         r = _solve_once(t, phi0_fun, strip, model, material, cells_per_debye=cells_per_debye, ratio=ratio,
-                        h_core=h_core, refine=refine, rtol=rtol, atol=atol, method=method, energy=energy,
+                        h_core=h_core, refine=1.0 if refine is None else refine,
+                        rtol=1e-8 if rtol is None else rtol, atol=atol, method=method, energy=energy,
                         profiles=profiles, moment=moment)
         r.sigma_error = np.full(r.t.size, np.nan)
         r.current_error = np.full(r.t.size, np.nan)
@@ -761,9 +764,16 @@ def solve_transient(t, phi0_fun, strip: Strip, model="constant", material: Mater
     mc = int(max_cells)
     if mc < 10:
         raise ValueError(f"max_cells must be an integer >= 10; got {max_cells!r}")
-    rt = min(rtol, 1e-2 * tol)
+    # the time integration's share of the error is 10 rt |sigma| = tol/10 (a looser tolerance
+    # takes longer steps); an explicit rtol is kept when tighter
+    rt = 1e-2 * tol if rtol is None else min(rtol, 1e-2 * tol)
     runs = []
-    rf = refine
+    # the first mesh level: the mesh error falls like h^2 and is ~1e-6 at refine 1 (measured on
+    # the nominal strip, 20 um - 2 mm alike), so a looser tolerance starts coarser, by
+    # sqrt(1e-6/tol) down to a quarter (one cell per Debye length); the ladder below still
+    # refines until its Richardson estimate meets tol, so the start only saves work.  At the
+    # default tol = 1e-6 the start is 1, as before
+    rf = min(1.0, max(0.25, math.sqrt(1e-6 / tol))) if refine is None else refine
     t_start = time.perf_counter()
     while True:
         r = _solve_once(t, phi0_fun, strip, model, material, cells_per_debye=cells_per_debye, ratio=ratio,
