@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from ipmc_asym.base.jsonio import dumps
 from ipmc_asym.base.registry import fidelity_names, model_choices
 from ipmc_asym.base.settings import VALIDITY_LIMIT
 from ipmc_asym.base.units import fmt_length
@@ -10,7 +11,6 @@ from ipmc_asym.cli.common import add_strip_options, first_run_notice, material_f
 from ipmc_asym.dynamics.electrode import charge_escalated
 from ipmc_asym.forward.estimate import SPREAD_NOTE, model_list, spread_of, spread_variants
 from ipmc_asym.forward.model import voltage_reason
-from ipmc_asym.io.jsonio import dumps
 from ipmc_asym.model.permittivity import MODELS
 
 

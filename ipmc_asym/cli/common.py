@@ -23,15 +23,15 @@ from ipmc_asym.base.units import (
     parse_time,
     parse_voltage,
 )
-from ipmc_asym.integral.api import check_min_thickness
 from ipmc_asym.io.fileio import check_output_path
 from ipmc_asym.model.electrode import METALS, beam_label
 from ipmc_asym.model.limits import bare_number_warning, material_warnings, range_warning
+from ipmc_asym.model.materials import bibliography
 from ipmc_asym.model.params import Strip, material_from_spec, set_thickness
 
 __all__ = ["UsageError", "Parser", "add_strip_options", "add_material_options", "print_citations", "material_comments",
            "scene_with_material",
-           "material_from_args", "strip_from_args",
+           "material_from_args", "strip_from_args", "strip_and_material",
            "arg_type", "count_type", "join_negative_values", "fmt_num", "c_moy_label", "length_type", "pressure_type",
            "voltage_type", "tol_type", "first_run_notice", "diffusion_type", "sidecar_path", "add_size_option", "check_size_caps",
            "add_output_option", "check_outputs",
@@ -85,7 +85,7 @@ def _positive(name, parse, example, check=None):
 def _plausible_length(name):
     def check(text, v):
         if name == "thickness" and v < MIN_THICKNESS:
-            return  # refused by strip_from_args, the one floor every command shares
+            return  # refused by the Strip (its thickness floor), the one check every command shares
         line = bare_number_warning(name, text, v, f"--{name}") or range_warning(name, v, f"--{name}")
         if line:
             warn(line)
@@ -353,22 +353,52 @@ def _strain_limit(text):
 
 def material_from_args(args):
     """The material of the options, through the library's one parser (params.material_from_spec)."""
-    spec = {"preset": getattr(args, "material", "nafion-li")}
-    if getattr(args, "modulus", None) is not None:
-        spec["E"] = args.modulus
-    if getattr(args, "c_moy", None) is not None:
-        spec["c_moy"] = args.c_moy
-    if getattr(args, "strain_limit", None) is not None:
-        spec["strain_limit"] = args.strain_limit
-    for k in ("electrode_thickness", "electrode_metal", "electrode_modulus", "electrode_density"):
-        if getattr(args, k, None) is not None:
-            spec[k] = getattr(args, k)
-    material = material_from_spec(spec, labels=_MATERIAL_OPTIONS)
+    material = material_from_spec(_material_spec(args), labels=_MATERIAL_OPTIONS)
     for line in material_warnings(material):
         warn(line)
     if getattr(args, "cite", False):
         print_citations(material, json_mode=bool(getattr(args, "json", False)))
     return material
+
+
+def _material_spec(args) -> dict:
+    """The material options given, as a ``[material]`` table of :func:`params.material_from_spec`."""
+    spec = {"preset": getattr(args, "material", "nafion-li")}
+    for key, dest in (("E", "modulus"), ("c_moy", "c_moy"), ("strain_limit", "strain_limit"),
+                      ("electrode_thickness", "electrode_thickness"), ("electrode_metal", "electrode_metal"),
+                      ("electrode_modulus", "electrode_modulus"), ("electrode_density", "electrode_density")):
+        if getattr(args, dest, None) is not None:
+            spec[key] = getattr(args, dest)
+    return spec
+
+
+def strip_and_material(args):
+    """``(strip, material, thickness_note)`` of the strip and material options, built in one place.
+
+    The constructors check what they are given (the Strip its geometry and the thickness floor,
+    the material parser every key), so the layers below trust both.  The material set's typical
+    thickness stands in for a ``--thickness`` not given (``thickness_note`` says so; empty when
+    the option was given or the set states none).  Warnings on implausible material values go to
+    stderr and ``--cite`` prints the bibliography here, before any work, as every command did.
+    """
+    spec = _material_spec(args)
+    material = material_from_spec(spec, labels=_MATERIAL_OPTIONS)
+    thickness, note = args.thickness, ""
+    if thickness is None:
+        try:
+            got = set_thickness(getattr(args, "material", None) or "nafion-li")
+        except ValueError:  # an unknown set: the material parser has said so already
+            got = None
+        thickness, note = got if got is not None else (DEFAULT_THICKNESS, "")
+        args.thickness, args.thickness_note = thickness, note
+    strip = Strip(length=args.length, width=args.width, thickness=thickness, voltage=getattr(args, "voltage", 1.0))
+    # written here rather than through warn() and print_citations(): the strip and material are
+    # built before anything is said, each line once
+    for line in material_warnings(material):
+        sys.stderr.write(f"ipmc-asym: warning: {line}\n")
+    if getattr(args, "cite", False):
+        (sys.stderr if getattr(args, "json", False) else sys.stdout).write(bibliography(material) + "\n")
+    return strip, material, note
 
 
 def scene_with_material(path, args):
@@ -407,8 +437,6 @@ def material_comments(material) -> list:
 
 def print_citations(material, json_mode=False):
     """``--cite``: the bibliography of the run (to stderr when stdout carries JSON)."""
-    from ipmc_asym.model.materials import bibliography  # deferred: reads the material set files; only --cite needs it
-
     (sys.stderr if json_mode else sys.stdout).write(bibliography(material) + "\n")
 
 
@@ -432,11 +460,9 @@ def default_thickness(material_name):
 
 
 def strip_from_args(args):
-    """The strip of the options; a thickness below ``settings.MIN_THICKNESS`` is refused here, the
-    one check every command with strip options shares (integral.api.check_min_thickness)."""
+    """The strip of the options (the Strip checks its geometry and the thickness floor)."""
     if getattr(args, "thickness", None) is None:
         args.thickness, args.thickness_note = default_thickness(getattr(args, "material", None))
-    check_min_thickness(args.thickness)
     return Strip(length=args.length, width=args.width, thickness=args.thickness,
                  voltage=getattr(args, "voltage", 1.0))
 

@@ -7,6 +7,7 @@ import sys
 
 import numpy as np
 
+from ipmc_asym.base.jsonio import dumps
 from ipmc_asym.base.registry import model_names
 from ipmc_asym.base.units import fmt_length
 from ipmc_asym.cli import SUMMARIES
@@ -38,7 +39,6 @@ from ipmc_asym.dynamics.drive import (
 )
 from ipmc_asym.dynamics.entry import time_response
 from ipmc_asym.io.fileio import atomic_path, atomic_write, check_output_path
-from ipmc_asym.io.jsonio import dumps
 from ipmc_asym.io.textfmt import format_table
 
 #: --json holds every row in memory: at most this many (the CSV is streamed)

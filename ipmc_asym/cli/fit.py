@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import sys
 
+from ipmc_asym.base.jsonio import dumps
 from ipmc_asym.base.registry import fidelity_names, model_names
 from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import (
@@ -26,7 +27,6 @@ from ipmc_asym.cli.common import (
 )
 from ipmc_asym.dynamics.circuit import BEAM_CHOICES
 from ipmc_asym.io.fileio import FIGURE_FORMATS, check_output_path
-from ipmc_asym.io.jsonio import dumps
 from ipmc_asym.model.electrode import beam_label
 from ipmc_asym.parallel.executors import check_scheduler
 from ipmc_asym.studies.calibrate import FREE_ALIASES, FREE_PARAMETERS, MAX_DATA_ROWS, CalibrationData, fit, parse_free

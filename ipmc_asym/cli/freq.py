@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ipmc_asym.base.jsonio import dumps
 from ipmc_asym.base.registry import model_names
 from ipmc_asym.base.units import fmt_length
 from ipmc_asym.beam.dynamics import CLAMPED_OUTPUTS
@@ -33,7 +34,6 @@ from ipmc_asym.dynamics.circuit import FREQ_METHODS
 from ipmc_asym.dynamics.entry import spectrum
 from ipmc_asym.dynamics.reduction import transfer_function
 from ipmc_asym.io.fileio import atomic_write, check_output_path
-from ipmc_asym.io.jsonio import dumps
 
 #: frequencies of one run (log-spaced: 1e5 points resolve any spectrum; the --json text stays ~10 MB);
 #: settable with --max-points

@@ -9,6 +9,7 @@ import sys
 
 import numpy as np
 
+from ipmc_asym.base.jsonio import dumps
 from ipmc_asym.base.registry import model_names
 from ipmc_asym.base.units import fmt_length
 from ipmc_asym.cli import SUMMARIES
@@ -38,7 +39,6 @@ from ipmc_asym.dynamics.drive import (
 from ipmc_asym.dynamics.entry import time_path, time_response
 from ipmc_asym.forward.model import CHECKS
 from ipmc_asym.io.fileio import atomic_write, check_output_path
-from ipmc_asym.io.jsonio import dumps
 
 COLUMNS = ("t", "phi0", "sigma", "current_density", "M_A", "theta", "w")
 #: output times of one run: the arrays of the integrator (~2 substeps per interval) and of the

@@ -10,6 +10,7 @@ import warnings
 
 import numpy as np
 
+from ipmc_asym.base.jsonio import dumps
 from ipmc_asym.base.progress import progress
 from ipmc_asym.base.registry import fidelity_names, model_choices, model_names
 from ipmc_asym.base.settings import MAX_ROWS
@@ -29,7 +30,6 @@ from ipmc_asym.cli.common import (
 from ipmc_asym.forward.model import ASSUMPTION_CHECKS, ASSUMPTION_LIMITS
 from ipmc_asym.io.datasets import sweep_dataset, write_netcdf
 from ipmc_asym.io.fileio import atomic_write, check_output_path
-from ipmc_asym.io.jsonio import dumps
 from ipmc_asym.parallel.executors import check_scheduler
 from ipmc_asym.studies.fits import sweep_fits
 from ipmc_asym.studies.sweep_chunks import sweep_chunked
