@@ -27,7 +27,7 @@ from ipmc_asym.io.fileio import check_output_path
 from ipmc_asym.model.electrode import METALS, beam_label
 from ipmc_asym.model.limits import bare_number_warning, material_warnings, range_warning
 from ipmc_asym.model.materials import bibliography
-from ipmc_asym.model.params import Strip, material_from_spec, set_thickness
+from ipmc_asym.model.params import Strip, check_min_thickness, material_from_spec, set_thickness
 
 __all__ = ["UsageError", "Parser", "add_strip_options", "add_material_options", "print_citations", "material_comments",
            "scene_with_material",
@@ -382,23 +382,15 @@ def strip_and_material(args):
     stderr and ``--cite`` prints the bibliography here, before any work, as every command did.
     """
     spec = _material_spec(args)
+    strip = strip_from_args(args)
     material = material_from_spec(spec, labels=_MATERIAL_OPTIONS)
-    thickness, note = args.thickness, ""
-    if thickness is None:
-        try:
-            got = set_thickness(getattr(args, "material", None) or "nafion-li")
-        except ValueError:  # an unknown set: the material parser has said so already
-            got = None
-        thickness, note = got if got is not None else (DEFAULT_THICKNESS, "")
-        args.thickness, args.thickness_note = thickness, note
-    strip = Strip(length=args.length, width=args.width, thickness=thickness, voltage=getattr(args, "voltage", 1.0))
     # written here rather than through warn() and print_citations(): the strip and material are
     # built before anything is said, each line once
     for line in material_warnings(material):
         sys.stderr.write(f"ipmc-asym: warning: {line}\n")
     if getattr(args, "cite", False):
         (sys.stderr if getattr(args, "json", False) else sys.stdout).write(bibliography(material) + "\n")
-    return strip, material, note
+    return strip, material, getattr(args, "thickness_note", "")
 
 
 def scene_with_material(path, args):
@@ -460,9 +452,11 @@ def default_thickness(material_name):
 
 
 def strip_from_args(args):
-    """The strip of the options (the Strip checks its geometry and the thickness floor)."""
+    """The strip of the options; a thickness below ``settings.MIN_THICKNESS`` is refused here, in
+    the option's words, before the Strip's own check."""
     if getattr(args, "thickness", None) is None:
         args.thickness, args.thickness_note = default_thickness(getattr(args, "material", None))
+    check_min_thickness(args.thickness)
     return Strip(length=args.length, width=args.width, thickness=args.thickness,
                  voltage=getattr(args, "voltage", 1.0))
 
