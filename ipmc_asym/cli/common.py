@@ -24,9 +24,9 @@ from ipmc_asym.base.units import (
     parse_voltage,
 )
 from ipmc_asym.io.fileio import check_output_path
-from ipmc_asym.model.electrode import METALS, beam_label
+from ipmc_asym.model.electrode import METALS
 from ipmc_asym.model.limits import bare_number_warning, material_warnings, range_warning
-from ipmc_asym.model.materials import bibliography
+from ipmc_asym.model.materials import bibliography, material_comments
 from ipmc_asym.model.params import Strip, check_min_thickness, material_from_spec, set_thickness
 
 __all__ = ["UsageError", "Parser", "add_strip_options", "add_material_options", "print_citations", "material_comments",
@@ -178,18 +178,21 @@ def check_size_caps(args):
                              f"lower {flag} or raise {cap}")
 
 
-def add_output_option(p, flag="--out", *, formats=None, kind="file", **kw):
+def add_output_option(p, flag="--out", *, formats=None, kind="file", sidecar=False, **kw):
     """An output option ``flag`` (a file whose format follows its extension, one of ``formats``, or
     a directory, ``kind="dir"``), checked by :func:`check_outputs` before any work.
 
     ``main`` calls :func:`check_outputs` right after parsing: a format the command cannot write
     (``--out d.xlsx`` of a CSV writer, ``--plot x.xlsx``), an empty path (``--out ''``), a
     missing or read-only directory is refused in one line before anything is computed, the same
-    way for every command (``io.fileio.check_output_path``).
+    way for every command (``io.fileio.check_output_path``).  ``sidecar``: the file's metadata
+    sidecar (:func:`sidecar_path`) is checked with it.
     """
     p.add_argument(flag, **kw)
     outs = p.get_default("_outputs") or ()
     p.set_defaults(_outputs=tuple(outs) + ((flag, kind, tuple(formats) if formats else None),))
+    if sidecar:
+        p.set_defaults(_sidecars=tuple(p.get_default("_sidecars") or ()) + (flag,))
 
 
 def check_outputs(args):
@@ -198,6 +201,10 @@ def check_outputs(args):
         v = getattr(args, _dest(flag), None)
         if v is not None:
             check_output_path(v, kind, flag, formats=formats)
+    for flag in getattr(args, "_sidecars", ()) or ():
+        v = getattr(args, _dest(flag), None)
+        if v:
+            check_output_path(sidecar_path(v), "file")
 
 
 def _seed(text):
@@ -353,7 +360,8 @@ def _strain_limit(text):
 
 def material_from_args(args):
     """The material of the options, through the library's one parser (params.material_from_spec)."""
-    material = material_from_spec(_material_spec(args), labels=_MATERIAL_OPTIONS)
+    spec = _material_spec(args)
+    material = material_from_spec(spec, labels=_MATERIAL_OPTIONS)
     for line in material_warnings(material):
         warn(line)
     if getattr(args, "cite", False):
@@ -384,12 +392,13 @@ def strip_and_material(args):
     spec = _material_spec(args)
     strip = strip_from_args(args)
     material = material_from_spec(spec, labels=_MATERIAL_OPTIONS)
-    # written here rather than through warn() and print_citations(): the strip and material are
-    # built before anything is said, each line once
+    # said once both are built: a refused option has printed nothing
     for line in material_warnings(material):
         sys.stderr.write(f"ipmc-asym: warning: {line}\n")
     if getattr(args, "cite", False):
         (sys.stderr if getattr(args, "json", False) else sys.stdout).write(bibliography(material) + "\n")
+    if getattr(args, "diffusion", None) is not None:  # the dynamic commands' --diffusion over the set's D
+        material = material.with_(D=args.diffusion)
     return strip, material, getattr(args, "thickness_note", "")
 
 
@@ -417,14 +426,6 @@ def electrode_spec(args) -> dict:
     """The electrode options given (``electrode_thickness`` ... -> value), for a material table."""
     return {k: getattr(args, k) for k in ("electrode_thickness", "electrode_metal", "electrode_modulus",
                                           "electrode_density") if getattr(args, k, None) is not None}
-
-
-def material_comments(material) -> list:
-    """Header comment lines of a result file: the material set, the beam when it carries electrode
-    layers (the bare membrane is the paper's beam) and the numbered sources."""
-    beam = [f"beam: {beam_label(material.electrode)}"] if material.electrode.present else []
-    return [f"material set: {material.name}"] + beam + [f"source [{i}]: {c}"
-                                                       for i, c in enumerate(material.sources, 1)]
 
 
 def print_citations(material, json_mode=False):
@@ -641,13 +642,14 @@ def add_support_options(p):
                         "the active moment acts there only, the beam outputs are small-displacement")
 
 
-def support_from_args(args, strip):
-    """``(support, electrode)`` checked against the strip and the other options (one-line ValueError)."""
+def support_from_args(args):
+    """``(support, electrode)`` checked against ``--length`` and the other options (one-line
+    ValueError), before the strip is built."""
     el = args.electrode
     if el is not None:
         x1, x2 = el
-        if not 0.0 <= x1 < x2 <= strip.length:
-            raise ValueError(f"--electrode X1:X2 must satisfy 0 <= X1 < X2 <= L = {fmt_length(strip.length)}; "
+        if not 0.0 <= x1 < x2 <= args.length:
+            raise ValueError(f"--electrode X1:X2 must satisfy 0 <= X1 < X2 <= L = {fmt_length(args.length)}; "
                              f"got {fmt_length(x1)}:{fmt_length(x2)}")
     if el is not None or args.support == "clamped-clamped":
         what = "--support clamped-clamped" if args.support == "clamped-clamped" else "--electrode"

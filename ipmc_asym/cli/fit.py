@@ -17,11 +17,10 @@ from ipmc_asym.cli.common import (
     diffusion_type,
     first_run_notice,
     fmt_num,
-    material_from_args,
     model_help,
     seed_type,
     sheet_resistance_type,
-    strip_from_args,
+    strip_and_material,
     viscous_modulus_type,
     waveform_type,
 )
@@ -103,12 +102,9 @@ def run(args) -> int:
     parse_free(args.free)
     if len(args.data) > MAX_FILES:
         raise ValueError(f"DATA.csv: {len(args.data)} files; at most {MAX_FILES}")
-    material = material_from_args(args)
-    if args.diffusion is not None:
-        material = material.with_(D=args.diffusion)
+    strip, material, _ = strip_and_material(args)
     if args.sheet_resistance is not None:
         material = material.with_(sheet_resistance=args.sheet_resistance)
-    strip = strip_from_args(args)
     files = [read_file(d, strip, waveform=args.waveform, max_rows=args.max_rows) for d in args.data]
     first_run_notice("fit")
     static_only = len(files) == 1 and isinstance(files[0], CalibrationData)
