@@ -7,7 +7,7 @@ from ipmc_asym.base.registry import fidelity_names, model_choices
 from ipmc_asym.base.units import fmt_length
 from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import add_strip_options, first_run_notice, strip_and_material, warn
-from ipmc_asym.dynamics.electrode import charge_report
+from ipmc_asym.forward.charge import charge_report
 
 
 def register(sub):

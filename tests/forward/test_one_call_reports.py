@@ -10,7 +10,7 @@ import numpy as np
 
 from ipmc_asym.base.jsonio import dumps
 from ipmc_asym.cli import main
-from ipmc_asym.dynamics.electrode import charge_report
+from ipmc_asym.forward.charge import charge_report
 from ipmc_asym.forward.estimate import estimate_document, estimate_report, model_list
 from ipmc_asym.model.params import NAFION_LI, Strip
 from ipmc_asym.model.spread import spread_of
