@@ -43,6 +43,7 @@ _LAZY = {
     # charge and dynamics (charge, step, drive, freq): the dynamic entry (Drive, time_response,
     # spectrum) makes the choice the commands make; the functions behind it stay public
     "charge": ("ipmc_asym.integral.charge", "charge"),
+    "sense": ("ipmc_asym.forward.sensing", "sense"),
     "Drive": ("ipmc_asym.dynamics.entry", "Drive"),
     "time_response": ("ipmc_asym.dynamics.entry", "time_response"),
     "spectrum": ("ipmc_asym.dynamics.entry", "spectrum"),
@@ -69,6 +70,7 @@ _LAZY = {
     "BeamResult": ("ipmc_asym.beam.statics", "BeamResult"),
     "ForwardResult": ("ipmc_asym.forward.model", "ForwardResult"),
     "ChargeResult": ("ipmc_asym.integral.charge", "ChargeResult"),
+    "SenseResult": ("ipmc_asym.forward.sensing", "SenseResult"),
     "TimeResponse": ("ipmc_asym.dynamics.entry", "TimeResponse"),
     "StepResult": ("ipmc_asym.dynamics.circuit", "StepResult"),
     "FrequencyResult": ("ipmc_asym.dynamics.circuit", "FrequencyResult"),

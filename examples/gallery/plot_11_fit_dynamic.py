@@ -39,7 +39,7 @@ for name, unit in (("diffusion", "m^2/s"), ("c_moy", "mol/m^3")):
 
 # %%
 # Data and fitted model: the step's current and tip deflection (the fit's ``deflection`` is
-# ``-w``, positive in the direction a positive voltage bends the strip), the spectrum's |Z| and
+# ``-w``, positive in the direction a positive voltage bends the strip), the spectrum's ``|Z|`` and
 # phase.  ``res.data`` and ``res.predictions`` hold one entry per file, in SI units.
 step, spec = res.data
 p_step, p_spec = res.predictions

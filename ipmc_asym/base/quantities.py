@@ -128,6 +128,14 @@ QUANTITIES = (
     Quantity("footprint", "m^2", "footprint L 2l of the strip"),
     Quantity("diffusion", "m^2/s", "cation diffusion coefficient D"),
     Quantity("viscous_modulus", "Pa s", "viscous modulus of the strip (Kelvin-Voigt damping)"),
+    # sensing (derivations/sensing.py)
+    Quantity("curvature", "1/m", "imposed curvature kappa = w'' at the clamp (eps_xx = -kappa z)"),
+    Quantity("tip_displacement", "m", "imposed tip displacement w (small displacement)"),
+    Quantity("V_oc", "V", "open-circuit voltage phi(-e) - phi(e) of the relaxed bent strip"),
+    Quantity("error_V_oc", "1", "relative error estimate of V_oc"),
+    Quantity("Q_per_w", "C/m", "short-circuit charge per tip displacement Q/w"),
+    Quantity("strain_parameter", "1", "b = (1 - 2 nu) kappa e/phi4 at the clamp: fixed-charge change at a face"),
+    Quantity("nu", "1", "drained Poisson ratio of the membrane (assumption: no source read)"),
 )
 
 #: every name (result-row name and scene name) -> its quantity

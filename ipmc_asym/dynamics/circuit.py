@@ -747,7 +747,7 @@ class FrequencyResult(ResultMixin):
     Z : ndarray complex (n,)  impedance of the strip (electrode area 2l L), Ohm
     Z_area : ndarray complex  impedance per unit area, Ohm m^2
     H_w : ndarray complex     tip deflection per volt (small displacements), m/V
-    w_amp, w_phase : ndarray  |H_w| (m/V), arg H_w (rad; w < 0 for phi0 > 0 gives phase pi at DC);
+    w_amp, w_phase : ndarray  ``|H_w|`` (m/V), ``arg H_w`` (rad; w < 0 for phi0 > 0 gives phase pi at DC);
                               H_w is the layers' (quasi-static) moment at the layer voltage V(sigma)
     tau : float ; method : str ; model : str ; notes : list
     H_w_profiles : ndarray complex or None   pnp-linear only: transfer of the full profile moment

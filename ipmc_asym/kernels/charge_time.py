@@ -22,7 +22,7 @@ __all__ = ["shat", "integrate_circuit", "integrate_line"]
 
 @jit
 def shat(A, rho, mid, X, Wt):
-    """Signed sigma_hat(A) and Cd_hat(|A|) at the thermal voltage A = F u/(R T)."""
+    """Signed ``sigma_hat(A)`` and ``Cd_hat(|A|)`` at the thermal voltage ``A = F u/(R T)``."""
     s, c, _ = charge_hat_point(abs(A), rho, mid, 0, X, Wt)
     return (s if A >= 0.0 else -s), c
 

@@ -55,6 +55,7 @@ BUILDERS = {
     "BeamResult": lambda: ia.solve_beam(np.array([1e-5, 1e-4, 1e-3]), 0.02, 1e-6, e=1e-4),
     "ForwardResult": _forward,
     "ChargeResult": lambda: ia.charge(np.array([100e-6, 200e-6]), np.array([0.5, 1.0])),
+    "SenseResult": lambda: ia.sense(ia.NOMINAL_STRIP, tip_displacement=np.array([-1e-3, 0.0, 1e-3])),
     "StepResult": lambda: ia.step_response(1.0, points=40),
     "FrequencyResult": lambda: ia.frequency_response(np.geomspace(0.1, 1e3, 9)),
     "LineResult": lambda: ia.line_response(np.geomspace(0.1, 1e3, 9), sheet_resistance=2.5),

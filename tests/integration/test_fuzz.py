@@ -120,6 +120,8 @@ CHEAP = {
     "sweep": {**STRIP, "--voltage": VOLTS, "--model": MODELS, "--fidelity": ["leading", "corrected"],
               "--max-rows": COUNTS, "--json": None, "--no-progress": None, "--spread": None},
     "materials": {"--json": None},
+    "sense": {**STRIP, "--model": MODELS, "--fidelity": ["leading", "exact"], "--support": ["free", "tip-force", "x"],
+              "--load": ["short", "open", "100"], "--nu": ["0", "0.3", "0.7"], "--json": None},
     "drive": {**STRIP, "--model": MODELS[:3], "--points": COUNTS, "--duration": TIMES,
               "--beam": ["quasi-static", "dynamic", "x"], "--json": None},
 }
@@ -140,6 +142,8 @@ def cheap_argv(draw):
         argv += ["--from", draw(values(FREQS)), "--to", draw(values(FREQS))]
     if cmd in ("step", "freq") and "--points" not in argv:
         argv += ["--points", "20"]
+    if cmd == "sense":
+        argv += ["--curvature", draw(values(["2/m", "0", "-5", "1e4", "2m", "3 m^-1"]))]
     if cmd == "materials" and draw(st.booleans()):
         argv.insert(1, draw(st.sampled_from(MATERIAL_NAMES)))
     if cmd == "drive":

@@ -1,0 +1,161 @@
+"""``ipmc-asym sense``: the strip as a sensor at rest -- charge and open-circuit voltage of an imposed bending."""
+
+from __future__ import annotations
+
+import csv
+
+from ipmc_asym.base.registry import fidelity_names, model_choices
+from ipmc_asym.base.units import fmt_length, parse_length, parse_quantity
+from ipmc_asym.cli import SUMMARIES
+from ipmc_asym.cli.common import (
+    add_output_option,
+    add_strip_options,
+    arg_type,
+    first_run_notice,
+    material_from_args,
+    strip_from_args,
+    tol_type,
+    warn,
+)
+from ipmc_asym.forward.estimate import model_list
+from ipmc_asym.forward.sensing import DEFAULT_NU, SENSE_LOADS, SENSE_SUPPORTS, sense
+from ipmc_asym.io.fileio import atomic_write
+from ipmc_asym.io.jsonio import dumps
+
+#: curvature units (1/m); a bare number is 1/m
+_CURVATURE = {"1/m": 1.0, "m^-1": 1.0, "/m": 1.0, "1/mm": 1e3, "mm^-1": 1e3, "/mm": 1e3, "1/cm": 1e2, "cm^-1": 1e2,
+              "/cm": 1e2}
+#: the per-point columns of --out, in order
+COLUMNS = ("curvature", "tip_displacement", "sigma", "Q", "V_oc", "Q_per_w", "error", "error_V_oc",
+           "strain_parameter", "max_strain", "check_strain", "check_beam_regime", "valid", "fidelity_used")
+
+
+def _curvature(text):
+    return parse_quantity("curvature", text, _CURVATURE, "curvature")
+
+
+def _tip(text):
+    return parse_length("tip displacement", text)
+
+
+def _load(text):
+    t = str(text).strip().lower()
+    if t not in SENSE_LOADS:
+        raise ValueError(f"--load must be one of {', '.join(SENSE_LOADS)} (a resistive load at DC after relaxation "
+                         f"carries no current and reads the open-circuit voltage: use open); got {text!r}")
+    return t
+
+
+def _nu(text):
+    try:
+        v = float(text)
+    except ValueError:
+        v = float("nan")
+    if not 0.0 <= v <= 0.5:
+        raise ValueError(f"--nu must be a drained Poisson ratio in [0, 0.5]; got {text!r}")
+    return v
+
+
+def register(sub):
+    p = sub.add_parser("sense", help=SUMMARIES["sense"])
+    add_strip_options(p, voltage=False, mechanics=True)
+    g = p.add_mutually_exclusive_group(required=True)
+    g.add_argument("--curvature", type=arg_type(_curvature, "curvature"),
+                   help="curvature at the clamp kappa = w'' (uniform for --support free), e.g. 2/m: 1/m, m^-1, 1/mm "
+                        "or a bare number in 1/m; its sign is the bending direction (+: toward the face z = +e)")
+    g.add_argument("--tip-displacement", type=arg_type(_tip, "tip-displacement"),
+                   help="imposed tip displacement w (small displacement), e.g. 1mm or -0.5mm")
+    p.add_argument("--support", default="free", choices=SENSE_SUPPORTS,
+                   help="free: an end moment, uniform curvature, w = kappa L^2/2; tip-force: a tip force on the "
+                        "cantilever, kappa(x) = kappa0 (1 - x/L), w = kappa0 L^2/3 (default free)")
+    p.add_argument("--load", type=arg_type(_load, "load"), default="short",
+                   help="short (the charge that flows between short-circuited electrodes) or open (the voltage); "
+                        "both are computed, this picks the one printed first. A resistive load at DC after "
+                        "relaxation carries no current: it reads the open-circuit voltage")
+    p.add_argument("--nu", type=arg_type(_nu, "nu"), default=DEFAULT_NU,
+                   help="drained Poisson ratio of the membrane (default 0, an assumption: the paper's section 3 "
+                        "kinematics; no measured value was read; the answers scale as 1 - 2 nu)")
+    p.add_argument("--model", default="all", choices=model_choices(), help="permittivity model (default all three)")
+    p.add_argument("--fidelity", default="leading", choices=fidelity_names(),
+                   help="rung to start from (default leading, the linear closed form); corrected and quadrature "
+                        "start at exact (the closed form is exact in the Debye length already); escalated until "
+                        "the error estimate meets --tol")
+    p.add_argument("--tol", type=tol_type, default=None, help="relative accuracy required, e.g. 1e-4 or 1%% "
+                   "(default settings.VALIDITY_LIMIT)")
+    p.add_argument("--pressure-term", action="store_true",
+                   help="keep the pressure term of the Nernst-Planck law (eq. (5)); linear order only")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    add_output_option(p, "--out", formats=(".csv", ".nc"), default=None, metavar="F.csv|F.nc",
+                      help="write the rows (one per model) to a CSV or NetCDF file (written atomically)")
+
+
+def run(args):
+    material = material_from_args(args)
+    strip = strip_from_args(args)
+    first_run_notice()
+    kw = {"curvature": args.curvature} if args.curvature is not None else {"tip_displacement": args.tip_displacement}
+    results = {m: sense(strip, support=args.support, load=args.load, model=m, fidelity=args.fidelity, tol=args.tol,
+                        nu=args.nu, material=material, pressure_term=args.pressure_term, **kw)
+               for m in model_list(args.model)}
+    rows = []
+    for m, r in results.items():
+        row = {"model": m}
+        for c in COLUMNS:
+            v = getattr(r, c)[0]
+            row[c] = str(v) if c == "fidelity_used" else (bool(v) if c in ("check_strain", "check_beam_regime", "valid") else float(v))
+        rows.append(row)
+    warnings = []
+    for m, r in results.items():
+        if not bool(r.check_strain[0]):
+            warnings.append(f"{m}: face strain {float(r.max_strain[0]):.3g} above the small-strain limit "
+                            f"{material.strain_limit:g} (Material.strain_limit); kept, flagged valid = false")
+        if not bool(r.check_beam_regime[0]):
+            warnings.append(f"{m}: |kappa0| L = {abs(float(r.curvature[0])) * strip.length:.3g} past a quarter turn: "
+                            "the small-displacement beam relating w and kappa does not hold; kept, flagged valid = false")
+        if bool(r.check_strain[0]) and bool(r.check_beam_regime[0]) and not bool(r.valid[0]):
+            warnings.append(f"{m}: {r.message}; kept, flagged valid = false")
+    for w in warnings:
+        warn(w)
+    notes = ["Q: charge of the electrode z = -e in short circuit (the other carries -Q), after relaxation; V_oc = "
+             "phi(-e) - phi(e) in open circuit; both are odd in the curvature",
+             f"drained Poisson ratio nu = {args.nu:g} (an assumption; the answers scale as 1 - 2 nu at linear order)",
+             "reciprocity: dQ/dw (tip force) / dF_block/dV = (1 - 2 nu)/(3 (1 + A3)) in the paper's model "
+             "(docs/sensing.md): its actuation and sensing do not derive from one free energy"]
+    inputs = {"length": strip.length, "width_total": strip.width, "thickness_total": strip.thickness,
+              "support": args.support, "load": args.load, "nu": args.nu, "c_moy": material.C_moy}
+    if args.out:
+        _write(args.out, results, rows)
+    if args.json:
+        print(dumps({"inputs": inputs, "results": rows, "notes": notes, "warnings": warnings}, indent=2))
+        return 0
+    r0 = next(iter(results.values()))
+    print(f"IPMC strip as a sensor: L = {fmt_length(strip.length)}, total width 2l = {fmt_length(strip.width)}, "
+          f"total thickness 2e = {fmt_length(strip.thickness)}, support {args.support}, "
+          f"kappa0 = {float(r0.curvature[0]):.6g} 1/m, w = {float(r0.tip_displacement[0]):.6g} m")
+    first, second = (("Q", "C"), ("V_oc", "V")) if args.load == "short" else (("V_oc", "V"), ("Q", "C"))
+    print(f"{'model':9s} {'fidelity':9s} {first[0] + ' [' + first[1] + ']':>14s} {second[0] + ' [' + second[1] + ']':>14s}"
+          f" {'Q/w [C/m]':>12s} {'rel.err':>8s}")
+    for row in rows:
+        err = max(row["error"], row["error_V_oc"])
+        print(f"{row['model']:9s} {row['fidelity_used']:9s} {row[first[0]]:14.6g} {row[second[0]]:14.6g} "
+              f"{row['Q_per_w']:12.5g} {err:8.1e}" + ("" if row["valid"] else "  not valid (see warning)"))
+    for n in notes:
+        print("note: " + n)
+    return 0
+
+
+def _write(path, results, rows):
+    if str(path).lower().endswith(".nc"):
+        import xarray as xr  # deferred: xarray is heavy (start-up)
+
+        from ipmc_asym.io.datasets import write_netcdf  # deferred: loads xarray (start-up)
+
+        ds = xr.concat([r.to_xarray() for r in results.values()], dim="model")
+        ds = ds.assign_coords(model=list(results))
+        write_netcdf(ds, path)
+        return
+    with atomic_write(path, newline="") as fh:
+        wr = csv.writer(fh)
+        wr.writerow(("model",) + COLUMNS)
+        for row in rows:
+            wr.writerow([row["model"]] + [repr(row[c]) if isinstance(row[c], float) else row[c] for c in COLUMNS])

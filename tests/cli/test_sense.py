@@ -1,0 +1,98 @@
+"""``sense``: the rows of the library, units of the curvature, the load choices, refusals in one
+line with exit 2, and the CSV/NetCDF outputs written whole."""
+
+from __future__ import annotations
+
+import csv
+import json
+
+import pytest
+
+import ipmc_asym as ia
+from ipmc_asym.cli import main
+
+
+def _run(capsys, *argv):
+    try:
+        rc = main(["sense", *argv])
+    except SystemExit as exc:  # argparse's own refusals (cli.common.Parser: one line, status 2)
+        rc = exc.code
+    cap = capsys.readouterr()
+    return rc, cap.out, cap.err
+
+
+def test_json_rows_are_the_library(capsys):
+    rc, out, err = _run(capsys, "--tip-displacement", "1mm", "--support", "tip-force", "--model", "linear", "--json")
+    assert rc == 0 and err == ""
+    row = json.loads(out)["results"][0]
+    r = ia.sense(ia.NOMINAL_STRIP, tip_displacement=1e-3, support="tip-force", model="linear")
+    assert row["Q"] == float(r.Q[0]) and row["V_oc"] == float(r.V_oc[0]) and row["valid"] is True
+    assert row["curvature"] == pytest.approx(3e-3 / 0.02**2)
+
+
+@pytest.mark.parametrize("text", ["2", "2/m", "2 /m", "2m^-1", "0.002/mm", "0.02cm^-1"])
+def test_curvature_units(capsys, text):
+    rc, out, _ = _run(capsys, "--curvature", text, "--model", "constant", "--json")
+    assert rc == 0
+    assert json.loads(out)["results"][0]["curvature"] == pytest.approx(2.0)
+
+
+def test_negative_curvature_is_the_mirror(capsys):
+    _, out_p, _ = _run(capsys, "--curvature", "2", "--model", "affine", "--json")
+    _, out_m, _ = _run(capsys, "--curvature", "-2", "--model", "affine", "--json")
+    p, m = json.loads(out_p)["results"][0], json.loads(out_m)["results"][0]
+    assert m["Q"] == -p["Q"] and m["V_oc"] == -p["V_oc"]
+
+
+@pytest.mark.parametrize("argv,needle", [
+    (["--curvature", "2m"], "curvature: unknown unit 'm'"),
+    (["--curvature", "2", "--load", "100ohm"], "--load must be one of short, open"),
+    (["--curvature", "2", "--nu", "0.6"], "--nu must be a drained Poisson ratio in [0, 0.5]"),
+    (["--curvature", "1e4"], "curvature: (1 - 2 nu) |kappa| e/phi4"),
+    (["--tip-displacement", "1mm", "--support", "pinned"], "argument --support: invalid choice"),
+    (["--curvature", "2", "--tip-displacement", "1mm"], "not allowed with argument"),
+    ([], "one of the arguments --curvature --tip-displacement is required"),
+    (["--curvature", "2", "--out", "x.xlsx"], "allowed: .csv, .nc"),
+])
+def test_refusals_one_line_exit_2(capsys, argv, needle):
+    rc, out, err = _run(capsys, *argv)
+    assert rc == 2 and out == ""
+    assert len(err.strip().splitlines()) == 1 and needle in err, err
+
+
+def test_past_the_limits_is_kept_and_flagged(capsys):
+    rc, out, err = _run(capsys, "--curvature", "300", "--model", "linear", "--json")
+    assert rc == 0
+    row = json.loads(out)["results"][0]
+    assert row["check_strain"] is False and row["check_beam_regime"] is False and row["valid"] is False
+    assert "small-strain limit" in err and "quarter turn" in err
+
+
+def test_open_load_leads_with_the_voltage(capsys):
+    rc, out, _ = _run(capsys, "--curvature", "2", "--load", "open", "--model", "constant")
+    assert rc == 0
+    head = next(line for line in out.splitlines() if line.startswith("model"))
+    assert head.index("V_oc") < head.index("Q [C]")
+
+
+def test_csv_and_netcdf_outputs(capsys, tmp_path):
+    f = tmp_path / "s.csv"
+    rc, _, _ = _run(capsys, "--tip-displacement", "0.5mm", "--out", str(f))
+    assert rc == 0
+    with f.open() as fh:
+        rows = list(csv.DictReader(fh))
+    assert [r["model"] for r in rows] == ["constant", "linear", "affine"]
+    r = ia.sense(ia.NOMINAL_STRIP, tip_displacement=0.5e-3, model="affine")
+    assert float(rows[2]["Q"]) == float(r.Q[0])
+    xr = pytest.importorskip("xarray")
+    g = tmp_path / "s.nc"
+    try:
+        rc, _, err = _run(capsys, "--tip-displacement", "0.5mm", "--out", str(g))
+    except ImportError:
+        pytest.skip("no NetCDF engine")
+    assert rc == 0, err
+    with xr.open_dataset(g) as ds:
+        assert list(ds["model"].values) == ["constant", "linear", "affine"]
+        assert float(ds["Q"].sel(model="affine")[0]) == float(r.Q[0])
+        assert ds["Q"].attrs["units"] == "C"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s.csv", "s.nc"]
