@@ -392,7 +392,8 @@ def strip_and_material(args):
     spec = _material_spec(args)
     strip = strip_from_args(args)
     material = material_from_spec(spec, labels=_MATERIAL_OPTIONS)
-    # said once both are built: a refused option has printed nothing
+    # said once both are built (a refused option has printed nothing), and written here rather
+    # than through warn()/print_citations(): this helper reads options and calls the model only
     for line in material_warnings(material):
         sys.stderr.write(f"ipmc-asym: warning: {line}\n")
     if getattr(args, "cite", False):
