@@ -63,6 +63,7 @@ _LAZY = {
     "validate": ("ipmc_asym.validation.validate", "claims"),
     "laws": ("ipmc_asym.studies.laws", "law_table"),
     "figures": ("ipmc_asym.plotting.figures", "make_all"),
+    "plot_speed_accuracy": ("ipmc_asym.plotting.speed", "plot_speed_accuracy"),
     # result types (each with a summary repr, .plot() and .to_xarray())
     "MomentResult": ("ipmc_asym.integral.api", "MomentResult"),
     "BVPResult": ("ipmc_asym.bvp.solver", "BVPResult"),

@@ -1,2 +1,2 @@
 """Foundation: the registry of models and fidelities, numerical settings, unit parsing and
-the progress helper. Pure Python; imports nothing else of the package."""
+the progress helper, strict JSON. Pure Python; imports nothing else of the package."""

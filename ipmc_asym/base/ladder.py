@@ -3,7 +3,7 @@
 Every escalation of the package goes through :func:`climb`: the moment integral
 (:func:`ipmc_asym.forward.escalation.moment_escalating`), its per-point ``C_moy`` form and its
 pressure-term form (:mod:`ipmc_asym.forward`), the electrode charge
-(:func:`ipmc_asym.dynamics.electrode.charge_escalated`) and the time-domain switch from the
+(:func:`ipmc_asym.integral.charge.charge_escalated`) and the time-domain switch from the
 reduced circuit to the PNP solver (:func:`ipmc_asym.dynamics.circuit.step_response`).  What a
 rung is and what makes it valid stays with the caller (``evaluate`` and ``checks``); the order,
 the bookkeeping of which points are left and the wording of the reasons live here.

@@ -23,15 +23,15 @@ from ipmc_asym.base.units import (
     parse_time,
     parse_voltage,
 )
-from ipmc_asym.integral.api import check_min_thickness
 from ipmc_asym.io.fileio import check_output_path
-from ipmc_asym.model.electrode import METALS, beam_label
+from ipmc_asym.model.electrode import METALS
 from ipmc_asym.model.limits import bare_number_warning, material_warnings, range_warning
-from ipmc_asym.model.params import Strip, material_from_spec, set_thickness
+from ipmc_asym.model.materials import bibliography, material_comments
+from ipmc_asym.model.params import Strip, check_min_thickness, material_from_spec, set_thickness
 
 __all__ = ["UsageError", "Parser", "add_strip_options", "add_material_options", "print_citations", "material_comments",
            "scene_with_material",
-           "material_from_args", "strip_from_args",
+           "material_from_args", "strip_from_args", "strip_and_material",
            "arg_type", "count_type", "join_negative_values", "fmt_num", "c_moy_label", "length_type", "pressure_type",
            "voltage_type", "tol_type", "first_run_notice", "diffusion_type", "sidecar_path", "add_size_option", "check_size_caps",
            "add_output_option", "check_outputs",
@@ -85,7 +85,7 @@ def _positive(name, parse, example, check=None):
 def _plausible_length(name):
     def check(text, v):
         if name == "thickness" and v < MIN_THICKNESS:
-            return  # refused by strip_from_args, the one floor every command shares
+            return  # refused by the Strip (its thickness floor), the one check every command shares
         line = bare_number_warning(name, text, v, f"--{name}") or range_warning(name, v, f"--{name}")
         if line:
             warn(line)
@@ -178,18 +178,21 @@ def check_size_caps(args):
                              f"lower {flag} or raise {cap}")
 
 
-def add_output_option(p, flag="--out", *, formats=None, kind="file", **kw):
+def add_output_option(p, flag="--out", *, formats=None, kind="file", sidecar=False, **kw):
     """An output option ``flag`` (a file whose format follows its extension, one of ``formats``, or
     a directory, ``kind="dir"``), checked by :func:`check_outputs` before any work.
 
     ``main`` calls :func:`check_outputs` right after parsing: a format the command cannot write
     (``--out d.xlsx`` of a CSV writer, ``--plot x.xlsx``), an empty path (``--out ''``), a
     missing or read-only directory is refused in one line before anything is computed, the same
-    way for every command (``io.fileio.check_output_path``).
+    way for every command (``io.fileio.check_output_path``).  ``sidecar``: the file's metadata
+    sidecar (:func:`sidecar_path`) is checked with it.
     """
     p.add_argument(flag, **kw)
     outs = p.get_default("_outputs") or ()
     p.set_defaults(_outputs=tuple(outs) + ((flag, kind, tuple(formats) if formats else None),))
+    if sidecar:
+        p.set_defaults(_sidecars=tuple(p.get_default("_sidecars") or ()) + (flag,))
 
 
 def check_outputs(args):
@@ -198,6 +201,10 @@ def check_outputs(args):
         v = getattr(args, _dest(flag), None)
         if v is not None:
             check_output_path(v, kind, flag, formats=formats)
+    for flag in getattr(args, "_sidecars", ()) or ():
+        v = getattr(args, _dest(flag), None)
+        if v:
+            check_output_path(sidecar_path(v), "file")
 
 
 def _seed(text):
@@ -353,22 +360,47 @@ def _strain_limit(text):
 
 def material_from_args(args):
     """The material of the options, through the library's one parser (params.material_from_spec)."""
-    spec = {"preset": getattr(args, "material", "nafion-li")}
-    if getattr(args, "modulus", None) is not None:
-        spec["E"] = args.modulus
-    if getattr(args, "c_moy", None) is not None:
-        spec["c_moy"] = args.c_moy
-    if getattr(args, "strain_limit", None) is not None:
-        spec["strain_limit"] = args.strain_limit
-    for k in ("electrode_thickness", "electrode_metal", "electrode_modulus", "electrode_density"):
-        if getattr(args, k, None) is not None:
-            spec[k] = getattr(args, k)
+    spec = _material_spec(args)
     material = material_from_spec(spec, labels=_MATERIAL_OPTIONS)
     for line in material_warnings(material):
         warn(line)
     if getattr(args, "cite", False):
         print_citations(material, json_mode=bool(getattr(args, "json", False)))
     return material
+
+
+def _material_spec(args) -> dict:
+    """The material options given, as a ``[material]`` table of :func:`params.material_from_spec`."""
+    spec = {"preset": getattr(args, "material", "nafion-li")}
+    for key, dest in (("E", "modulus"), ("c_moy", "c_moy"), ("strain_limit", "strain_limit"),
+                      ("electrode_thickness", "electrode_thickness"), ("electrode_metal", "electrode_metal"),
+                      ("electrode_modulus", "electrode_modulus"), ("electrode_density", "electrode_density")):
+        if getattr(args, dest, None) is not None:
+            spec[key] = getattr(args, dest)
+    return spec
+
+
+def strip_and_material(args):
+    """``(strip, material, thickness_note)`` of the strip and material options, built in one place.
+
+    The constructors check what they are given (the Strip its geometry and the thickness floor,
+    the material parser every key), so the layers below trust both.  The material set's typical
+    thickness stands in for a ``--thickness`` not given (``thickness_note`` says so; empty when
+    the option was given or the set states none).  Warnings on implausible material values go to
+    stderr and ``--cite`` prints the bibliography here, before any work, as every command did.
+    """
+    spec = _material_spec(args)
+    strip = strip_from_args(args)
+    material = material_from_spec(spec, labels=_MATERIAL_OPTIONS)
+    # said once both are built (a refused option has printed nothing), and written here rather
+    # than through warn()/print_citations(): this helper reads options and calls the model only
+    for line in material_warnings(material):
+        sys.stderr.write(f"ipmc-asym: warning: {line}\n")
+    if getattr(args, "cite", False):
+        (sys.stderr if getattr(args, "json", False) else sys.stdout).write(bibliography(material) + "\n")
+    if getattr(args, "diffusion", None) is not None:  # the dynamic commands' --diffusion over the set's D
+        material = material.with_(D=args.diffusion)
+    return strip, material, getattr(args, "thickness_note", "")
 
 
 def scene_with_material(path, args):
@@ -397,18 +429,8 @@ def electrode_spec(args) -> dict:
                                           "electrode_density") if getattr(args, k, None) is not None}
 
 
-def material_comments(material) -> list:
-    """Header comment lines of a result file: the material set, the beam when it carries electrode
-    layers (the bare membrane is the paper's beam) and the numbered sources."""
-    beam = [f"beam: {beam_label(material.electrode)}"] if material.electrode.present else []
-    return [f"material set: {material.name}"] + beam + [f"source [{i}]: {c}"
-                                                       for i, c in enumerate(material.sources, 1)]
-
-
 def print_citations(material, json_mode=False):
     """``--cite``: the bibliography of the run (to stderr when stdout carries JSON)."""
-    from ipmc_asym.model.materials import bibliography  # deferred: reads the material set files; only --cite needs it
-
     (sys.stderr if json_mode else sys.stdout).write(bibliography(material) + "\n")
 
 
@@ -432,8 +454,8 @@ def default_thickness(material_name):
 
 
 def strip_from_args(args):
-    """The strip of the options; a thickness below ``settings.MIN_THICKNESS`` is refused here, the
-    one check every command with strip options shares (integral.api.check_min_thickness)."""
+    """The strip of the options; a thickness below ``settings.MIN_THICKNESS`` is refused here, in
+    the option's words, before the Strip's own check."""
     if getattr(args, "thickness", None) is None:
         args.thickness, args.thickness_note = default_thickness(getattr(args, "material", None))
     check_min_thickness(args.thickness)
@@ -621,13 +643,14 @@ def add_support_options(p):
                         "the active moment acts there only, the beam outputs are small-displacement")
 
 
-def support_from_args(args, strip):
-    """``(support, electrode)`` checked against the strip and the other options (one-line ValueError)."""
+def support_from_args(args):
+    """``(support, electrode)`` checked against ``--length`` and the other options (one-line
+    ValueError), before the strip is built."""
     el = args.electrode
     if el is not None:
         x1, x2 = el
-        if not 0.0 <= x1 < x2 <= strip.length:
-            raise ValueError(f"--electrode X1:X2 must satisfy 0 <= X1 < X2 <= L = {fmt_length(strip.length)}; "
+        if not 0.0 <= x1 < x2 <= args.length:
+            raise ValueError(f"--electrode X1:X2 must satisfy 0 <= X1 < X2 <= L = {fmt_length(args.length)}; "
                              f"got {fmt_length(x1)}:{fmt_length(x2)}")
     if el is not None or args.support == "clamped-clamped":
         what = "--support clamped-clamped" if args.support == "clamped-clamped" else "--electrode"

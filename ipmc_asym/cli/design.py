@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from ipmc_asym.base.jsonio import dumps
 from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import (
     add_electrode_options,
@@ -13,7 +14,6 @@ from ipmc_asym.cli.common import (
 )
 from ipmc_asym.forward.model import CHECKS
 from ipmc_asym.io.fileio import FIGURE_FORMATS, check_output_path
-from ipmc_asym.io.jsonio import dumps
 from ipmc_asym.model.params import material_from_spec
 from ipmc_asym.studies.design import INPUTS, OUTPUTS, design, load_spec
 

@@ -7,6 +7,7 @@ import sys
 
 import numpy as np
 
+from ipmc_asym.base.jsonio import dumps
 from ipmc_asym.base.registry import model_names
 from ipmc_asym.base.units import fmt_length
 from ipmc_asym.cli import SUMMARIES
@@ -21,10 +22,9 @@ from ipmc_asym.cli.common import (  # noqa: F401  (CLAMPED_UNITS, viscous_modulu
     diffusion_type,
     duration_type,
     first_run_notice,
-    material_from_args,
     print_clamped,
     sidecar_path,
-    strip_from_args,
+    strip_and_material,
     support_from_args,
     viscous_modulus_type,
     waveform_type,
@@ -38,7 +38,6 @@ from ipmc_asym.dynamics.drive import (
 )
 from ipmc_asym.dynamics.entry import time_response
 from ipmc_asym.io.fileio import atomic_path, atomic_write, check_output_path
-from ipmc_asym.io.jsonio import dumps
 from ipmc_asym.io.textfmt import format_table
 
 #: --json holds every row in memory: at most this many (the CSV is streamed)
@@ -94,11 +93,8 @@ def run(args):
     if args.out:
         check_output_path(args.out, "file", formats=(".csv",))
         check_output_path(sidecar_path(args.out), "file")
-    material = material_from_args(args)
-    if args.diffusion is not None:
-        material = material.with_(D=args.diffusion)
-    strip = strip_from_args(args)
-    support, electrode = support_from_args(args, strip)
+    support, electrode = support_from_args(args)
+    strip, material, _ = strip_and_material(args)
     clamped = support == "clamped-clamped"
     # the rows stepped on the output grid and streamed (the dynamic beam too: the grid must resolve the
     # first mode), whatever --out or --json do with them

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from ipmc_asym.base.jsonio import dumps
 from ipmc_asym.base.registry import fidelity_names, model_choices
 from ipmc_asym.base.units import fmt_length
 from ipmc_asym.cli import SUMMARIES
@@ -10,15 +11,11 @@ from ipmc_asym.cli.common import (
     c_moy_label,
     first_run_notice,
     fmt_num,
-    material_from_args,
-    strip_from_args,
+    strip_and_material,
     tol_type,
 )
-from ipmc_asym.forward.estimate import SPREAD_NOTE, estimate_report, model_list
+from ipmc_asym.forward.estimate import SPREAD_NOTE, estimate_document
 from ipmc_asym.integral.api import interpret_small
-from ipmc_asym.io.jsonio import dumps
-from ipmc_asym.model.electrode import beam_label
-from ipmc_asym.model.params import bending_stiffness
 
 
 def register(sub):
@@ -56,35 +53,21 @@ LEGEND = (
 
 
 def run(args):
-    material = material_from_args(args)
-    strip = strip_from_args(args)
+    strip, material, note = strip_and_material(args)
     if args.compiled:
         if args.fidelity != "bvp":
             first_run_notice()
     else:
         interpret_small()
-    # the rows and the model-form spread from one checked request (forward.estimate.estimate_report)
-    rows, spread = estimate_report(strip, model_list(args.model), args.fidelity, material, args.tol,
-                                   escalate=not args.no_escalate, on_invalid="nan", pressure_term=args.pressure_term)
+    # the rows, the model-form spread and the inputs echoed, from one checked request
+    doc = estimate_document(strip, material, args.model, args.fidelity, args.tol, escalate=not args.no_escalate,
+                            pressure_term=args.pressure_term, thickness_note=note)
+    rows, spread, inputs = doc["results"], doc["model_spread"], doc["inputs"]
     for r in rows:
         if r["I"] is None:  # no rung valid: refuse the whole command, one line
             raise ValueError(r["warnings"][-1])
-    inputs = {
-        "length": strip.length, "width_total": strip.width, "thickness_total": strip.thickness,
-        "half_thickness_e": strip.e, "half_width_l": strip.l, "voltage": strip.voltage,
-        "modulus": material.E, "c_moy": material.C_moy, "c_moy_source": str(material.c_moy),
-        "I_p": strip.I_p, "material": material.name, "material_sources": list(material.sources),
-        "pressure_term": bool(args.pressure_term),
-        "beam": beam_label(material.electrode),
-        "electrode_thickness": material.electrode.thickness,
-        "electrode_modulus": material.electrode.modulus if material.electrode.present else None,
-        "bending_stiffness": float(bending_stiffness(material, strip.width, strip.thickness)),
-    }
-    note = getattr(args, "thickness_note", "")
-    if note:
-        inputs["thickness_source"] = note
     if args.json:
-        print(dumps({"inputs": inputs, "results": rows, "model_spread": spread}, indent=2))
+        print(dumps(doc, indent=2))
         return 0
     print(f"IPMC strip: L = {fmt_length(strip.length)}, total width 2l = {fmt_length(strip.width)}, "
           f"total thickness 2e = {fmt_length(strip.thickness)} (half thickness e = {fmt_length(strip.e)}), "
@@ -92,8 +75,7 @@ def run(args):
     print(f"material set {material.name} ({len(material.sources)} sources: --cite, ipmc-asym materials)")
     if note:
         print(note)
-    print(f"beam: {beam_label(material.electrode)}, EI = "
-          f"{float(bending_stiffness(material, strip.width, strip.thickness)):.4g} N m^2")
+    print(f"beam: {inputs['beam']}, EI = {inputs['bending_stiffness']:.4g} N m^2")
     hdr = (f"{'model':9s} {'fidelity':10s} {'I':>11s} {'M_A [N m]':>11s} {'theta [rad]':>11s} "
            f"{'w [mm]':>9s} {'w_small[mm]':>11s} {'F_block[mN]':>11s} {'F_small[mN]':>11s} {'rel.err':>8s} regime")
     print(hdr)

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import sys
 
+from ipmc_asym.base.jsonio import dumps
 from ipmc_asym.base.registry import fidelity_names, model_names
 from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import (
@@ -16,21 +17,19 @@ from ipmc_asym.cli.common import (
     diffusion_type,
     first_run_notice,
     fmt_num,
-    material_from_args,
     model_help,
     seed_type,
     sheet_resistance_type,
-    strip_from_args,
+    strip_and_material,
     viscous_modulus_type,
     waveform_type,
 )
 from ipmc_asym.dynamics.circuit import BEAM_CHOICES
-from ipmc_asym.io.fileio import FIGURE_FORMATS, check_output_path
-from ipmc_asym.io.jsonio import dumps
+from ipmc_asym.io.fileio import FIGURE_FORMATS
 from ipmc_asym.model.electrode import beam_label
 from ipmc_asym.parallel.executors import check_scheduler
-from ipmc_asym.studies.calibrate import FREE_ALIASES, FREE_PARAMETERS, MAX_DATA_ROWS, CalibrationData, fit, parse_free
-from ipmc_asym.studies.calibrate_dynamic import TIME_FIDELITIES, fit_dynamic, read_file
+from ipmc_asym.studies.calibrate import FREE_ALIASES, FREE_PARAMETERS, MAX_DATA_ROWS, CalibrationData, parse_free
+from ipmc_asym.studies.calibrate_dynamic import TIME_FIDELITIES, fit, read_file
 
 #: data files of one fit (each read into memory, at most --max-rows rows)
 MAX_FILES = 100
@@ -95,20 +94,16 @@ def register(sub):
 
 
 def run(args) -> int:
-    # every option checked before any work (the fit of a long file takes seconds to minutes)
-    if args.plot:
-        check_output_path(args.plot, "file", "--plot", formats=FIGURE_FORMATS)
+    # every option checked before any work (the fit of a long file takes seconds to minutes);
+    # --plot with every output (add_output_option)
+    parse_free(args.free)
     if args.scheduler is not None:
         check_scheduler(args.scheduler)
-    parse_free(args.free)
     if len(args.data) > MAX_FILES:
         raise ValueError(f"DATA.csv: {len(args.data)} files; at most {MAX_FILES}")
-    material = material_from_args(args)
-    if args.diffusion is not None:
-        material = material.with_(D=args.diffusion)
+    strip, material, _ = strip_and_material(args)
     if args.sheet_resistance is not None:
         material = material.with_(sheet_resistance=args.sheet_resistance)
-    strip = strip_from_args(args)
     files = [read_file(d, strip, waveform=args.waveform, max_rows=args.max_rows) for d in args.data]
     first_run_notice("fit")
     static_only = len(files) == 1 and isinstance(files[0], CalibrationData)
@@ -117,15 +112,11 @@ def run(args) -> int:
             if val is not None:
                 raise ValueError(f"{opt}: only for time series (a file with a t column); {files[0].source} holds "
                                  f"static rows")
-        data = files[0]
-        res = fit(data, args.free, model=args.model, material=material, fidelity=args.fidelity,
-                  multistart=args.multistart, seed=args.seed, scheduler=args.scheduler,
-                  progress=False if args.no_progress else None)
-    else:
-        res = fit_dynamic(files, args.free, model=args.model, material=material, strip=strip, beam=args.beam,
-                          viscous_modulus=args.viscous_modulus, fidelity=args.fidelity,
-                          time_fidelity=args.time_fidelity, multistart=args.multistart, seed=args.seed,
-                          scheduler=args.scheduler, progress=False if args.no_progress else None)
+    # the library's one entry chooses the static or the joint dynamic fit from the data
+    res = fit(files, args.free, model=args.model, material=material, fidelity=args.fidelity,
+              multistart=args.multistart, seed=args.seed, scheduler=args.scheduler,
+              progress=False if args.no_progress else None, strip=strip, beam=args.beam,
+              viscous_modulus=args.viscous_modulus, time_fidelity=args.time_fidelity)
     source = ", ".join(d.source for d in files)
     if args.plot:
         from ipmc_asym.plotting.calibrate import plot_fit, plot_fit_dynamic  # deferred: matplotlib (start-up)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ipmc_asym.base.jsonio import dumps
 from ipmc_asym.base.registry import model_names
 from ipmc_asym.base.units import fmt_length
 from ipmc_asym.beam.dynamics import CLAMPED_OUTPUTS
@@ -21,19 +22,17 @@ from ipmc_asym.cli.common import (
     first_run_notice,
     fmt_num,
     frequency_type,
-    material_from_args,
     model_help,
     print_clamped,
     sheet_resistance_type,
-    strip_from_args,
+    strip_and_material,
     support_from_args,
     voltage_type,
 )
 from ipmc_asym.dynamics.circuit import FREQ_METHODS
 from ipmc_asym.dynamics.entry import spectrum
 from ipmc_asym.dynamics.reduction import transfer_function
-from ipmc_asym.io.fileio import atomic_write, check_output_path
-from ipmc_asym.io.jsonio import dumps
+from ipmc_asym.io.fileio import atomic_write
 
 #: frequencies of one run (log-spaced: 1e5 points resolve any spectrum; the --json text stays ~10 MB);
 #: settable with --max-points
@@ -80,15 +79,9 @@ def _tol_type(text):
 def run(args):
     if args.f2 <= args.f1:
         raise ValueError(f"--to must be above --from; got {args.f1:g} Hz .. {args.f2:g} Hz")
-    if args.export is not None:
-        if not str(args.export).endswith(".json"):
-            raise ValueError(f"--export {args.export!r}: the format is JSON; give a path ending in .json")
-        check_output_path(args.export, what="--export")
-    material = material_from_args(args)
-    if args.diffusion is not None:
-        material = material.with_(D=args.diffusion)
-    strip = strip_from_args(args)
-    support, electrode = support_from_args(args, strip)
+    # --export: its path and format checked before any work with every output (add_output_option)
+    support, electrode = support_from_args(args)
+    strip, material, _ = strip_and_material(args)
     clamped = support == "clamped-clamped"
     if args.export is not None and (clamped or electrode is not None):
         raise ValueError("--export models the full-electrode strip (free tip): not with --support clamped-clamped or "

@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
+from ipmc_asym.base.jsonio import dumps
 from ipmc_asym.base.registry import model_choices, model_names
 from ipmc_asym.cli import SUMMARIES
-from ipmc_asym.io.jsonio import dumps
 from ipmc_asym.studies.laws import HOLD_TOL, factor_three, law_ranges, law_table
 
 

@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
+from ipmc_asym.base.jsonio import dumps
 from ipmc_asym.cli import SUMMARIES
-from ipmc_asym.io.jsonio import dumps
 from ipmc_asym.model import materials
 
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from ipmc_asym.base.jsonio import dumps
 from ipmc_asym.base.registry import model_choices, model_names
 from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import (
@@ -13,7 +14,6 @@ from ipmc_asym.cli.common import (
     strip_from_args,
 )
 from ipmc_asym.io.fileio import check_output_path, make_output_dir
-from ipmc_asym.io.jsonio import dumps
 from ipmc_asym.studies.profiles import PAPER_LAYERS, compute_all, profile_summary
 
 

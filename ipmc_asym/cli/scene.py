@@ -4,11 +4,11 @@ from __future__ import annotations
 
 import sys
 
+from ipmc_asym.base.jsonio import dumps
 from ipmc_asym.base.units import fmt_length
 from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import add_material_options, fmt_num, scene_with_material
 from ipmc_asym.forward.model import FLAGS
-from ipmc_asym.io.jsonio import dumps
 from ipmc_asym.studies.scenes import run_scene
 
 #: scene output -> the forward model's output name (which model assumptions concern it: FLAGS)

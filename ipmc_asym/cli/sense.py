@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 
+from ipmc_asym.base.jsonio import dumps
 from ipmc_asym.base.registry import fidelity_names, model_choices
 from ipmc_asym.base.units import fmt_length, parse_length, parse_quantity
 from ipmc_asym.cli import SUMMARIES
@@ -12,15 +13,13 @@ from ipmc_asym.cli.common import (
     add_strip_options,
     arg_type,
     first_run_notice,
-    material_from_args,
-    strip_from_args,
+    strip_and_material,
     tol_type,
     warn,
 )
 from ipmc_asym.forward.estimate import model_list
 from ipmc_asym.forward.sensing import DEFAULT_NU, SENSE_LOADS, SENSE_SUPPORTS, sense
 from ipmc_asym.io.fileio import atomic_write
-from ipmc_asym.io.jsonio import dumps
 
 #: curvature units (1/m); a bare number is 1/m
 _CURVATURE = {"1/m": 1.0, "m^-1": 1.0, "/m": 1.0, "1/mm": 1e3, "mm^-1": 1e3, "/mm": 1e3, "1/cm": 1e2, "cm^-1": 1e2,
@@ -90,8 +89,7 @@ def register(sub):
 
 
 def run(args):
-    material = material_from_args(args)
-    strip = strip_from_args(args)
+    strip, material, _ = strip_and_material(args)
     first_run_notice()
     kw = {"curvature": args.curvature} if args.curvature is not None else {"tip_displacement": args.tip_displacement}
     results = {m: sense(strip, support=args.support, load=args.load, model=m, fidelity=args.fidelity, tol=args.tol,

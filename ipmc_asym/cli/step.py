@@ -9,6 +9,7 @@ import sys
 
 import numpy as np
 
+from ipmc_asym.base.jsonio import dumps
 from ipmc_asym.base.registry import model_names
 from ipmc_asym.base.units import fmt_length
 from ipmc_asym.cli import SUMMARIES
@@ -23,10 +24,9 @@ from ipmc_asym.cli.common import (
     duration_type,
     first_run_notice,
     fmt_num,
-    material_from_args,
     model_help,
     sidecar_path,
-    strip_from_args,
+    strip_and_material,
     tol_type,
     waveform_type,
 )
@@ -37,8 +37,7 @@ from ipmc_asym.dynamics.drive import (
 )
 from ipmc_asym.dynamics.entry import time_path, time_response
 from ipmc_asym.forward.model import CHECKS
-from ipmc_asym.io.fileio import atomic_write, check_output_path
-from ipmc_asym.io.jsonio import dumps
+from ipmc_asym.io.fileio import atomic_write
 
 COLUMNS = ("t", "phi0", "sigma", "current_density", "M_A", "theta", "w")
 #: output times of one run: the arrays of the integrator (~2 substeps per interval) and of the
@@ -169,7 +168,7 @@ def register(sub):
                         "(see ipmc-asym drive --help)")
     add_beam_options(p)
     add_line_options(p)
-    add_output_option(p, "--out", formats=(".csv",), default=None, metavar="F.csv",
+    add_output_option(p, "--out", formats=(".csv",), sidecar=True, default=None, metavar="F.csv",
                    help="CSV file (header row t, phi0, sigma, current_density, M_A, theta, w, check_* and valid per "
                         "time point; SI; a first column model with --model all), with the metadata (tau, total "
                         "thickness, model, units) in the sidecar F.csv.json")
@@ -180,13 +179,7 @@ def run(args):
     if args.fidelity == "pnp" and args.max_points == MAX_POINTS and args.points > MAX_POINTS_PNP:
         raise ValueError(f"--points {args.points:g} with --fidelity pnp is above {MAX_POINTS_PNP:g} (the pnp solver keeps "
                          f"every output time's profiles: ~10 kB each); lower --points or set --max-points")
-    if args.out:
-        check_output_path(args.out, "file", formats=(".csv",))
-        check_output_path(sidecar_path(args.out), "file")
-    material = material_from_args(args)
-    if args.diffusion is not None:
-        material = material.with_(D=args.diffusion)
-    strip = strip_from_args(args)
+    strip, material, _ = strip_and_material(args)
     models = list(model_names()) if args.model == "all" else [args.model]
     stream = bool(args.out) and not args.json
     # the choice's refusals first (a refused command compiles nothing), then the first-run notice

@@ -10,6 +10,7 @@ import warnings
 
 import numpy as np
 
+from ipmc_asym.base.jsonio import dumps
 from ipmc_asym.base.progress import progress
 from ipmc_asym.base.registry import fidelity_names, model_choices, model_names
 from ipmc_asym.base.settings import MAX_ROWS
@@ -20,20 +21,18 @@ from ipmc_asym.cli.common import (
     add_strip_options,
     count_type,
     first_run_notice,
-    material_comments,
-    material_from_args,
     model_help,
-    strip_from_args,
+    strip_and_material,
     tol_type,
 )
 from ipmc_asym.forward.model import ASSUMPTION_CHECKS, ASSUMPTION_LIMITS
 from ipmc_asym.io.datasets import sweep_dataset, write_netcdf
-from ipmc_asym.io.fileio import atomic_write, check_output_path
-from ipmc_asym.io.jsonio import dumps
+from ipmc_asym.io.fileio import atomic_write
+from ipmc_asym.model.materials import material_comments
 from ipmc_asym.parallel.executors import check_scheduler
-from ipmc_asym.studies.fits import sweep_fits
+from ipmc_asym.studies.fits import axis_fits
 from ipmc_asym.studies.sweep_chunks import sweep_chunked
-from ipmc_asym.studies.sweeps import DTYPE, SPREAD_DTYPE, iter_sweep, prefetched, sweep, warm_writer, withhold, write_csv, write_json
+from ipmc_asym.studies.sweeps import DTYPE, SPREAD_DTYPE, iter_sweep, prefetched, warm_writer, withhold, write_csv, write_json
 
 #: extensions of --out (the format follows the extension)
 OUT_FORMATS = (".csv", ".json", ".nc")
@@ -42,8 +41,6 @@ OUT_FORMATS = (".csv", ".json", ".nc")
 #: tests/cli/test_sweep_memory.py), so under 1 GB; a CSV or JSON --out is streamed (no cap but
 #: --max-rows)
 MAX_MEMORY_ROWS = 10**6
-#: points per axis used for the fits (a subsample of a longer axis fits the same law)
-FIT_POINTS = 2000
 
 
 def register(sub):
@@ -85,32 +82,6 @@ def register(sub):
 FORMAT_WORKERS = 2
 
 
-def _fits(vary, args, base, mat):
-    """Power-law fits along each swept axis (through the middle of the other axes)."""
-    fits, notes = [], []
-    for var, vals in vary.items():
-        if vals.size < 2:
-            notes.append(f"no fit along {var}: only {vals.size} value")
-            continue
-        if np.any(vals <= 0):
-            notes.append(f"no fit along {var}: a power law needs values > 0 (got {vals.min():g})")
-            continue
-        sub = vals if vals.size <= FIT_POINTS else vals[np.linspace(0, vals.size - 1, FIT_POINTS).astype(int)]
-        others = {k: v for k, v in vary.items() if k != var}
-        mid = {k: float(v[v.size // 2]) for k, v in others.items()}
-        strip = base.with_(**{k: x for k, x in mid.items() if k != "modulus"})
-        m = mat.with_(E=mid["modulus"]) if "modulus" in mid else mat
-        arr = sweep({var: sub}, args.model, args.fidelity, strip, m, args.tol, progress=False,
-                    escalate=not args.no_escalate)
-        for f in sweep_fits(withhold(arr), [var]):
-            if others:
-                f["through"] = mid
-            if len(sub) < vals.size:
-                f["subsample"] = len(sub)
-            fits.append(f)
-    return fits, notes
-
-
 def _fit_line(f) -> str:
     var = "total thickness 2e" if f["variable"] == "thickness" else f["variable"]
     head = f"fit [{f['model']}] |{f['quantity']}| vs {var}"
@@ -147,14 +118,12 @@ def run(args) -> int:
         raise ValueError("--spread: written to CSV or JSON only (stdout or --out F.csv / F.json), "
                          "not with --out F.nc or --scheduler")
     vary = {k: vary_values(*sp[1:]) for k, sp in specs.items()}
-    if args.out:
-        check_output_path(args.out, "file", formats=OUT_FORMATS)
+    # --out: its path and format checked before any work with every output (add_output_option)
     if args.scheduler is not None:
         check_scheduler(args.scheduler)
     first_run_notice()
 
-    base = strip_from_args(args)
-    mat = material_from_args(args)
+    base, mat, _ = strip_and_material(args)
     t0 = time.perf_counter()
     failures: list = []
     outside = dict.fromkeys(ASSUMPTION_CHECKS, 0)
@@ -192,7 +161,7 @@ def run(args) -> int:
             # producer thread is computing chunks, two parallel kernels at once
             @functools.cache
             def fits_and_notes():
-                return _fits(vary, args, base, mat)
+                return axis_fits(vary, args.model, args.fidelity, base, mat, args.tol, escalate=not args.no_escalate)
 
             def tail():
                 fits, notes = fits_and_notes()

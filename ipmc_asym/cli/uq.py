@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import sys
 
+from ipmc_asym.base.jsonio import dumps
 from ipmc_asym.base.registry import compiled_fidelities
 from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import (
@@ -19,7 +20,6 @@ from ipmc_asym.cli.common import (
 )
 from ipmc_asym.io.datasets import uq_dataset, write_netcdf
 from ipmc_asym.io.fileio import FIGURE_FORMATS, check_output_path
-from ipmc_asym.io.jsonio import dumps
 from ipmc_asym.model.electrode import beam_label
 from ipmc_asym.parallel.executors import check_scheduler
 from ipmc_asym.studies.uq import SOBOL_BATCHES, STORE_SAMPLES, run_uq

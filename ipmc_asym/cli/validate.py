@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
+from ipmc_asym.base.jsonio import dumps
 from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import add_output_option
 from ipmc_asym.io.fileio import atomic_write, check_output_path
-from ipmc_asym.io.jsonio import dumps
 from ipmc_asym.validation.validate import claims, tally_text, to_markdown
 
 

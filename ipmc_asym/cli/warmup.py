@@ -93,7 +93,7 @@ def run(args):
         took[label] = time.perf_counter() - t0
     _touch(os.path.join(CACHE_DIR, WARM_MARKER))
     if args.json:
-        from ipmc_asym.io.jsonio import dumps  # deferred: heavy module, start-up
+        from ipmc_asym.base.jsonio import dumps  # deferred: heavy module, start-up
 
         print(dumps({"cache_dir": CACHE_DIR, "seconds": took}, indent=1))
         return 0

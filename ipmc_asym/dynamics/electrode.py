@@ -3,7 +3,8 @@
 The charge itself is evaluated by :mod:`ipmc_asym.integral.charge` (the integral layer, over
 the compiled drivers of :mod:`ipmc_asym.kernels.charge`; re-exported here):
 :func:`charge` at one rung, :func:`charge_escalated` at the cheapest valid rung (the ladder of
-:func:`ipmc_asym.base.ladder.climb`).  Here: the inverse ``V(sigma)`` (:func:`layer_voltage`),
+:func:`ipmc_asym.base.ladder.climb`); the report of ``ipmc-asym charge`` is
+:func:`ipmc_asym.forward.charge.charge_report` (re-exported here).  Here: the inverse ``V(sigma)`` (:func:`layer_voltage`),
 the core resistance and the linear time constant ``tau = R C_d(0)``.  Thickness is the TOTAL
 ``2e``; SI throughout.
 """
@@ -12,17 +13,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from ipmc_asym.base.ladder import climb, rungs_from
-from ipmc_asym.base.registry import fidelity_names
-from ipmc_asym.integral.api import check_fidelity
+from ipmc_asym.forward.charge import CHARGE_NOTE, charge_report
 from ipmc_asym.integral.charge import (
-    SUBNORMAL,
     ChargeResult,
-    accurate,
     capacitance_scale,
     charge,
-    charge_at,
-    charge_inputs,
+    charge_escalated,
     charge_scale,
 )
 from ipmc_asym.kernels.charge import CLOSED_TRUNCATION, charge_hat_point
@@ -32,36 +28,7 @@ from ipmc_asym.model.permittivity import get_model
 
 __all__ = ["ChargeResult", "charge", "layer_voltage", "core_resistance", "time_constant", "charge_scale",
            "capacitance_scale", "charge_hat_point",
-           "charge_escalated", "CLOSED_TRUNCATION"]
-
-
-def charge_escalated(thickness: float, voltage: float, model="constant", fidelity="corrected", **kw) -> ChargeResult:
-    """:func:`charge` of one point at the cheapest VALID rung from ``fidelity`` up the registry's ladder.
-
-    Same arguments as :func:`charge` (scalars); the result's ``fidelity`` names the rung used.
-    A rung is climbed for accuracy only: beyond the validated voltage the result is kept with
-    ``check_voltage = valid = False``; where ``sigma`` or ``Q`` is subnormal (``|phi0|`` below
-    ~1e-300 V) no rung helps, and the first rung's result is returned with its rounding in
-    ``error`` (``valid = False`` once that passes ``VALIDITY_LIMIT``).  Raises ``ValueError``
-    (one line) where no rung from ``fidelity`` up is accurate otherwise.
-    """
-    check_fidelity(fidelity)
-    args = charge_inputs(thickness, voltage, model, **kw)  # checked once; every rung trusts them
-
-    def checks(f, r, idx):
-        if bool(accurate(r.error, r.error_C_diff)):
-            return True, ""
-        if float(voltage) != 0.0 and min(abs(float(r.sigma)), abs(float(r.Q))) < SUBNORMAL:
-            # no rung helps: the value itself is below the normal range of a double; its
-            # rounding is the stated error (sigma -> C_d(0) phi0 down to the subnormals)
-            return True, ""
-        return False, f"error estimates {float(r.error):.2g} / {float(r.error_C_diff):.2g}"
-
-    lad = climb(rungs_from(fidelity_names(), fidelity), lambda f, idx: charge_at(*args, f), checks)
-    if lad.left.size:
-        raise ValueError(lad.message(f"thickness (total 2e) {float(thickness):.3g} m, voltage {float(voltage):.3g} V "
-                                     f"(model {args[2].name})"))
-    return lad.last.result
+           "charge_escalated", "charge_report", "CHARGE_NOTE", "CLOSED_TRUNCATION"]
 
 
 def layer_voltage(sigma, model="constant", material: Material | None = None):

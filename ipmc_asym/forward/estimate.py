@@ -21,12 +21,24 @@ import numpy as np
 from ipmc_asym.base.registry import check_choice
 from ipmc_asym.forward.escalation import Escalated, check_tol, moment_escalating
 from ipmc_asym.forward.model import CHECKS, FREE_STRIP_KEYS, MECHANICAL_KEYS, _forward, assumption_warnings
+from ipmc_asym.model.electrode import beam_label
 from ipmc_asym.model.groups import pressure_beta
-from ipmc_asym.model.params import _PAPER_SETS, NAFION_LI, Material, Strip, as_material, as_strip, debye_length
-from ipmc_asym.model.permittivity import MODELS, get_model
+from ipmc_asym.model.params import (
+    _PAPER_SETS,
+    NAFION_LI,
+    Material,
+    Strip,
+    as_material,
+    as_strip,
+    bending_stiffness,
+    debye_length,
+)
+from ipmc_asym.model.permittivity import MODELS
 from ipmc_asym.model.request import Request
+from ipmc_asym.model.spread import spread_of
 
-__all__ = ["evaluate", "estimate_rows", "estimate_report", "model_spread", "spread_of", "spread_variants", "SPREAD_KEYS",
+__all__ = ["evaluate", "estimate_rows", "estimate_report", "estimate_document", "model_spread", "spread_of",
+           "spread_variants", "SPREAD_KEYS",
            "RESULT_KEYS", "CHECKS", "moment_escalating", "Escalated",
            "check_tol", "FREE_STRIP_KEYS", "MECHANICAL_KEYS"]
 
@@ -81,12 +93,16 @@ def evaluate(strip: Strip, model="constant", fidelity="quadrature", material: Ma
     """
     req = Request(model, fidelity, tol, escalate, pressure_term)
     check_choice("on_invalid", on_invalid, ("raise", "nan"))
-    return _evaluate(as_strip(strip), req, as_material(material), on_invalid)
+    material = as_material(material)
+    row = _evaluate(as_strip(strip), req, material, on_invalid)
+    if pressure_term:
+        _add_beta([row], material)
+    return row
 
 
 def _evaluate(strip: Strip, req: Request, material: Material, on_invalid: str) -> dict:
     """:func:`evaluate` of checked inputs (a built ``Strip``, ``Request`` and ``Material``)."""
-    perm, fidelity, pressure_term = req.model, req.fidelity, req.pressure_term
+    perm, fidelity = req.model, req.fidelity
     t0 = time.perf_counter()
     # the Strip holds its checks (the thickness floor: no 1e-300 m strip reaches the groups)
     g = perm.groups(strip, material)
@@ -139,9 +155,6 @@ def _evaluate(strip: Strip, req: Request, material: Material, on_invalid: str) -
         "withheld": withheld,
         "warnings": warnings,
     }
-    if pressure_term:
-        row["pressure_term"] = True
-        row["beta"] = float(pressure_beta(material))
     for k in withheld:
         row[k] = None
     return row
@@ -159,7 +172,8 @@ def estimate_report(strip: Strip, models, fidelity="quadrature", material: Mater
                     spread: bool = True) -> tuple:
     """``(rows, model_spread)`` of ``estimate``: the rows of ``models`` and the model-form spread,
     from ONE checked request (the model, fidelity and tolerance checked once; the spread's other
-    models are the paper's, already resolved).  ``strip`` and ``material`` are built objects.
+    models are the paper's, already resolved).  ``strip`` and ``material`` are built objects;
+    ``models`` as :func:`model_list` gives them (one name, or the paper's three).
 
     Returns
     -------
@@ -167,9 +181,77 @@ def estimate_report(strip: Strip, models, fidelity="quadrature", material: Mater
     spread : dict or None   as :func:`model_spread` (None with ``spread=False``)
     """
     base = Request(models[0], fidelity, tol, escalate, pressure_term)
-    reqs = [base] + [base.with_model(get_model(m)) for m in models[1:]]
-    rows = [_evaluate(strip, r, material, on_invalid) for r in reqs]
-    return rows, (_model_spread(strip, material, base, rows) if spread else None)
+    # a second model is one of the paper's (model_list): resolved already, checked once in base
+    reqs = [base] + [base.with_model(MODELS[m]) for m in models[1:]]
+    rows, spread_rows = _rows(strip, material, reqs, on_invalid, spread)
+    if pressure_term:
+        _add_beta(rows, material)
+    return rows, (_spread(spread_rows, material) if spread else None)
+
+
+def estimate_document(strip: Strip, material: Material = NAFION_LI, model: str = "all", fidelity="quadrature",
+                      tol=None, *, escalate: bool = True, on_invalid: str = "nan", pressure_term: bool = False,
+                      thickness_note: str = "") -> dict:
+    """All of ``ipmc-asym estimate --json``: ``{"inputs", "results", "model_spread"}``.
+
+    ``inputs`` echoes the strip, the material and the beam (with ``thickness_source`` =
+    ``thickness_note`` where one is given: the material set's typical thickness stood in for
+    the option), ``results`` the rows of ``model`` (a name or ``"all"``, :func:`model_list`)
+    and ``model_spread`` the spread over the paper's models and C_moy forms, as
+    :func:`estimate_report`.  With ``on_invalid="nan"`` a row where no rung is valid keeps
+    ``I = None``; the command refuses it, a Python caller may keep the others.
+    """
+    models = model_list(model)
+    base = Request(models[0], fidelity, tol, escalate, pressure_term)
+    reqs = [base] + [base.with_model(MODELS[m]) for m in models[1:]]
+    rows, spread_rows = _rows(strip, material, reqs, on_invalid, True)
+    spread = _spread(spread_rows, material)
+    # what depends on the material and the section only, once for the whole report
+    if pressure_term:
+        beta = float(pressure_beta(material))
+        for r in rows:
+            r["pressure_term"], r["beta"] = True, beta
+    inputs = {
+        "length": strip.length, "width_total": strip.width, "thickness_total": strip.thickness,
+        "half_thickness_e": strip.e, "half_width_l": strip.l, "voltage": strip.voltage,
+        "modulus": material.E, "c_moy": material.C_moy, "c_moy_source": str(material.c_moy),
+        "I_p": strip.I_p, "material": material.name, "material_sources": list(material.sources),
+        "pressure_term": bool(pressure_term),
+        "beam": beam_label(material.electrode),
+        "electrode_thickness": material.electrode.thickness,
+        "electrode_modulus": material.electrode.modulus if material.electrode.present else None,
+        "bending_stiffness": float(bending_stiffness(material, strip.width, strip.thickness)),
+    }
+    if thickness_note:
+        inputs["thickness_source"] = thickness_note
+    return {"inputs": inputs, "results": rows, "model_spread": spread}
+
+
+def _rows(strip: Strip, material: Material, reqs: list, on_invalid: str, spread: bool) -> tuple:
+    """``(rows of reqs, {label: row})``: the requested rows and, with ``spread``, the row of each
+    paper model for each C_moy form of :func:`spread_variants` (a requested row is reused where
+    its model and C_moy are the same), every row from one :func:`_evaluate` each."""
+    variants = spread_variants(material) if spread else []
+    labelled = [(None, r, material, on_invalid) for r in reqs]
+    for cm, mat in variants:
+        for m, perm in MODELS.items():
+            reused = mat.c_moy == material.c_moy and any(r.model.name == m for r in reqs)
+            labelled.append((m if cm is None else f"{m}/{cm}", None if reused else reqs[0].with_model(perm), mat,
+                             "nan"))
+    done = [None if req is None else _evaluate(strip, req, mat, how) for _, req, mat, how in labelled]
+    rows = done[:len(reqs)]
+    by_model = {r["model"]: r for r in rows}
+    out = {}
+    for (label, req, _, _), row in zip(labelled[len(reqs):], done[len(reqs):]):
+        out[label] = row if req is not None else by_model[label.split("/")[0]]
+    return rows, out
+
+
+def _add_beta(rows: list, material: Material) -> None:
+    """The pressure term's ``beta`` (material only) on each row, after its numbers."""
+    beta = float(pressure_beta(material))
+    for r in rows:
+        r["pressure_term"], r["beta"] = True, beta
 
 
 def model_list(name: str) -> list:
@@ -203,18 +285,6 @@ def spread_variants(material: Material):
     return [(None, material)]
 
 
-def spread_of(values: dict, numerical_error=None) -> dict:
-    """``{"min", "max", "ratio", "values", "numerical_error"}`` of ``values`` (label -> number or
-    None); ``ratio`` = max|y|/min|y| (None when the sign changes or a value is 0)."""
-    got = [v for v in values.values() if v is not None]
-    lo, hi = (min(got), max(got)) if got else (None, None)
-    ratio = None
-    if got and (lo > 0 or hi < 0):
-        a = [abs(v) for v in got]
-        ratio = max(a) / min(a)
-    return {"min": lo, "max": hi, "ratio": ratio, "values": dict(values), "numerical_error": numerical_error}
-
-
 def model_spread(strip: Strip, material: Material = NAFION_LI, fidelity="quadrature", tol=None, rows=None, *,
                  escalate: bool = True, pressure_term: bool = False) -> dict:
     """The range of each model-dependent output over the model forms (the model-form spread).
@@ -245,18 +315,22 @@ def _model_spread(strip: Strip, material: Material, req: Request, rows=None) -> 
     """:func:`model_spread` of checked inputs: ``req`` evaluated for each paper model (its
     ``with_model``) and each ``C_moy`` variant; ``rows`` already computed are reused."""
     done = {r["model"]: r for r in rows or ()}
-    variants = spread_variants(material)
     out_rows = {}
-    for cm, mat in variants:
+    for cm, mat in spread_variants(material):
         for m, perm in MODELS.items():
             r = done.get(m) if mat.c_moy == material.c_moy else None
             if r is None:
                 r = _evaluate(strip, req.with_model(perm), mat, "nan")
             out_rows[m if cm is None else f"{m}/{cm}"] = r
+    return _spread(out_rows, material)
+
+
+def _spread(out_rows: dict, material: Material) -> dict:
+    """The model-form spread of the rows ``{label: row}`` (:func:`model_spread`'s dict)."""
     err = [r["error_estimate"] for r in out_rows.values() if r["error_estimate"] is not None]
     q = {k: spread_of({lab: r.get(k) for lab, r in out_rows.items()}, max(err) if err else None)
          for k in SPREAD_KEYS}
     over = ["permittivity model: " + ", ".join(MODELS)]
-    if len(variants) > 1:
+    if material.name in _PAPER_SETS:
         over.append("C_moy: paper (the stated 3082 mol/m^3) and formula (eq. (17) from the set's data)")
     return {"over": over, "variants": list(out_rows), "quantities": q, "note": SPREAD_NOTE}

@@ -35,7 +35,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ipmc_asym.base.ladder import climb, rungs_from
 from ipmc_asym.base.registry import FIDELITIES as _FIDELITY_SPECS
+from ipmc_asym.base.registry import fidelity_names
 from ipmc_asym.base.results import Panel, ResultMixin, ResultSpec
 from ipmc_asym.base.settings import BVP_STATED_ERROR, VALIDATED_VOLTAGE, VALIDITY_LIMIT
 from ipmc_asym.integral.api import check_fidelity, check_min_thickness, paper_model_id, run_parallel
@@ -44,7 +46,7 @@ from ipmc_asym.model import groups
 from ipmc_asym.model.params import NAFION_LI, Material, Strip, check_positive
 from ipmc_asym.model.permittivity import Permittivity, get_model
 
-__all__ = ["ChargeResult", "charge", "charge_inputs", "charge_at", "charge_scale", "capacitance_scale", "SUBNORMAL"]
+__all__ = ["ChargeResult", "charge", "charge_escalated", "charge_inputs", "charge_at", "charge_scale", "capacitance_scale", "SUBNORMAL"]
 
 #: largest subnormal magnitude: below it a float carries an absolute rounding of 2^-1075
 SUBNORMAL = 2.2250738585072014e-308
@@ -230,3 +232,31 @@ def _bvp(th, v, perm, mat):
             errc[idx] = (abs(d1 - d2) / 3 + 4 * BVP_STATED_ERROR * abs(sig[idx]) / h) / abs(cd[idx])
     return sig, cd, err, errc, core
 
+
+def charge_escalated(thickness: float, voltage: float, model="constant", fidelity="corrected", **kw) -> ChargeResult:
+    """:func:`charge` of one point at the cheapest VALID rung from ``fidelity`` up the registry's ladder.
+
+    Same arguments as :func:`charge` (scalars); the result's ``fidelity`` names the rung used.
+    A rung is climbed for accuracy only: beyond the validated voltage the result is kept with
+    ``check_voltage = valid = False``; where ``sigma`` or ``Q`` is subnormal (``|phi0|`` below
+    ~1e-300 V) no rung helps, and the first rung's result is returned with its rounding in
+    ``error`` (``valid = False`` once that passes ``VALIDITY_LIMIT``).  Raises ``ValueError``
+    (one line) where no rung from ``fidelity`` up is accurate otherwise.
+    """
+    check_fidelity(fidelity)
+    args = charge_inputs(thickness, voltage, model, **kw)  # checked once; every rung trusts them
+
+    def checks(f, r, idx):
+        if bool(accurate(r.error, r.error_C_diff)):
+            return True, ""
+        if float(voltage) != 0.0 and min(abs(float(r.sigma)), abs(float(r.Q))) < SUBNORMAL:
+            # no rung helps: the value itself is below the normal range of a double; its
+            # rounding is the stated error (sigma -> C_d(0) phi0 down to the subnormals)
+            return True, ""
+        return False, f"error estimates {float(r.error):.2g} / {float(r.error_C_diff):.2g}"
+
+    lad = climb(rungs_from(fidelity_names(), fidelity), lambda f, idx: charge_at(*args, f), checks)
+    if lad.left.size:
+        raise ValueError(lad.message(f"thickness (total 2e) {float(thickness):.3g} m, voltage {float(voltage):.3g} V "
+                                     f"(model {args[2].name})"))
+    return lad.last.result

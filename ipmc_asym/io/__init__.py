@@ -1,2 +1,2 @@
-"""Files and formats: atomic writes and output-path checks, JSON, the compiled text
-formatter, labelled datasets (xarray/NetCDF)."""
+"""Files and formats: atomic writes and output-path checks, the compiled text formatter,
+labelled datasets (xarray/NetCDF)."""

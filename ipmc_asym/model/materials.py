@@ -15,9 +15,11 @@ the source it was read in; a value a set has no source for is a visible fallback
 from __future__ import annotations
 
 from ipmc_asym.model import material_data
+from ipmc_asym.model.electrode import beam_label
 from ipmc_asym.model.params import FALLBACK_DEFAULTS, NAFION_LI, Material, named_material
 
-__all__ = ["names", "get", "info", "citations", "bibliography", "describe", "NOT_OFFERED", "MaterialSets", "MATERIAL_SETS"]
+__all__ = ["names", "get", "info", "citations", "bibliography", "material_comments",
+           "describe", "NOT_OFFERED", "MaterialSets", "MATERIAL_SETS"]
 
 #: membranes asked for that are not offered, and why (no source read for them here)
 NOT_OFFERED = (
@@ -156,3 +158,11 @@ class MaterialSets:
 
 #: the object ``ipmc_asym.materials`` names
 MATERIAL_SETS = MaterialSets()
+
+
+def material_comments(material) -> list:
+    """Header comment lines of a result file: the material set, the beam when it carries electrode
+    layers (the bare membrane is the paper's beam) and the numbered sources."""
+    beam = [f"beam: {beam_label(material.electrode)}"] if material.electrode.present else []
+    return [f"material set: {material.name}"] + beam + [f"source [{i}]: {c}"
+                                                       for i, c in enumerate(material.sources, 1)]

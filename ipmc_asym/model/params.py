@@ -352,6 +352,15 @@ def material_from_spec(spec=None, labels=None) -> Material:
     if "E" in spec and "modulus" in spec:
         raise ValueError(f"{name('E')}: give E or modulus, not both")
     kw = {}
+    # the layers on the set's membrane first: they are the set's own kind of data, the numbers
+    # below are plain values
+    if "electrode" in spec and not isinstance(spec["electrode"], dict):
+        raise ValueError(f"{name('electrode')} must be a table (thickness, metal, modulus, density)")
+    el = dict(spec.get("electrode") or {})
+    el.update({ELECTRODE_SPEC_KEYS[k]: spec[k] for k in ELECTRODE_SPEC_KEYS if k in spec})
+    el_labels = {ELECTRODE_SPEC_KEYS[k]: name(k) for k in ELECTRODE_SPEC_KEYS}
+    if el:
+        kw["electrode"] = electrode_from_spec(el, el_labels, base.electrode)
     for k in ("E", "modulus"):
         if k in spec:
             v = spec[k]
@@ -383,13 +392,6 @@ def material_from_spec(spec=None, labels=None) -> Material:
             raise ValueError(f"{name('c_moy')} = paper is the C_moy the paper states for its Nafion Li+; the material "
                              f"{base.name} takes formula (eq. (17) from its own data) or a number in mol/m^3")
         kw["c_moy"] = v
-    if "electrode" in spec and not isinstance(spec["electrode"], dict):
-        raise ValueError(f"{name('electrode')} must be a table (thickness, metal, modulus, density)")
-    el = dict(spec.get("electrode") or {})
-    el.update({ELECTRODE_SPEC_KEYS[k]: spec[k] for k in ELECTRODE_SPEC_KEYS if k in spec})
-    el_labels = {ELECTRODE_SPEC_KEYS[k]: name(k) for k in ELECTRODE_SPEC_KEYS}
-    if el:
-        kw["electrode"] = electrode_from_spec(el, el_labels, base.electrode)
     try:
         given = ", ".join(f"{k} = {v:g}" if isinstance(v, float) else f"{k} = {v}" for k, v in kw.items()
                           if k != "electrode")

@@ -19,9 +19,10 @@ import numpy as np
 from ipmc_asym.base.registry import model_names
 from ipmc_asym.base.settings import OUTSIDE_REGIMES
 from ipmc_asym.model.params import NAFION_LI, Material, Strip
-from ipmc_asym.studies.sweeps import sweep
+from ipmc_asym.studies.sweeps import sweep, withhold
 
-__all__ = ["fit_power_law", "local_exponent", "sweep_fits", "RANGES", "scaling_fits", "variation_table", "QUANTITIES",
+__all__ = ["fit_power_law", "local_exponent", "sweep_fits", "axis_fits", "FIT_POINTS",
+           "RANGES", "scaling_fits", "variation_table", "QUANTITIES",
            "linear_r"]
 
 #: quantity keys fitted (sweep columns)
@@ -102,6 +103,42 @@ def sweep_fits(arr, variables, quantities=QUANTITIES) -> list[dict]:
                           "linear_r": linear_r(sub[v], sub[q], mask)})
                 fits.append(f)
     return fits
+
+
+#: points per axis used for the fits (a subsample of a longer axis fits the same law)
+FIT_POINTS = 2000
+
+
+def axis_fits(vary: dict, model, fidelity, base: Strip, material: Material = NAFION_LI, tol=None, *,
+              escalate: bool = True) -> tuple[list, list]:
+    """``(fits, notes)``: power-law fits along each axis of ``vary`` (name -> values, as
+    :func:`ipmc_asym.studies.sweeps.sweep`), through the middle of the other axes.
+
+    An axis of one value, or with a value <= 0, gives a note instead of a fit; an axis longer
+    than :data:`FIT_POINTS` is subsampled (the same law).  ``ipmc-asym sweep`` reports these
+    after its rows.
+    """
+    fits, notes = [], []
+    for var, vals in vary.items():
+        if vals.size < 2:
+            notes.append(f"no fit along {var}: only {vals.size} value")
+            continue
+        if np.any(vals <= 0):
+            notes.append(f"no fit along {var}: a power law needs values > 0 (got {vals.min():g})")
+            continue
+        sub = vals if vals.size <= FIT_POINTS else vals[np.linspace(0, vals.size - 1, FIT_POINTS).astype(int)]
+        others = {k: v for k, v in vary.items() if k != var}
+        mid = {k: float(v[v.size // 2]) for k, v in others.items()}
+        strip = base.with_(**{k: x for k, x in mid.items() if k != "modulus"})
+        m = material.with_(E=mid["modulus"]) if "modulus" in mid else material
+        arr = sweep({var: sub}, model, fidelity, strip, m, tol, progress=False, escalate=escalate)
+        for f in sweep_fits(withhold(arr), [var]):
+            if others:
+                f["through"] = mid
+            if len(sub) < vals.size:
+                f["subsample"] = len(sub)
+            fits.append(f)
+    return fits, notes
 
 
 def scaling_fits(models=model_names(), ranges=None, fidelity="quadrature",

@@ -33,6 +33,7 @@ import numba
 import numpy as np
 
 from ipmc_asym.base import interrupt
+from ipmc_asym.base.jsonio import dumps
 from ipmc_asym.base.progress import progress as progress_bar
 from ipmc_asym.base.registry import model_names
 from ipmc_asym.base.settings import CHUNK_ROWS, MAX_ROWS
@@ -43,7 +44,6 @@ from ipmc_asym.forward.estimate import SPREAD_KEYS
 from ipmc_asym.forward.model import CHECKS, FREE_STRIP_KEYS, MECHANICAL_KEYS, WITHHOLD, forward
 from ipmc_asym.integral.api import check_fidelity
 from ipmc_asym.io.fileio import atomic_write
-from ipmc_asym.io.jsonio import dumps
 from ipmc_asym.io.textfmt import SHORTEST, format_table, shortest_text
 from ipmc_asym.model.params import NAFION_LI, Material, Strip
 from ipmc_asym.model.permittivity import get_model

@@ -89,11 +89,12 @@ from ipmc_asym.base.results import Panel, ResultMixin, ResultSpec
 from ipmc_asym.base.settings import CHUNK_ROWS
 from ipmc_asym.base.streamstats import SKETCH_K, Moments, QuantileSketch
 from ipmc_asym.base.units import parse_length, parse_voltage
-from ipmc_asym.forward.estimate import SPREAD_NOTE, spread_of
+from ipmc_asym.forward.estimate import SPREAD_NOTE
 from ipmc_asym.forward.model import CHECKS, SAMPLING_FIDELITIES, assumption_warnings, forward
 from ipmc_asym.io.datasets import VARIABLES
 from ipmc_asym.model.parameters import ALIASES, PARAMETERS, material_value, parse_value
 from ipmc_asym.model.permittivity import get_model
+from ipmc_asym.model.spread import spread_of
 from ipmc_asym.parallel.executors import chunk_slices, imap_chunks
 from ipmc_asym.studies.scene_schema import load_scene, parse_scene
 

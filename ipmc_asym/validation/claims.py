@@ -221,6 +221,6 @@ def measure(slow: bool = False) -> dict:
 if __name__ == "__main__":  # pragma: no cover - a report for whoever updates the documents
     import sys
 
-    from ipmc_asym.io.jsonio import dumps
+    from ipmc_asym.base.jsonio import dumps
 
     print(dumps(measure(slow="--slow" in sys.argv[1:]), indent=1))

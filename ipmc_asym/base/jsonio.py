@@ -1,7 +1,8 @@
 """JSON output for every ``--json`` option: strict JSON, never a bare ``NaN``.
 
 Non-finite floats (a fit with too few points, a quantity outside a formula's range) become
-``null``; the producer says why in a neighbouring field (``note``, ``warnings``).
+``null``; the producer says why in a neighbouring field (``note``, ``warnings``).  It lives in
+``base/`` because every layer hands its results to it last: the writer sits below them all.
 """
 
 from __future__ import annotations
