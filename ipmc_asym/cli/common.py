@@ -70,6 +70,17 @@ def warn(line):
     sys.stderr.write(f"ipmc-asym: warning: {line}\n")
 
 
+def nu_type(text):
+    """``--nu``: the drained Poisson ratio of the sensing mode, in [0, 0.5] (sense, freq --mode sensing)."""
+    try:
+        v = float(text)
+    except ValueError:
+        v = float("nan")
+    if not 0.0 <= v <= 0.5:
+        raise ValueError(f"--nu must be a drained Poisson ratio in [0, 0.5]; got {text!r}")
+    return v
+
+
 def _positive(name, parse, example, check=None):
     def conv(text):
         v = parse(name, text)

@@ -25,6 +25,7 @@ from ipmc_asym.cli.common import (
     frequency_type,
     material_from_args,
     model_help,
+    nu_type,
     print_clamped,
     sheet_resistance_type,
     strip_from_args,
@@ -32,7 +33,6 @@ from ipmc_asym.cli.common import (
     voltage_type,
     warn,
 )
-from ipmc_asym.cli.sense import _nu
 from ipmc_asym.dynamics.circuit import FREQ_METHODS
 from ipmc_asym.dynamics.entry import spectrum
 from ipmc_asym.dynamics.reduction import transfer_function
@@ -73,7 +73,7 @@ def register(sub):
     p.add_argument("--load", type=arg_type(_load_type, "--load"), default=None,
                    help="--mode sensing: short (default), open, or a resistance across the electrodes (10kOhm, 1MOhm, "
                         "470ohm; a bare number is ohms) for the load columns")
-    p.add_argument("--nu", type=arg_type(_nu, "nu"), default=None,
+    p.add_argument("--nu", type=arg_type(nu_type, "nu"), default=None,
                    help="--mode sensing: drained Poisson ratio (default 0, an assumption; the answers scale as 1 - 2 nu)")
     p.add_argument("--amplitude", type=_positive("--amplitude", parse_length, "1mm"), default=None,
                    help="--mode sensing: peak tip displacement of the load columns (default 1mm)")
