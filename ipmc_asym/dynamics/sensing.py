@@ -195,6 +195,16 @@ def sensing_response(f, strip: Strip | None = None, *, model="constant", materia
     Returns
     -------
     SensingResponse
+
+    Examples
+    --------
+    >>> import ipmc_asym as ia
+    >>> r = ia.sensing_response([1e-4, 1e-2], model="linear", load=1e3)
+    >>> static = ia.sense(tip_displacement=[1e-3], support="tip-force", model="linear").Q_per_w[0]
+    >>> round(float(abs(r.Q_per_w[0] / static)), 3)  # 0.1 mHz: the static charge per tip displacement
+    1.0
+    >>> r.valid.tolist()  # 10 mHz: past the one-way coupling bound (the streaming potential)
+    [True, False]
     """
     check_choice("method", method, FREQ_METHODS)
     check_choice("support", support, SENSE_SUPPORTS)

@@ -185,3 +185,18 @@ def test_refusals_name_the_input(kw, word):
         sensing_response([1.0], **kw)
     with pytest.raises(ValueError, match="frequencies"):
         sensing_response([0.0])
+
+
+def test_summary_plot_and_dataset():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from matplotlib.figure import Figure
+
+    r = sensing_response(np.geomspace(1e-4, 1.0, 7), model="affine", load=1e3)
+    text = repr(r)
+    assert text.startswith("SensingResponse") and "[C/m]" in text and "[W]" in text
+    fig = r.plot()
+    assert isinstance(fig, Figure) and all(ax.get_ylabel() for ax in fig.axes)
+    ds = r.to_xarray()
+    assert ds["harvested_power"].attrs["units"] == "W" and ds.attrs["load_resistance"] == 1e3
