@@ -147,6 +147,7 @@ QUANTITIES = (
     Quantity("check_one_way", "1", "one-way coupling estimate within its bound"),
     Quantity("amplitude", "m", "peak tip displacement of the load columns"),
     Quantity("load_resistance", "Ohm", "resistance of the load across the electrodes"),
+    Quantity("sensitivity", "C/m", "static short-circuit charge per tip displacement |Q/w| (design output)"),
     Quantity("f_stream", "Hz", "frequency 3 D/(2 pi e^2) where the streaming potential equals the static EMF"),
 )
 

@@ -52,7 +52,7 @@ from ipmc_asym.model.params import NAFION_LI, NOMINAL_STRIP, Material, Strip, ch
 from ipmc_asym.model.permittivity import get_model
 
 __all__ = ["SensingResponse", "sensing_response", "voc_hat", "voc_hat_leading", "SENSING_LOADS",
-           "DEFAULT_AMPLITUDE", "ONE_WAY_GROWTH", "WATER_ASSUMPTION"]
+           "DEFAULT_AMPLITUDE", "ONE_WAY_GROWTH", "WATER_ASSUMPTION", "strip_sensing_outputs"]
 
 #: the readings: short circuit, open circuit, or a resistance in ohms (a number)
 SENSING_LOADS = ("short", "open")
@@ -282,3 +282,50 @@ def sensing_response(f, strip: Strip | None = None, *, model="constant", materia
                            valid=valid, amplitude=w0, load=load, load_resistance=R, support=support, method=method,
                            model=perm.name, nu=nu, tau=tau, f_stream=f_stream, f_d=float(fr.f_d),
                            check_strain=check_strain, check_beam_regime=check_beam, notes=notes)
+
+
+def strip_sensing_outputs(length, width, thickness, material: Material | None = None, model="constant", *,
+                          frequency=None, load=None, amplitude: float = DEFAULT_AMPLITUDE, nu: float = DEFAULT_NU,
+                          support: str = "tip-force", C_moy=None) -> dict:
+    """The design outputs of sensing, vectorised over candidate strips (arrays, SI, TOTAL width and thickness).
+
+    ``sensitivity``: the static short-circuit charge per tip displacement ``|Q/w|`` (C/m), the linear
+    closed form exact in ``lam`` (:func:`ipmc_asym.forward.sensing.sense` at rung ``leading``, ``w -> 0``);
+    ``harvested_power``: the mean power (W) into the resistance ``load`` (Ohm) at ``frequency`` (Hz)
+    for the peak tip amplitude ``amplitude`` (m), exact linear form (``pnp-linear``), NaN when
+    ``frequency`` or ``load`` is None; ``power_flag``: the candidates whose power rests on a failed
+    assumption (one-way coupling past its bound, face strain above the limit, past a quarter turn).
+    ``C_moy``: per-candidate override (robust designs), default the material's.
+    """
+    m = NAFION_LI if material is None else material
+    perm = get_model(model)
+    L, Wd, T = (np.asarray(a, dtype=float) for a in (length, width, thickness))
+    cm = m.C_moy if C_moy is None else np.asarray(C_moy, dtype=float)
+    e = 0.5 * T
+    cs = 2.0 if support == "free" else 1.5  # int kappa dx / w  (free: 2 w/L, tip force: 1.5 w/L)
+    S = np.sqrt(m.phi4 * cm * perm.eps_moy * m.R * m.T)  # integral.sensing.charge_scale_sensing
+    lam = np.asarray(groups.debye_length(T, perm.eps_moy, m, C_moy=cm), dtype=float)
+    slope = (1.0 - 2.0 * nu) * e / m.phi4  # b per curvature
+    # Q/w = 2l S (coth(1/lam) - lam) (db/dkappa) int kappa dx / w (derivations.sensing:linear_solution)
+    with np.errstate(over="ignore"):
+        sens = Wd * S * (1.0 / np.tanh(1.0 / lam) - lam) * slope * cs / L
+    out = {"sensitivity": np.abs(sens)}
+    if frequency is None or load is None:
+        out["harvested_power"] = np.full(np.broadcast(L, Wd, T).shape, np.nan)
+        out["power_flag"] = np.zeros(out["harvested_power"].shape, bool)
+        return out
+    R = float(load)
+    Wf = 2.0 * math.pi * float(frequency) * e * e / m.D
+    k = np.sqrt(1.0 / lam**2 + 1j * Wf)
+    # the actuation's impedance per area (derivations/charge.py:small_signal): (e/kappa) Zhat
+    zhat = (2.0 / lam**2) * (1.0 / k**2 + (1.0 / (1j * Wf) - 1.0 / k**2) * np.tanh(k) / k)
+    Z = (e / np.asarray(groups.kappa(m, C_moy=cm), dtype=float)) * zhat / (Wd * L)
+    v = voc_hat(Wf, lam)
+    voc = groups.thermal_voltage(m) * slope * cs / L**2 * amplitude * v
+    out["harvested_power"] = np.abs(voc) ** 2 * R / (2.0 * np.abs(R + Z) ** 2)
+    growth = np.abs(v) / np.abs(2.0 * (1.0 - lam * np.tanh(1.0 / lam)))
+    k0 = np.asarray(tip_curvature(amplitude, L, support), dtype=float)
+    bad = (growth > ONE_WAY_GROWTH) | (e * np.abs(k0) > m.strain_limit) | (np.abs(k0) * L > 0.5 * math.pi)
+    bad |= np.abs(slope * k0) >= B_LIMIT
+    out["power_flag"] = bad
+    return out
