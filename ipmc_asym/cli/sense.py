@@ -43,7 +43,8 @@ def _load(text):
     t = str(text).strip().lower()
     if t not in SENSE_LOADS:
         raise ValueError(f"--load must be one of {', '.join(SENSE_LOADS)} (a resistive load at DC after relaxation "
-                         f"carries no current and reads the open-circuit voltage: use open); got {text!r}")
+                         f"carries no current and reads the open-circuit voltage: use open; a load at a frequency: "
+                         f"ipmc-asym freq --mode sensing --load R); got {text!r}")
     return t
 
 
