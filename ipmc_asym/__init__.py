@@ -44,6 +44,7 @@ _LAZY = {
     # spectrum) makes the choice the commands make; the functions behind it stay public
     "charge": ("ipmc_asym.integral.charge", "charge"),
     "sense": ("ipmc_asym.forward.sensing", "sense"),
+    "sensing_response": ("ipmc_asym.dynamics.sensing", "sensing_response"),
     "Drive": ("ipmc_asym.dynamics.entry", "Drive"),
     "time_response": ("ipmc_asym.dynamics.entry", "time_response"),
     "spectrum": ("ipmc_asym.dynamics.entry", "spectrum"),

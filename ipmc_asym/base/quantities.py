@@ -136,6 +136,19 @@ QUANTITIES = (
     Quantity("Q_per_w", "C/m", "short-circuit charge per tip displacement Q/w"),
     Quantity("strain_parameter", "1", "b = (1 - 2 nu) kappa e/phi4 at the clamp: fixed-charge change at a face"),
     Quantity("nu", "1", "drained Poisson ratio of the membrane (assumption: no source read)"),
+    # sensing in the frequency domain (derivations/sensing_dynamic.py)
+    Quantity("I_per_w", "A/m", "short-circuit current per tip displacement"),
+    Quantity("V_oc_per_w", "V/m", "open-circuit voltage per tip displacement"),
+    Quantity("V_load", "V", "voltage across the resistive load at the tip amplitude"),
+    Quantity("I_load", "A", "current through the resistive load at the tip amplitude"),
+    Quantity("harvested_power", "W", "mean power into the resistive load at the tip amplitude"),
+    Quantity("error_sensing", "1", "relative error of the sensing response against the exact linear form"),
+    Quantity("one_way_error", "1", "estimate of the neglected pressure feedback on the strain"),
+    Quantity("check_one_way", "1", "one-way coupling estimate within its bound"),
+    Quantity("amplitude", "m", "peak tip displacement of the load columns"),
+    Quantity("load_resistance", "Ohm", "resistance of the load across the electrodes"),
+    Quantity("sensitivity", "C/m", "static short-circuit charge per tip displacement |Q/w| (design output)"),
+    Quantity("f_stream", "Hz", "frequency 3 D/(2 pi e^2) where the streaming potential equals the static EMF"),
 )
 
 #: every name (result-row name and scene name) -> its quantity

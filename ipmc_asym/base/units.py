@@ -10,7 +10,7 @@ import re
 
 import numpy as np
 
-__all__ = ["parse_length", "parse_voltage", "parse_pressure", "parse_force", "parse_time", "parse_diffusion",
+__all__ = ["parse_length", "parse_voltage", "parse_pressure", "parse_force", "parse_time", "parse_diffusion", "parse_resistance",
            "parse_sheet_resistance", "parse_quantity", "fmt_length", "SWEEP_VARIABLES",
            "parse_vary_spec", "parse_vary", "vary_values"]
 
@@ -27,6 +27,9 @@ _DIFFUSION = {"m2/s": 1.0, "m^2/s": 1.0, "cm2/s": 1e-4, "cm^2/s": 1e-4, "mm2/s":
 # sheet (surface) resistance of a film, Ohm per square (matched case-insensitively: "ohm/sq", "Ohm/sq")
 _SHEET = {"ohm/sq": 1.0, "ohm/square": 1.0, "ohm/□": 1.0, "ω/sq": 1.0, "ω/□": 1.0, "kohm/sq": 1e3}
 
+# a resistance, Ohm (case-sensitive: MOhm is mega, mOhm milli)
+_RESISTANCE = {"Ohm": 1.0, "ohm": 1.0, "Ω": 1.0, "kOhm": 1e3, "kohm": 1e3, "kΩ": 1e3, "MOhm": 1e6, "Mohm": 1e6,
+               "MΩ": 1e6, "mOhm": 1e-3, "mohm": 1e-3, "mΩ": 1e-3}
 _NUM = re.compile(r"^\s*([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)\s*([^\s\d].*?)?\s*$")
 
 
@@ -89,6 +92,11 @@ def parse_diffusion(name: str, text) -> float:
 def parse_sheet_resistance(name: str, text) -> float:
     """``'2.5ohm/sq'``, ``'2.5 Ω/sq'``, ``'2.5'`` -> Ohm per square."""
     return parse_quantity(name, text, _SHEET, "sheet resistance", case_sensitive=False)
+
+
+def parse_resistance(name: str, text) -> float:
+    """``'10kOhm'``, ``'2.2 MΩ'``, ``'470ohm'``, ``'1e4'`` -> ohms (the unit's case matters: M, m)."""
+    return parse_quantity(name, text, _RESISTANCE, "resistance")
 
 
 def fmt_length(x: float) -> str:

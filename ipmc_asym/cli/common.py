@@ -70,6 +70,17 @@ def warn(line):
     sys.stderr.write(f"ipmc-asym: warning: {line}\n")
 
 
+def nu_type(text):
+    """``--nu``: the drained Poisson ratio of the sensing mode, in [0, 0.5] (sense, freq --mode sensing)."""
+    try:
+        v = float(text)
+    except ValueError:
+        v = float("nan")
+    if not 0.0 <= v <= 0.5:
+        raise ValueError(f"--nu must be a drained Poisson ratio in [0, 0.5]; got {text!r}")
+    return v
+
+
 def _positive(name, parse, example, check=None):
     def conv(text):
         v = parse(name, text)
@@ -630,14 +641,17 @@ def _electrode_conv(text):
     return tuple(parse_length("--electrode", v.strip()) for v in parts)
 
 
-def add_support_options(p):
-    """``--support`` and ``--electrode`` (freq, drive)."""
+def add_support_options(p, sensing=False):
+    """``--support`` and ``--electrode`` (freq, drive); ``sensing``: also ``free``/``tip-force`` (freq --mode sensing)."""
     from ipmc_asym.beam.dynamics import SUPPORTS  # deferred: heavy module, start-up (the dynamic commands only)
 
-    p.add_argument("--support", default=None, choices=SUPPORTS,
+    extra = ("free", "tip-force") if sensing else ()
+    p.add_argument("--support", default=None, choices=SUPPORTS + extra,
                    help="strip support: clamped-free and clamped-pinned give the default outputs (free tip w, theta; "
                         "blocked tip F_block); clamped-clamped adds the clamps' reaction moments and forces M_root, "
-                        "M_tip, F_root, F_tip and the midspan deflection w_mid (small displacements)")
+                        "M_tip, F_root, F_tip and the midspan deflection w_mid (small displacements)"
+                        + ("; with --mode sensing, how the tip displacement is imposed: free (an end moment, uniform "
+                           "curvature) or tip-force (the cantilever's tip moved; the default)" if sensing else ""))
     p.add_argument("--electrode", type=arg_type(_electrode_conv, "--electrode"), default=None,
                    help="X1:X2 covered part of the length (e.g. 2mm:18mm, 0 <= X1 < X2 <= L; default the whole strip): "
                         "the active moment acts there only, the beam outputs are small-displacement")

@@ -1,4 +1,5 @@
-"""``ipmc-asym freq``: small-signal impedance and tip-deflection/voltage transfer function."""
+"""``ipmc-asym freq``: small-signal impedance and tip-deflection/voltage transfer function; with
+``--mode sensing`` the strip as a sensor and harvester (:func:`ipmc_asym.dynamics.sensing.sensing_response`)."""
 
 from __future__ import annotations
 
@@ -6,11 +7,12 @@ import numpy as np
 
 from ipmc_asym.base.jsonio import dumps
 from ipmc_asym.base.registry import model_names
-from ipmc_asym.base.units import fmt_length
+from ipmc_asym.base.units import fmt_length, parse_length, parse_resistance
 from ipmc_asym.beam.dynamics import CLAMPED_OUTPUTS
 from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import (
     CLAMPED_UNITS,
+    _positive,
     add_beam_options,
     add_output_option,
     add_size_option,
@@ -23,17 +25,22 @@ from ipmc_asym.cli.common import (
     fmt_num,
     frequency_type,
     model_help,
+    nu_type,
     print_clamped,
     sheet_resistance_type,
     strip_and_material,
     support_from_args,
     voltage_type,
+    warn,
 )
 from ipmc_asym.dynamics.circuit import FREQ_METHODS
 from ipmc_asym.dynamics.entry import spectrum
 from ipmc_asym.dynamics.reduction import transfer_function
+from ipmc_asym.forward.sensing import DEFAULT_NU
 from ipmc_asym.io.fileio import atomic_write
 
+#: the two directions of the small signal
+MODES = ("actuation", "sensing")
 #: frequencies of one run (log-spaced: 1e5 points resolve any spectrum; the --json text stays ~10 MB);
 #: settable with --max-points
 MAX_POINTS = 10**5
@@ -57,7 +64,18 @@ def register(sub):
     p.add_argument("--sheet-resistance", dest="sheet_resistance", type=sheet_resistance_type, default=None,
                    help="sheet resistance of each electrode (2.5ohm/sq; a bare number is Ohm/sq; default 0 = ideal): "
                         "Z and w of the RC line along the strip, driven at the clamp")
-    add_support_options(p)
+    add_support_options(p, sensing=True)
+    p.add_argument("--mode", default="actuation", choices=MODES,
+                   help="actuation (default: a voltage drives the strip; the outputs above) or sensing (the tip is moved "
+                        "sinusoidally: short-circuit charge, current and open-circuit voltage per tip displacement; with "
+                        "--load R the load's voltage, current and mean power; docs/sensing.md)")
+    p.add_argument("--load", type=arg_type(_load_type, "--load"), default=None,
+                   help="--mode sensing: short (default), open, or a resistance across the electrodes (10kOhm, 1MOhm, "
+                        "470ohm; a bare number is ohms) for the load columns")
+    p.add_argument("--nu", type=arg_type(nu_type, "nu"), default=None,
+                   help="--mode sensing: drained Poisson ratio (default 0, an assumption; the answers scale as 1 - 2 nu)")
+    p.add_argument("--amplitude", type=_positive("--amplitude", parse_length, "1mm"), default=None,
+                   help="--mode sensing: peak tip displacement of the load columns (default 1mm)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     add_output_option(p, "--export", formats=(".json",), metavar="F.json", default=None,
                    help="write reduced-order models of V -> w and V -> charge over [--from, --to] (poles, residues, "
@@ -76,9 +94,27 @@ def _tol_type(text):
     return v
 
 
+def _load_type(text):
+    t = str(text).strip().lower()
+    if t in ("short", "open"):
+        return t
+    v = parse_resistance("--load", text)
+    if not v > 0.0:
+        raise ValueError(f"--load must be short, open or a resistance > 0 (e.g. 10kOhm); got {text!r}")
+    return v
+
+
 def run(args):
     if args.f2 <= args.f1:
         raise ValueError(f"--to must be above --from; got {args.f1:g} Hz .. {args.f2:g} Hz")
+    if args.mode == "sensing":
+        return _run_sensing(args)
+    for opt, v in (("--load", args.load), ("--nu", args.nu), ("--amplitude", args.amplitude)):
+        if v is not None:
+            raise ValueError(f"{opt} is an option of --mode sensing")
+    if args.support in ("free", "tip-force"):
+        raise ValueError(f"--support {args.support} is how --mode sensing imposes the tip displacement; actuation "
+                         "supports: clamped-free, clamped-pinned, clamped-clamped")
     # --export: its path and format checked before any work with every output (add_output_option)
     support, electrode = support_from_args(args)
     strip, material, _ = strip_and_material(args)
@@ -174,4 +210,94 @@ def run(args):
         print(f"wrote {args.export}")
         if bad:
             print(f"warning: the fit of {', '.join(bad)} misses --export-tol {args.export_tol:g} (its error is stated)")
+    return 0
+
+
+def _run_sensing(args):
+    """``--mode sensing``: the strip's tip moved sinusoidally (quasi-static beam), small signal."""
+    from ipmc_asym.dynamics.sensing import DEFAULT_AMPLITUDE, sensing_response  # deferred: the sensing mode only
+
+    for bad, what in ((args.voltage != 0.0, "--voltage (a DC bias)"), (args.sheet_resistance is not None, "--sheet-resistance"),
+                      (args.electrode is not None, "--electrode"), (args.export is not None, "--export"),
+                      (args.beam == "dynamic", "--beam dynamic (the tip displacement is imposed quasi-statically; base "
+                                               "excitation through the beam's modes is not modelled)"),
+                      (args.viscous_modulus != 0.0, "--viscous-modulus"),
+                      (args.support is not None and args.support.startswith("clamped"), f"--support {args.support}")):
+        if bad:
+            raise ValueError(f"--mode sensing does not take {what}")
+    strip, material, _ = strip_and_material(args)
+    support = args.support or "tip-force"
+    load = "short" if args.load is None else args.load
+    nu = DEFAULT_NU if args.nu is None else args.nu
+    amp = DEFAULT_AMPLITUDE if args.amplitude is None else args.amplitude
+    f = np.geomspace(args.f1, args.f2, args.points)
+    first_run_notice("freq")
+    r = sensing_response(f, strip, model=args.model, material=material, method=args.method or "pnp-linear", load=load,
+                         nu=nu, support=support, amplitude=amp)
+    resistive = not isinstance(load, str)
+    cols = {"f": r.f}
+    for n in ("Q_per_w", "I_per_w", "V_oc_per_w"):
+        cols[f"{n}_amp"], cols[f"{n}_phase"] = np.abs(getattr(r, n)), np.angle(getattr(r, n), deg=True)
+    cols["Z_abs"], cols["Z_phase"] = np.abs(r.Z), np.angle(r.Z, deg=True)
+    if resistive:
+        cols["V_load_amp"], cols["V_load_phase"] = np.abs(r.V_load), np.angle(r.V_load, deg=True)
+        cols["I_load_amp"], cols["I_load_phase"] = np.abs(r.I_load), np.angle(r.I_load, deg=True)
+        cols["power"] = r.power
+        cols["matched_power"] = r.power_at(np.abs(r.Z)).diagonal()
+    if r.method == "circuit":
+        cols["error"] = r.error
+    cols["one_way_error"] = r.one_way_error
+    cols["valid"] = r.valid
+    warnings = []
+    nbad = int(np.count_nonzero(~r.check_one_way))
+    if nbad:
+        f_bad = float(f[~r.check_one_way][0])
+        warnings.append(f"{nbad} of {f.size} frequencies (from {f_bad:.4g} Hz) past the one-way coupling bound: the "
+                        "streaming potential's pressure would deform the strip; kept, flagged valid = false")
+    if not r.check_strain:
+        warnings.append(f"amplitude {amp:g} m: face strain above the small-strain limit {material.strain_limit:g}; "
+                        "kept, flagged valid = false")
+    if not r.check_beam_regime:
+        warnings.append(f"amplitude {amp:g} m: past a quarter turn (small-displacement beam); kept, flagged valid = false")
+    for w in warnings:
+        warn(w)
+    units = {"f": "Hz", "Q_per_w_amp": "C/m", "I_per_w_amp": "A/m", "V_oc_per_w_amp": "V/m", "Z_abs": "Ohm",
+             "one_way_error": "1", "valid": "bool"}
+    units.update({f"{n}_phase": "deg" for n in ("Q_per_w", "I_per_w", "V_oc_per_w", "Z", "V_load", "I_load")})
+    if resistive:
+        units.update({"V_load_amp": "V (at the amplitude)", "I_load_amp": "A (at the amplitude)",
+                      "power": "W (mean, at the amplitude)", "matched_power": "W (mean, into R = |Z|)"})
+    if r.method == "circuit":
+        units["error"] = "relative, against the exact linear form (pnp-linear)"
+    head = {"mode": "sensing", "model": r.model, "method": r.method, "thickness_total": strip.thickness,
+            "length": strip.length, "width_total": strip.width, "support": support, "nu": nu, "amplitude": amp,
+            "load": load if isinstance(load, str) else "resistive", "load_resistance": None if not resistive else load,
+            "tau": r.tau, "f_stream": r.f_stream, "f_d": r.f_d, "diffusion_coefficient": material.D,
+            "units": units, "notes": r.notes, "warnings": warnings}
+    if args.json:
+        out = dict(head)
+        out.update(cols)
+        print(dumps(out, indent=1))
+        return 0
+    print(f"IPMC strip as a sensor, small signal: model {r.model}, method {r.method}, support {support}, L = "
+          f"{fmt_length(strip.length)}, 2l = {fmt_length(strip.width)}, 2e = {fmt_length(strip.thickness)}, nu = {nu:g}; "
+          f"tau = {r.tau:.4g} s, f_stream = 3D/(2 pi e^2) = {r.f_stream:.4g} Hz")
+    hdr = (f"{'f [Hz]':>11s} {'|Q/w| [C/m]':>12s} {'phase':>7s} {'|V_oc/w| [V/m]':>14s} {'phase':>7s} {'|Z| [Ohm]':>11s}")
+    if resistive:
+        hdr += f" {'|V_load| [V]':>12s} {'|I_load| [A]':>12s} {'P [W]':>10s}"
+    print(hdr + f" {'1-way':>7s}")
+    for i in range(f.size):
+        line = (f"{fmt_num(f[i], '11.4g')} {fmt_num(cols['Q_per_w_amp'][i], '12.5g')} {fmt_num(cols['Q_per_w_phase'][i], '7.1f')} "
+                f"{fmt_num(cols['V_oc_per_w_amp'][i], '14.5g')} {fmt_num(cols['V_oc_per_w_phase'][i], '7.1f')} "
+                f"{fmt_num(cols['Z_abs'][i], '11.5g')}")
+        if resistive:
+            line += (f" {fmt_num(cols['V_load_amp'][i], '12.5g')} {fmt_num(cols['I_load_amp'][i], '12.5g')} "
+                     f"{fmt_num(cols['power'][i], '10.4g')}")
+        print(line + f" {fmt_num(r.one_way_error[i], '7.2g')}" + ("" if r.valid[i] else "  not valid"))
+    print("legend: Q/w, V_oc/w = short-circuit charge of the electrode z = -e and open-circuit voltage phi(-e) - phi(e) "
+          "per tip displacement, phases in degrees against w; Z = the strip's impedance"
+          + (f"; V_load, I_load, P = the load {load:g} Ohm at the tip amplitude {amp:g} m (P the mean power)"
+             if resistive else "") + "; 1-way = estimate of the neglected pressure feedback")
+    for n in head["notes"]:
+        print(f"note: {n}")
     return 0

@@ -13,6 +13,7 @@ from ipmc_asym.cli.common import (
     add_strip_options,
     arg_type,
     first_run_notice,
+    nu_type,
     strip_and_material,
     tol_type,
     warn,
@@ -41,18 +42,11 @@ def _load(text):
     t = str(text).strip().lower()
     if t not in SENSE_LOADS:
         raise ValueError(f"--load must be one of {', '.join(SENSE_LOADS)} (a resistive load at DC after relaxation "
-                         f"carries no current and reads the open-circuit voltage: use open); got {text!r}")
+                         f"carries no current and reads the open-circuit voltage: use open; a load at a frequency: "
+                         f"ipmc-asym freq --mode sensing --load R); got {text!r}")
     return t
 
 
-def _nu(text):
-    try:
-        v = float(text)
-    except ValueError:
-        v = float("nan")
-    if not 0.0 <= v <= 0.5:
-        raise ValueError(f"--nu must be a drained Poisson ratio in [0, 0.5]; got {text!r}")
-    return v
 
 
 def register(sub):
@@ -71,7 +65,7 @@ def register(sub):
                    help="short (the charge that flows between short-circuited electrodes) or open (the voltage); "
                         "both are computed, this picks the one printed first. A resistive load at DC after "
                         "relaxation carries no current: it reads the open-circuit voltage")
-    p.add_argument("--nu", type=arg_type(_nu, "nu"), default=DEFAULT_NU,
+    p.add_argument("--nu", type=arg_type(nu_type, "nu"), default=DEFAULT_NU,
                    help="drained Poisson ratio of the membrane (default 0, an assumption: the paper's section 3 "
                         "kinematics; no measured value was read; the answers scale as 1 - 2 nu)")
     p.add_argument("--model", default="all", choices=model_choices(), help="permittivity model (default all three)")

@@ -719,7 +719,8 @@ def solve_transient(t, phi0_fun, strip: Strip, model="constant", material: Mater
         message) when the tolerance needs more.
     rtol, atol : float
         solve_ivp tolerances; ``rtol`` default: ``tol/100`` with a tolerance, 1e-8 without one
-        (``atol`` on ``S``, in units of ``e``; no looser than ``rtol`` times the small-signal charge ``lambda max|psi0|/2``, so that the time error stays relative at small signal).
+        (``atol`` on ``S``, in units of ``e``; no looser than ``rtol`` times the small-signal
+        charge ``lambda max|psi0|/2``, so that the time error stays relative at small signal).
     method : {"BDF", "Radau"}
     energy : bool
         Integrate the dissipation and return the energy balance in ``extra["energy"]``

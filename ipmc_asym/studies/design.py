@@ -31,8 +31,22 @@ Spec file (TOML; units as everywhere, thickness and width TOTAL)::
 
 Outputs (scene-file names): ``tip_deflection`` (|w|, large displacement), ``blocking_force``
 (|F|, large displacement), ``rotation`` (|theta|), ``moment`` (|M_A|), ``I``, ``work``
-(|F| |w|, force x deflection), ``max_strain`` (``e|kappa|``); besides them the inputs and
-``footprint`` (length x width) can be constrained.  Objective and constraints are magnitudes.
+(|F| |w|, force x deflection), ``max_strain`` (``e|kappa|``); the sensing outputs
+``sensitivity`` (the static short-circuit charge per tip displacement |Q/w|, C/m) and
+``harvested_power`` (the mean power, W, into a resistance at a frequency for a tip amplitude,
+``docs/sensing.md``), set by an optional table::
+
+    [sensing]
+    support = "tip-force"            # or "free" (how the tip displacement is imposed)
+    nu = 0                           # drained Poisson ratio (an assumption, default 0)
+    frequency = "5mHz"               # harvested_power: needs frequency and load
+    load = "1kOhm"
+    amplitude = "1mm"                # peak tip displacement (default 1mm)
+
+A candidate whose power rests on a failed assumption (the one-way coupling past its bound at that
+frequency, the amplitude past the small-strain or quarter-turn limits) has no power.  Besides the
+outputs, the inputs and ``footprint`` (length x width) can be constrained.  Objective and
+constraints are magnitudes.
 
 Every candidate goes through the one forward model (:func:`ipmc_asym.forward.model.forward`,
 with escalation); a candidate any of whose checks withholds or flags an output the design
@@ -68,8 +82,9 @@ import numpy as np
 from ipmc_asym.base.inputs import read_input_text
 from ipmc_asym.base.registry import fidelity_names, model_names
 from ipmc_asym.base.results import Panel, ResultMixin, ResultSpec
-from ipmc_asym.base.units import parse_force, parse_length, parse_quantity, parse_voltage
+from ipmc_asym.base.units import parse_force, parse_length, parse_quantity, parse_resistance, parse_voltage
 from ipmc_asym.beam.dynamics import first_resonance
+from ipmc_asym.dynamics.sensing import strip_sensing_outputs
 from ipmc_asym.forward.model import CHECKS, forward
 from ipmc_asym.model.electrode import beam_label
 from ipmc_asym.model.materials import citations
@@ -83,7 +98,7 @@ __all__ = ["DesignSpec", "DesignResult", "design", "parse_spec", "load_spec", "O
 INPUTS = ("length", "width", "thickness", "voltage")
 #: outputs (scene-file names) -> unit
 OUTPUTS = {"tip_deflection": "m", "blocking_force": "N", "rotation": "rad", "moment": "N m", "I": "1",
-           "work": "N m", "max_strain": "1", "first_resonance": "Hz"}
+           "work": "N m", "max_strain": "1", "first_resonance": "Hz", "sensitivity": "C/m", "harvested_power": "W"}
 #: what a constraint may name -> unit
 CONSTRAINABLE = {**OUTPUTS, "length": "m", "width": "m", "thickness": "m", "voltage": "V", "footprint": "m^2"}
 #: the pattern search stops when its step (in the unit box) is below this
@@ -107,7 +122,10 @@ _STARTS = 4
 _AREA = {"m2": 1.0, "m^2": 1.0, "cm2": 1e-4, "cm^2": 1e-4, "mm2": 1e-6, "mm^2": 1e-6}
 _WORK = {"J": 1.0, "mJ": 1e-3, "uJ": 1e-6, "µJ": 1e-6, "N m": 1.0, "Nm": 1.0}
 _TOP = {"name", "model", "material", "fidelity", "tolerance", "strip", "vary", "objective", "constraints", "pareto",
-        "uncertain", "robust"}
+        "uncertain", "robust", "sensing"}
+_POWER = {"W": 1.0, "mW": 1e-3, "uW": 1e-6, "µW": 1e-6, "nW": 1e-9, "pW": 1e-12, "fW": 1e-15}
+#: keys of the [sensing] table
+SENSING_KEYS = ("support", "nu", "frequency", "load", "amplitude")
 
 
 def _quantity(where: str, name: str, v) -> float:
@@ -124,6 +142,8 @@ def _quantity(where: str, name: str, v) -> float:
         return parse_quantity(where, v, _AREA, "area")
     if name in ("work", "moment"):
         return parse_quantity(where, v, _WORK, "work/moment (N m)")
+    if name == "harvested_power":
+        return parse_quantity(where, v, _POWER, "power")
     return parse_quantity(where, v, {}, f"number ({CONSTRAINABLE.get(name, '1')})")
 
 
@@ -146,6 +166,7 @@ class DesignSpec:
                              holds at all but ``failures`` of them, the binomial tail bound)
     failures : int           robust: samples a constraint may miss (from ``samples``, ``confidence``)
     near_tie : float         relative objective tolerance of a near-tie (``[objective] near_tie``)
+    sensing : dict           ``[sensing]``: support, nu, frequency (Hz), load (Ohm), amplitude (m)
     """
 
     name: str
@@ -166,6 +187,7 @@ class DesignSpec:
     confidence: float = 0.95
     failures: int = 0
     near_tie: float = NEAR_TIE_RTOL
+    sensing: dict = field(default_factory=dict)
 
 
 def _check_keys(where, d, allowed):
@@ -332,10 +354,41 @@ def parse_spec(spec: dict, name: str = "design") -> DesignSpec:
             notes = list(notes) + [why]
     elif "robust" in spec:
         raise ValueError("[robust] needs an [uncertain] table (the uq schema: modulus, c_moy)")
+    sensing = _parse_sensing(spec.get("sensing", {}))
+    needs = {out} | set(cons) | (set(pareto[:2]) if pareto else set())
+    if "harvested_power" in needs and ("frequency" not in sensing or "load" not in sensing):
+        raise ValueError("harvested_power needs [sensing] frequency (e.g. \"5mHz\") and load (e.g. \"1kOhm\")")
     return DesignSpec(name=spec.get("name", name), model=model, material=material, fidelity=fidelity, tol=tol,
                       fixed=fixed, ranges=ranges, choices=choices, objective=(out, sense), constraints=cons,
                       pareto=pareto, uncertain=unc, probability=float(prob), samples=samples, notes=notes,
-                      confidence=float(conf), failures=fails, near_tie=float(near_tie))
+                      confidence=float(conf), failures=fails, near_tie=float(near_tie), sensing=sensing)
+
+
+def _parse_sensing(d) -> dict:
+    """The ``[sensing]`` table, checked (SI); absent keys take the sensing mode's defaults."""
+    _check_keys("[sensing]", d, set(SENSING_KEYS))
+    out = {"support": d.get("support", "tip-force")}
+    if out["support"] not in ("free", "tip-force"):
+        raise ValueError(f"sensing.support must be free or tip-force; got {out['support']!r}")
+    nu = d.get("nu", 0.0)
+    if isinstance(nu, bool) or not isinstance(nu, (int, float)) or not 0.0 <= nu <= 0.5:
+        raise ValueError(f"sensing.nu must be a drained Poisson ratio in [0, 0.5]; got {nu!r}")
+    out["nu"] = float(nu)
+    if "frequency" in d:
+        f = parse_quantity("sensing.frequency", d["frequency"], {"Hz": 1.0, "mHz": 1e-3, "kHz": 1e3}, "frequency")
+        if not f > 0:
+            raise ValueError(f"sensing.frequency must be > 0 Hz; got {d['frequency']!r}")
+        out["frequency"] = f
+    if "load" in d:
+        R = parse_resistance("sensing.load", d["load"])
+        if not R > 0:
+            raise ValueError(f"sensing.load must be a resistance > 0 Ohm; got {d['load']!r}")
+        out["load"] = R
+    amp = parse_length("sensing.amplitude", d.get("amplitude", 1e-3))
+    if not amp > 0:
+        raise ValueError(f"sensing.amplitude must be a tip displacement > 0 m; got {d.get('amplitude')!r}")
+    out["amplitude"] = amp
+    return out
 
 
 def load_spec(path) -> dict:
@@ -351,6 +404,14 @@ def load_spec(path) -> dict:
 
 
 # ---- evaluation --------------------------------------------------------------------------------
+def _sensing(spec: DesignSpec, L, W, T, c_moy):
+    """``sensitivity`` and ``harvested_power`` of candidates (:func:`strip_sensing_outputs`)."""
+    sd = spec.sensing or {"support": "tip-force", "nu": 0.0, "amplitude": 1e-3}
+    return strip_sensing_outputs(L, W, T, spec.material, spec.model, frequency=sd.get("frequency"),
+                                 load=sd.get("load"), amplitude=sd["amplitude"], nu=sd["nu"], support=sd["support"],
+                                 C_moy=c_moy)
+
+
 class _Problem:
     """The spec's variables in the unit box and one vectorised evaluation of candidates."""
 
@@ -411,6 +472,9 @@ class _Problem:
             raw = {"tip_deflection": w, "blocking_force": F, "rotation": np.abs(r.theta), "moment": np.abs(r.M_A),
                    "I": np.abs(r.I), "work": w * F, "max_strain": np.asarray(r.max_strain, float),
                    "first_resonance": first_resonance(L, W, T, spec.material)}
+            so = _sensing(spec, L, W, T, kw.get("c_moy"))
+            raw["sensitivity"] = so["sensitivity"]
+            raw["harvested_power"] = np.where(so["power_flag"], np.nan, so["harvested_power"])
             # a design stays inside the model: an output flagged by a failed model assumption (past a
             # quarter turn, strain above the material's limit, beyond the validated voltage, not
             # slender) counts as withheld here, so no design rests on it
@@ -708,6 +772,9 @@ def _point_report(problem: _Problem, x: dict) -> tuple[dict, dict, dict]:
                "I": num(r.I), "work": (abs(w) * abs(F)) if w is not None and F is not None else None,
                "max_strain": num(r.max_strain), "footprint": float(x["length"][0] * x["width"][0]),
                "first_resonance": num(first_resonance(*(x[k] for k in INPUTS[:3]), spec.material))}
+    so = _sensing(spec, *(x[k] for k in INPUTS[:3]), None)
+    outputs["sensitivity"] = num(so["sensitivity"])
+    outputs["harvested_power"] = None if bool(np.asarray(so["power_flag"]).reshape(-1)[0]) else num(so["harvested_power"])
     checks = {c: bool(np.asarray(getattr(r, c)).reshape(-1)[0]) for c in CHECKS}
     checks["valid"] = bool(np.asarray(r.valid).reshape(-1)[0])
     checks["fidelity_used"] = str(np.asarray(r.fidelity_used).reshape(-1)[0])
