@@ -256,7 +256,9 @@ def test_exact_rung_against_the_bvp_subset(model):
 @pytest.mark.slow
 @pytest.mark.parametrize("model", MODELS3)
 def test_exact_rung_against_the_bvp_extremes(model):
-    _bvp_points(np.geomspace(1e-6, 1e-2, 4), (-20.0, -1e-4, 1e-3, 1.0, 20.0), model)
+    # the corners and the middle of 1 um - 10 mm x 1 mV - 20 V, both signs at the top (the subset
+    # test above holds -0.1 mV on thin strips, the tiny-voltage grid below the small signal)
+    _bvp_points(np.geomspace(1e-6, 1e-2, 3), (-20.0, 1e-3, 1.0, 20.0), model)
 
 
 TINY = (0.0, 5e-324, 1e-300, 1e-100, 1e-20, 1e-12, 1e-7)
