@@ -5,7 +5,7 @@ D = 3e-10 m^2/s and C_moy = 2600 mol/m^3 (the "truth" the example recovers; neit
 measured value): a 0.5 V step written by ``ipmc-asym step --out`` as it is (its columns,
 per-area units and signs; the model's own columns dropped) and an impedance spectrum written
 from ``ipmc-asym freq --json``'s ``Z_abs``, ``Z_phase`` (deg), with seeded noise: 2 % of each time
-column's root mean square, 1 % on |Z| and 0.01 rad on the phase.
+column's root mean square, 1 % on ``|Z|`` and 0.01 rad on the phase.
 
 Run from the repository root: ``python examples/make_dynamic_fit_data.py``.
 """

@@ -104,7 +104,7 @@ class SensingResponse(ResultMixin):
     power : ndarray               mean power into the load, ``|V_load|^2/(2 R)``, W (NaN without a load)
     error : ndarray               relative error against the exact linear form (``pnp-linear``: 0;
                                   ``circuit``: the impedance's and the leading-order EMF's)
-    one_way_error : ndarray       estimate of the neglected pressure feedback, (R T C_moy/E) |V_oc(f)/V_oc(0)|
+    one_way_error : ndarray       estimate of the neglected pressure feedback, (R T C_moy/E) ``|V_oc(f)/V_oc(0)|``
     check_one_way : ndarray of bool   one_way_error within ONE_WAY_GROWTH times its static value
     valid : ndarray of bool       check_one_way and the amplitude's strain and beam checks
     amplitude : float             peak tip displacement of the load columns, m
@@ -115,7 +115,7 @@ class SensingResponse(ResultMixin):
     f_stream : float              3 D/(2 pi e^2), Hz: where the streaming potential equals the static EMF
     f_d : float                   dielectric relaxation frequency, Hz
     check_strain, check_beam_regime : bool   of the amplitude (face strain e kappa0 <= strain_limit,
-                                  |kappa0| L <= pi/2); values kept
+                                  ``|kappa0|`` L <= pi/2); values kept
     notes : list of str
     """
 

@@ -194,7 +194,7 @@ def parse_waveform(spec) -> Waveform:
 
 
 def check_drive_voltage(name, volts) -> float:
-    """``volts`` (the largest |phi0| a drive reaches) within :data:`MAX_DRIVE_VOLTAGE`, else a
+    """``volts`` (the largest ``|phi0|`` a drive reaches) within :data:`MAX_DRIVE_VOLTAGE`, else a
     one-line ``ValueError`` naming ``name``."""
     v = abs(float(volts))
     if not v <= MAX_DRIVE_VOLTAGE:

@@ -72,7 +72,7 @@ class SenseResult(ResultMixin):
     strain_parameter : ndarray   b = (1 - 2 nu) kappa e/phi4 at the clamp
     max_strain : ndarray   face strain e|kappa| at the clamp
     check_strain : ndarray of bool   max_strain <= material.strain_limit (small strain; values kept)
-    check_beam_regime : ndarray of bool   the strip turns less than a quarter turn, |kappa0| L <= pi/2
+    check_beam_regime : ndarray of bool   the strip turns less than a quarter turn, ``|kappa0|`` L <= pi/2
         (the small-displacement beam relating w and kappa; values kept)
     valid : ndarray of bool   a rung met the tolerance and both checks hold
     fidelity_used : ndarray of str   the rung kept at each point

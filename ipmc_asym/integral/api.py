@@ -180,7 +180,7 @@ def _core_error(core, lam):
 
 @jit
 def _point(lam, A2, A3, rho, model_id, order):
-    """(I for |phi0|, error, B1, core) of one point; ``order`` 0 = quadrature, 3 = exact.
+    """(I for ``|phi0|``, error, B1, core) of one point; ``order`` 0 = quadrature, 3 = exact.
 
     ``error`` bounds the relative error of the returned ``I`` (not of one term of it).
     Zero volts: no field, I = 0 exactly (the odd extension; no 0/0).

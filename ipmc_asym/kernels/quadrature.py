@@ -5,7 +5,7 @@ The layer functions (``derivations/model.py``)
     W0(Y) = int_0^Y w(y) dy,        W1(Y) = int_0^Y (w(y)/y) W0(y) dy
 
 are integrated with composite Gauss-Legendre panels whose breakpoints double
-(0, 1/2, 1, 2, 4, ... |Y|): ``w`` is analytic with its nearest complex singularities at a
+(0, 1/2, 1, 2, 4, ... ``|Y|``): ``w`` is analytic with its nearest complex singularities at a
 distance comparable to ``|y|``, so each panel converges geometrically.  ``W0`` at the
 nodes comes from the spectral cumulative-integration matrix of the panel, so ``W1`` costs
 no extra evaluations of ``w``.  Along the way the distance from the wall to the point where
@@ -64,7 +64,7 @@ def doubling_panels(integrand):
 
 @jit
 def _layer(Y, rho, X, Wt, S):
-    """Return (W0(Y), W1(Y), width) where width = int_{|y|>=1} w/|y| dy (units of lambda)."""
+    """Return (W0(Y), W1(Y), width) where width = int_{``|y|``>=1} w/``|y|`` dy (units of lambda)."""
     n = X.shape[0]
     sgn = 1.0 if Y >= 0.0 else -1.0
     T = abs(Y)

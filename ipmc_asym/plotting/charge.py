@@ -75,7 +75,7 @@ def plot_step(path, voltage=1.0, strip: Strip | None = None, material=NAFION_LI)
 
 
 def plot_bode(path, strip: Strip | None = None, material=NAFION_LI) -> str:
-    """|Z|, arg Z and |w|/V, arg w: exact linearised PNP (lines) and the circuit (dashed)."""
+    """``|Z|``, arg Z and ``|w|``/V, arg w: exact linearised PNP (lines) and the circuit (dashed)."""
     s = Strip() if strip is None else strip
     plt = pyplot()
     fig, ax = plt.subplots(2, 2, figsize=(PAGE_WIDTH_IN, 4.4), sharex=True)

@@ -383,7 +383,7 @@ def predict(values: dict, geometry: dict, model="constant", fidelity="leading",
     Returns
     -------
     outputs : dict
-        ``deflection`` (|w|, large displacement, m) and ``blocking_force`` (|F|, large
+        ``deflection`` (``|w|``, large displacement, m) and ``blocking_force`` (``|F|``, large
         displacement, N): arrays (n_rows,), NaN where the beam has no answer.
     errors : dict
         Relative error estimate of each output, arrays (n_rows,): the error estimate of ``I``
@@ -904,7 +904,7 @@ def _bias_check(prob, res, out, errs, chi2, n, p, has_sigma):
     The per-point rule (error < 1/10 of the data's relative error) does not see that the
     estimates average over ``n`` points while a systematic model error does not average out.
     Linearised: the shift of the log parameters is ``G r_model`` with ``G = (J^T J)^+ J^T``
-    and ``r_model`` the worst-case weighted model error (error estimate x |prediction| /
+    and ``r_model`` the worst-case weighted model error (error estimate x ``|prediction|`` /
     weight scale, every sign the worst one: ``|G| |r_model|``).
     """
     J = np.asarray(res.jac, float)

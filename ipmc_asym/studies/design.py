@@ -29,10 +29,10 @@ Spec file (TOML; units as everywhere, thickness and width TOTAL)::
     confidence = 0.95                # ... with this confidence (distribution-free; samples raised to meet it)
     samples = 32
 
-Outputs (scene-file names): ``tip_deflection`` (|w|, large displacement), ``blocking_force``
-(|F|, large displacement), ``rotation`` (|theta|), ``moment`` (|M_A|), ``I``, ``work``
-(|F| |w|, force x deflection), ``max_strain`` (``e|kappa|``); the sensing outputs
-``sensitivity`` (the static short-circuit charge per tip displacement |Q/w|, C/m) and
+Outputs (scene-file names): ``tip_deflection`` (``|w|``, large displacement), ``blocking_force``
+(``|F|``, large displacement), ``rotation`` (``|theta|``), ``moment`` (``|M_A|``), ``I``, ``work``
+(``|F|`` ``|w|``, force x deflection), ``max_strain`` (``e|kappa|``); the sensing outputs
+``sensitivity`` (the static short-circuit charge per tip displacement ``|Q/w|``, C/m) and
 ``harvested_power`` (the mean power, W, into a resistance at a frequency for a tip amplitude,
 ``docs/sensing.md``), set by an optional table::
 

@@ -94,7 +94,7 @@ def _mid(v):
 
 
 def _mechanics(material: Material):
-    """|w|, |F_block| and the strain per unit charge of the nominal strip for each permittivity
+    """``|w|``, ``|F_block|`` and the strain per unit charge of the nominal strip for each permittivity
     model (quadrature): the membrane's face strain ``e|M_A|/EI`` (forward's ``max_strain``,
     the composite EI with layers) over the electrode charge per area ``|sigma|`` (which the
     layers do not change: the electrochemistry keeps the membrane)."""

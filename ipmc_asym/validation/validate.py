@@ -601,7 +601,7 @@ def _F_width(ctx):
 
 
 def _large_3mm(ctx):
-    """|w| at which the small-displacement deflection is off by the paper's 1 %."""
+    """``|w|`` at which the small-displacement deflection is off by the paper's 1 %."""
     acc = CLAIM_PAPER["block_1pct"]
     L = ctx.s.length
     kl = np.linspace(1e-4, math.pi / 2, 40001)
