@@ -27,7 +27,9 @@ The stated relative error (``error``): the circuit's impedance ``lam/2`` (the bo
 :func:`ipmc_asym.dynamics.circuit.circuit_impedance_error`, at any frequency) + the leading-order
 EMF's ``max |v_lead/v_exact - 1|`` up to the fastest frequency of the run (the drive's highest for
 periodic drives; ``1/(2 pi dt)`` of the output spacing for steps, ramps and measured drives) +
-the interpolation's.  Assumptions as :func:`ipmc_asym.sensing_response` (water instantly
+the interpolation's + the linearisation's (the static leading rung's ``2 |c3| b^2 (1 + lam)`` at
+the peak bend).  ``error_settled``: the same for the relaxed rows, the DC values of the first two
+(exponentially small in ``1/lam``) + the linearisation's.  Assumptions as :func:`ipmc_asym.sensing_response` (water instantly
 redistributed; one-way coupling, rows flagged where ``|e(t)|`` exceeds ``ONE_WAY_GROWTH`` times the
 static EMF of the largest bend; the static sense's strain and beam limits per row, kept and flagged).
 """
@@ -42,6 +44,7 @@ from scipy.linalg import expm
 
 from ipmc_asym.base.registry import check_choice
 from ipmc_asym.base.results import Panel, ResultMixin, ResultSpec
+from ipmc_asym.dynamics.circuit import circuit_impedance_error
 from ipmc_asym.dynamics.electrode import capacitance_scale, core_resistance
 from ipmc_asym.dynamics.sensing import (
     ONE_WAY_GROWTH,
@@ -52,7 +55,7 @@ from ipmc_asym.dynamics.sensing import (
 )
 from ipmc_asym.dynamics.waveforms import Waveform, parse_waveform
 from ipmc_asym.forward.sensing import DEFAULT_NU, SENSE_SUPPORTS, tip_curvature
-from ipmc_asym.integral.sensing import B_LIMIT, strain_parameter
+from ipmc_asym.integral.sensing import B_LIMIT, sense_hat, strain_parameter
 from ipmc_asym.kernels.lti import lti_foh
 from ipmc_asym.model import groups
 from ipmc_asym.model.params import NAFION_LI, NOMINAL_STRIP, Material, Strip, check_finite
@@ -84,7 +87,9 @@ class SensingTransient(ResultMixin):
     power : ndarray         instantaneous power into the load V I, W
     check_strain, check_beam_regime, check_one_way, valid : ndarray of bool   per row (values kept)
     error : float           stated relative error of Q, I, V (module docstring)
-    error_circuit, error_emf, error_interp : float   its parts
+    error_circuit, error_emf, error_interp, error_linear : float   its parts
+    error_settled : float   stated relative error of the relaxed rows (many ``tau`` and ``e^2/D`` after the
+                            last change of ``w``): the circuit's and the EMF's DC errors + the linearisation's
     mean_power : float      time-mean of ``power`` over the last whole period (periodic drives) or the run, W
     load : str or float ; load_resistance : float (Ohm, NaN for short/open)
     support, model, waveform : str ; nu, tau, f_stream, f_top : float
@@ -94,7 +99,7 @@ class SensingTransient(ResultMixin):
     _result = ResultSpec("t", "t", ("w", "kappa", "emf", "Q", "I", "V", "power", "check_strain",
                                     "check_beam_regime", "check_one_way", "valid"),
                          (Panel("t", ("w",)), Panel("t", ("Q",)), Panel("t", ("V",)), Panel("t", ("I",))),
-                         ("nu", "load_resistance", "tau", "f_stream", "f_top", "error", "mean_power"),
+                         ("nu", "load_resistance", "tau", "f_stream", "f_top", "error", "error_settled", "mean_power"),
                          {"w": "tip_displacement", "kappa": "curvature", "I": "I_load", "V": "V_load",
                           "power": "power_instant", "error": "error_sensing", "mean_power": "harvested_power"})
     _HEADLINE = ("model", "support", "load", "waveform")
@@ -115,6 +120,8 @@ class SensingTransient(ResultMixin):
     error_circuit: float
     error_emf: float
     error_interp: float
+    error_linear: float
+    error_settled: float
     mean_power: float
     load: object
     load_resistance: float
@@ -220,9 +227,9 @@ def sensing_transient(waveform, duration, points: int = 2001, strip: Strip | Non
     Examples
     --------
     >>> import ipmc_asym as ia
-    >>> r = ia.sensing_transient("step:1mm", 5.0, 101, model="linear")
+    >>> r = ia.sensing_transient("step:1mm", 20.0, 101, model="linear")  # 40 tau: relaxed
     >>> static = ia.sense(tip_displacement=[1e-3], support="tip-force", model="linear").Q[0]
-    >>> abs(r.Q[-1] / static - 1) < r.error
+    >>> bool(abs(r.Q[-1] / static - 1) < r.error_settled)
     True
     """
     check_choice("support", support, SENSE_SUPPORTS)
@@ -320,7 +327,16 @@ def sensing_transient(waveform, duration, points: int = 2001, strip: Strip | Non
     Ws = 2.0 * math.pi * fs * e * e / m.D
     err_emf = float(np.max(np.abs(voc_hat_leading(Ws, lam) / voc_hat(Ws, lam) - 1.0)))
     err_circ = 0.5 * lam
-    error = (err_circ + err_emf + interp) * (1.0 + 1e-12) + 1e-15
+    # linearisation: the static leading rung's bound 2 |c3| b^2 (1 + lam) at the peak clamp curvature
+    # (integral/sensing.py; the nonlinear part of the relaxed response this linear circuit leaves out)
+    b_peak = float(strain_parameter(k_peak, s.thickness, nu, m))
+    hat = sense_hat(np.array([abs(b_peak)]), lam, perm, m, "leading", escalate=False)
+    err_lin = float(max(hat.error[0], hat.error_v[0])) if b_peak != 0.0 else 0.0
+    error = (err_circ + err_emf + interp + err_lin) * (1.0 + 1e-12) + 1e-15
+    # the relaxed state (rows many tau and e^2/D after the last change of w): the DC parts only
+    dc_circ = float(circuit_impedance_error(np.array([1e-12]), s.thickness, perm, m)[0])
+    dc_emf = float(abs(voc_hat_leading(0.0, lam) / voc_hat(0.0, lam) - 1.0))
+    error_settled = (dc_circ + dc_emf + err_lin) * (1.0 + 1e-12) + 1e-15
 
     # flags (values kept): the static sense's strain and beam limits, and the one-way coupling
     check_strain = e * np.abs(kappa) <= m.strain_limit
@@ -344,7 +360,8 @@ def sensing_transient(waveform, duration, points: int = 2001, strip: Strip | Non
              "actuation's reduced circuit (R, C_g, C_d(0)), integrated exactly for b linear between knots; at a jump "
              "of w the streaming EMF is a delta (not in the samples; its charge is)",
              f"error = lambda/2 (circuit impedance, any frequency) {err_circ:.3g} + leading-order EMF up to "
-             f"f_top = {f_top:.3g} Hz {err_emf:.3g} + interpolation {interp:.2g}",
+             f"f_top = {f_top:.3g} Hz {err_emf:.3g} + interpolation {interp:.2g} + linearisation {err_lin:.2g}; "
+             f"relaxed rows (many tau after the last change of w): error_settled = {error_settled:.2g}",
              f"one-way coupling: rows where |e(t)| exceeds {ONE_WAY_GROWTH:g} times the static EMF of the largest bend "
              "are flagged (check_one_way)",
              f"tip displacement imposed quasi-statically ({support}); drained Poisson ratio nu = {nu:g} (an assumption)",
@@ -355,7 +372,9 @@ def sensing_transient(waveform, duration, points: int = 2001, strip: Strip | Non
                      "potential is not small there (the one-way flag says where it matters)")
     return SensingTransient(t=t, w=w, kappa=kappa, emf=emf, Q=Q, I=I, V=V, power=power, check_strain=check_strain,
                             check_beam_regime=check_beam, check_one_way=check_one_way, valid=valid, error=error,
-                            error_circuit=err_circ, error_emf=err_emf, error_interp=interp, mean_power=mean_power,
+                            error_circuit=err_circ, error_emf=err_emf, error_interp=interp, error_linear=err_lin,
+                            error_settled=error_settled,
+                            mean_power=mean_power,
                             load=load, load_resistance=R_L, support=support, model=perm.name,
                             waveform=getattr(wave, "spec", repr(wave)), nu=nu, tau=tau, f_stream=f_stream,
                             f_top=f_top, notes=notes)
