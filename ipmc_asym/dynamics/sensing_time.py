@@ -18,10 +18,14 @@ impedance ``Z``.  Both are taken from their reduced forms:
 Linear, so by superposition ``Q = -K [(1 - lam) q + (e^2/(3D)) q']`` with ``q = G b`` the charge the
 circuit takes from an applied voltage ``b(t)`` (``K = 2 R T/F``, ``G = 1/(s (Z + R_load))``):
 the derivative of the EMF never has to be integrated (a step in ``w`` is a delta in ``db/dt``).
-``q`` is integrated exactly for ``b`` linear between knots (the augmented matrix exponential,
-:mod:`ipmc_asym.kernels.lti`): the only discretisation error is the linear interpolation of ``b``,
-``h^2 max|b''|/8`` (the knots refined until it is below 1e-6 of ``max|b|``; jumps of steps and
-square waves are knots).
+``q``, ``q'`` and ``q''`` are the circuit driven by ``b``, ``b'`` and ``b''`` (``G b' = (G b)'`` from
+rest; each input interpolated on its own, so no output is a difference of near-equal states over a
+short time constant), integrated exactly for inputs linear between knots (the augmented matrix
+exponential, :mod:`ipmc_asym.kernels.lti`); the impulses of ``b'`` and ``b''`` at the jumps of ``b``
+(steps, square flips, and ``t = 0`` from rest) are kicks of the states.  The only discretisation
+error is the linear interpolation, ``h^2 max|b''|/8`` (the knots refined until it is below 1e-6 of
+``max|b|``; jumps are knots; the corners of ramps, triangles and measured drives are not, and the
+delta of the streaming current there is not in ``I``).
 
 The stated relative error (``error``): the circuit's impedance ``lam/2`` (the bound of
 :func:`ipmc_asym.dynamics.circuit.circuit_impedance_error`, at any frequency) + the leading-order
@@ -173,7 +177,8 @@ def _knots(wave: Waveform, duration, points):
     knots = np.union1d(grid, tj) if tj.size else grid
     h = grid[1] - grid[0]
     interp = d2 * h * h / (8.0 * peak) if peak > 0 else 0.0
-    return knots, interp
+    # the output rows are every sub-th point of the grid, found among the knots by their exact values
+    return knots, interp, grid[::sub]
 
 
 def _segments(wave, knots, scale):
@@ -258,8 +263,7 @@ def sensing_transient(waveform, duration, points: int = 2001, strip: Strip | Non
     if abs(float(strain_parameter(k_peak, s.thickness, nu, m))) >= B_LIMIT:
         raise ValueError(f"waveform: a peak tip displacement of {peak:.3g} m gives (1 - 2 nu) |kappa0| e/phi4 >= 1 "
                          "(a face would lose all its water)")
-    knots, interp = _knots(wave, T, points)
-    t = np.linspace(0.0, T, points)
+    knots, interp, t = _knots(wave, T, points)
     w = wave(t)
     kappa = np.asarray(tip_curvature(w, L, support), dtype=float)
 
@@ -293,26 +297,42 @@ def sensing_transient(waveform, duration, points: int = 2001, strip: Strip | Non
             A = np.array([[-1.0 / tau, 1.0 / R],
                           [gam / (R * C0 * Cg), -(1.0 + R_L * gam / R) / (R_L * Cg)]])
             B = np.array([0.0, 1.0 / (R_L * Cg)])
-        u0, us, hs = _segments(wave, knots, b_per_w)
-        Phi, G0, G1, which = _discretise(A, B, hs)
-        xs = np.zeros((hs.size, A.shape[0]))
-        lti_foh(Phi, G0, G1, which, u0, us, np.zeros(A.shape[0]), xs)
-        xk = np.vstack([np.zeros((1, A.shape[0])), xs])
-        idx = np.searchsorted(knots, t)
-        idx[-1] = knots.size - 1
-        x = xk[idx]
+        # q, q' and q'' are the circuit driven by b, b' and b'' (G b' = (G b)' from rest): each input
+        # interpolated on its own, so no output is a difference of near-equal states over a short time
+        # constant; the impulses of b' and b'' at the jumps of b (and at t = 0, from rest) kick the states
+        n_x = A.shape[0]
+        tj, dj = wave.jumps(0.0, T)
+        seg_j = np.searchsorted(knots, tj)  # a jump at knot i starts segment i
+        d1_0 = float(wave.derivative(np.array([0.0]), 1)[0])
+        x0 = np.zeros(n_x)
+        res = []
+        for order in (0, 1, 2):
+            fun = wave if order == 0 else (lambda tt, o=order: wave.derivative(tt, o))
+            u0, us, hs = _segments(fun, knots, b_per_w)
+            if order == 0:
+                Phi, G0, G1, which = _discretise(A, B, hs)
+            # from rest: b jumps by b(0+) and b' by b'(0+) at t = 0; later jumps of b by dj
+            at, kicks = [0], [np.zeros(n_x)]
+            if order == 1:
+                kicks[0] = B * b_per_w * float(wave(np.array([0.0]))[0])
+                at += seg_j.tolist()
+                kicks += [B * b_per_w * d for d in dj]
+            elif order == 2:
+                kicks[0] = A @ B * b_per_w * float(wave(np.array([0.0]))[0]) + B * b_per_w * d1_0
+                at += seg_j.tolist()
+                kicks += [A @ B * b_per_w * d for d in dj]
+            at = np.asarray(at, dtype=np.int64)
+            kicks = np.asarray(kicks, dtype=float).reshape(-1, n_x)
+            xs = np.zeros((hs.size, n_x))
+            lti_foh(Phi, G0, G1, which, u0, us, at, kicks, x0, xs)
+            xk = np.vstack([x0[None, :], xs])
+            np.add.at(xk, at, kicks)  # the rows report right-limits: after the kick at their knot
+            res.append(xk[np.searchsorted(knots, t)])
+        ins = (b, db, d2b)
         if load == "short":
-            sL = x[:, 0]
-            dsL = (b - sL / C0) / R
-            q = gam * sL + Cg * b
-            dq = gam * dsL + Cg * db
-            d2q = gam * (db - dsL / C0) / R + Cg * d2b
+            q, dq, d2q = (gam * x[:, 0] + Cg * u for x, u in zip(res, ins))
         else:
-            sL, v = x[:, 0], x[:, 1]
-            q = gam * sL + Cg * v
-            dq = (b - v) / R_L
-            dv = A[1, 0] * sL + A[1, 1] * v + B[1] * b
-            d2q = (db - dv) / R_L
+            q, dq, d2q = (gam * x[:, 0] + Cg * x[:, 1] for x in res)
         Q = -K * ((1.0 - lam) * q + ts * dq)
         I = K * ((1.0 - lam) * dq + ts * d2q)  # -dQ/dt
         V = np.zeros(points) if load == "short" else R_L * I
@@ -367,6 +387,9 @@ def sensing_transient(waveform, duration, points: int = 2001, strip: Strip | Non
              f"tip displacement imposed quasi-statically ({support}); drained Poisson ratio nu = {nu:g} (an assumption)",
              "Q: charge of the electrode z = -e; I = -dQ/dt through the load from z = -e to z = +e; V across the load "
              "(open circuit: the EMF); power = V I"]
+    if not isinstance(load, str):
+        notes.append(f"with the load the layers charge through R + R_load: time constant (R + R_load) C_d = "
+                     f"{(R + R_L) * C0:.4g} s (the start-up transient; the mean power is over the last period)")
     if f_top > 0.5 * f_stream:
         notes.append(f"the drive reaches f_top = {f_top:.3g} Hz, past f_stream/2 = {0.5 * f_stream:.3g} Hz: the streaming "
                      "potential is not small there (the one-way flag says where it matters)")

@@ -17,17 +17,24 @@ __all__ = ["lti_foh"]
 
 
 @jit
-def lti_foh(Phi, G0, G1, which, u_start, u_slope, x0, out):
+def lti_foh(Phi, G0, G1, which, u_start, u_slope, kick_at, kick, x0, out):
     """States at every segment end: ``out[k]`` = ``x(t_k+1)`` (``out`` shape ``(n_seg, n)``).
 
-    ``Phi`` (n_tab, n, n), ``G0``, ``G1`` (n_tab, n); ``x0`` the state at ``t_0``.
+    ``Phi`` (n_tab, n, n), ``G0``, ``G1`` (n_tab, n); ``x0`` the state at ``t_0``; ``kick[i]`` is
+    added to the state at the start of segment ``kick_at[i]`` (sorted): the state's jump under an
+    impulse of the input (``B`` times its weight).
     """
     n = x0.shape[0]
     x = np.empty(n)
     y = np.empty(n)
     for i in range(n):
         x[i] = x0[i]
+    ik = 0
     for k in range(which.shape[0]):
+        while ik < kick_at.shape[0] and kick_at[ik] == k:
+            for i in range(n):
+                x[i] += kick[ik, i]
+            ik += 1
         j = which[k]
         for i in range(n):
             acc = G0[j, i] * u_start[k] + G1[j, i] * u_slope[k]
