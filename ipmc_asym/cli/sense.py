@@ -151,7 +151,7 @@ def _run_time(args, strip, material):
     for m, r in results.items():
         for c, what in (("check_strain", f"face strain above the small-strain limit {material.strain_limit:g}"),
                         ("check_beam_regime", "|kappa0| L past a quarter turn (the small-displacement beam)"),
-                        ("check_one_way", "|e(t)| past twice the static EMF of the largest bend (one-way coupling)")):
+                        ("check_one_way", "core voltage past twice the static EMF of the largest bend (one-way coupling)")):
             bad = int(np.count_nonzero(~getattr(r, c)))
             if bad:
                 warnings.append(f"{m}: {bad} of {r.t.size} rows: {what}; kept, flagged valid = false")
