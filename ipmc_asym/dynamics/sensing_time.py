@@ -73,6 +73,8 @@ MAX_SENSE_POINTS = 1_000_000
 MAX_SENSE_STEPS = 5_000_000
 #: relative interpolation error of b between knots aimed at
 INTERP_TOL = 1e-6
+#: rows the mean power's window needs (trapezoid of a sampled period: relative error ~ (pi/n)^2/3)
+MIN_POWER_ROWS = 200
 
 
 @dataclass(repr=False)
@@ -95,6 +97,7 @@ class SensingTransient(ResultMixin):
     error_settled : float   stated relative error of the relaxed rows (many ``tau`` and ``e^2/D`` after the
                             last change of ``w``): the circuit's and the EMF's DC errors + the linearisation's
     mean_power : float      time-mean of ``power`` over the last whole period (periodic drives) or the run, W
+                            (NaN with fewer than MIN_POWER_ROWS rows there)
     load : str or float ; load_resistance : float (Ohm, NaN for short/open)
     support, model, waveform : str ; nu, tau, f_stream, f_top : float
     notes : list of str
@@ -375,8 +378,10 @@ def sensing_transient(waveform, duration, points: int = 2001, strip: Strip | Non
         per = 1.0 / min(p["f"] for k, p in wave.terms if "f" in p)
         if per <= T:
             sel = t >= T - per
-    mean_power = float(np.trapezoid(power[sel], t[sel]) / max(t[sel][-1] - t[sel][0], 1e-300)) if sel.sum() > 1 \
-        else float(power[-1])
+    # the trapezoid of the sampled power: only with enough rows in the window (else NaN, noted)
+    mean_power = math.nan
+    if sel.sum() >= MIN_POWER_ROWS:
+        mean_power = float(np.trapezoid(power[sel], t[sel]) / (t[sel][-1] - t[sel][0]))
     f_stream = 3.0 * m.D / (2.0 * math.pi * e * e)
     notes = [WATER_ASSUMPTION, STREAMING_NOTE,
              "time domain: EMF e(t) = (R T/F) 2 [(1 - lambda) b + (e^2/(3 D)) db/dt] (leading order in lambda) behind the "
@@ -390,6 +395,8 @@ def sensing_transient(waveform, duration, points: int = 2001, strip: Strip | Non
              f"tip displacement imposed quasi-statically ({support}); drained Poisson ratio nu = {nu:g} (an assumption)",
              "Q: charge of the electrode z = -e; I = -dQ/dt through the load from z = -e to z = +e; V across the load "
              "(open circuit: the EMF); power = V I"]
+    if not isinstance(load, str) and math.isnan(mean_power):
+        notes.append(f"mean power not computed: fewer than {MIN_POWER_ROWS} rows in its window (raise points)")
     if not isinstance(load, str):
         notes.append(f"with the load the layers charge through R + R_load: time constant (R + R_load) C_d = "
                      f"{(R + R_L) * C0:.4g} s (the start-up transient; the mean power is over the last period)")
