@@ -77,7 +77,7 @@ def test_open_circuit_voltage_is_the_emf_formula():
 
 def test_power_into_the_load_is_i2r():
     R = 2.2e3
-    # (R + R_load) C_d ~ 220 s for the linear model: 3000 s leaves e^-13 of the start-up
+    # (R + R_load) C_d ~ 230 s for the linear model: 3000 s leaves e^-13 of the start-up
     r = ia.sensing_transient("sine:1mm@3mHz", 3000.0, 6001, model="linear", load=R)
     assert np.allclose(r.power, r.I**2 * R, rtol=1e-12, atol=0)
     assert np.allclose(r.V, r.I * R, rtol=1e-12, atol=0)
