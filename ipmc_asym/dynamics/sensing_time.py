@@ -339,7 +339,8 @@ def sensing_transient(waveform, duration, points: int = 2001, strip: Strip | Non
         Q = -K * ((1.0 - lam) * q + ts * dq)
         I = K * ((1.0 - lam) * dq + ts * d2q)  # -dQ/dt
         V = np.zeros(points) if load == "short" else R_L * I
-    power = V * I
+    Q, I, V = Q + 0.0, I + 0.0, V + 0.0  # + 0.0: no "-0" in the rows
+    power = V * I + 0.0
 
     # the stated error: circuit (lam/2 at any frequency), leading-order EMF up to f_top, interpolation
     periodic_only = all(k in ("sine", "square", "triangle", "dc") for k, _ in wave.terms) and wave.max_frequency > 0
