@@ -45,6 +45,7 @@ _LAZY = {
     "charge": ("ipmc_asym.integral.charge", "charge"),
     "sense": ("ipmc_asym.forward.sensing", "sense"),
     "sensing_response": ("ipmc_asym.dynamics.sensing", "sensing_response"),
+    "sensing_transient": ("ipmc_asym.dynamics.sensing_time", "sensing_transient"),
     "Drive": ("ipmc_asym.dynamics.entry", "Drive"),
     "time_response": ("ipmc_asym.dynamics.entry", "time_response"),
     "spectrum": ("ipmc_asym.dynamics.entry", "spectrum"),

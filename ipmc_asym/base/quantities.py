@@ -148,6 +148,10 @@ QUANTITIES = (
     Quantity("amplitude", "m", "peak tip displacement of the load columns"),
     Quantity("load_resistance", "Ohm", "resistance of the load across the electrodes"),
     Quantity("sensitivity", "C/m", "static short-circuit charge per tip displacement |Q/w| (design output)"),
+    Quantity("emf", "V", "EMF of the bent strip in time (its open-circuit voltage phi(-e) - phi(e))"),
+    Quantity("power_instant", "W", "instantaneous power into the load V I"),
+    Quantity("error_settled", "1", "relative error of the relaxed rows of a sensing transient"),
+    Quantity("f_top", "Hz", "highest frequency the time-domain error is evaluated to"),
     Quantity("f_stream", "Hz", "frequency 3 D/(2 pi e^2) where the streaming potential equals the static EMF"),
 )
 

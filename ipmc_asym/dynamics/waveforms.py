@@ -13,7 +13,10 @@ command line)::
 
 e.g. ``dc:0.2V+sine:0.5V@10Hz`` or ``step:1V+square:0.1V@50Hz``.  :func:`parse_waveform`
 returns a vectorised callable (volts); any Python callable ``f(t)`` is accepted by the dynamic
-functions as well.
+functions as well.  ``parse_waveform(spec, quantity="length")`` reads the same grammar with
+lengths (``sine:1mm@0.01Hz``, ``step:0.5mm``; a bare number is metres): the imposed tip
+displacement of sensing.  :meth:`Waveform.derivative` and :meth:`Waveform.jumps` give the regular
+part of its time derivatives and its discontinuities (the streaming EMF of sensing needs them).
 """
 
 from __future__ import annotations
@@ -28,7 +31,7 @@ import numpy as np
 
 from ipmc_asym.base.inputs import read_input_text
 from ipmc_asym.base.settings import MAX_DRIVE_VOLTAGE, VALIDATED_VOLTAGE
-from ipmc_asym.base.units import parse_quantity, parse_time, parse_voltage
+from ipmc_asym.base.units import parse_length, parse_quantity, parse_time, parse_voltage
 
 __all__ = ["Waveform", "parse_waveform", "WAVEFORM_KINDS", "MAX_CSV_ROWS"]
 
@@ -68,6 +71,35 @@ class Waveform:
     def __repr__(self):
         return f"Waveform({self.spec!r})"
 
+    def derivative(self, t, order=1):
+        """Regular part of the ``order``-th time derivative (1 or 2) at ``t``: the jumps of step and
+        square terms and the corners of ramp, triangle and csv terms are left out (their deltas live
+        at isolated instants; :meth:`jumps` lists the jumps)."""
+        t = np.asarray(t, dtype=float)
+        d = np.zeros(t.shape)
+        for kind, p in self.terms:
+            d = d + _term_derivative(kind, p, t, order)
+        return d
+
+    def jumps(self, t0, t1):
+        """``(times, sizes)`` of the discontinuities in ``(t0, t1]`` (sorted; steps after 0 and square flips)."""
+        out = {}
+        for kind, p in self.terms:
+            if kind == "step" and t0 < p["t0"] <= t1:
+                out[p["t0"]] = out.get(p["t0"], 0.0) + p["V"]
+            elif kind == "square":
+                f, ph = p["f"], p.get("phase", 0.0) / 360.0
+                n0 = math.floor(2.0 * (f * t0 + ph)) + 1
+                n1 = math.floor(2.0 * (f * t1 + ph))
+                if n1 - n0 + 1 > MAX_CSV_ROWS:
+                    raise ValueError(f"square term: more than {MAX_CSV_ROWS} flips in the duration")
+                for n in range(n0, n1 + 1):
+                    tj = (0.5 * n - ph) / f
+                    if t0 < tj <= t1:
+                        out[tj] = out.get(tj, 0.0) + (2.0 * p["V"] if n % 2 == 0 else -2.0 * p["V"])
+        ts = np.array(sorted(out))
+        return ts, np.array([out[x] for x in ts])
+
 
 def _term(kind, p, t):
     V = p.get("V", 0.0)
@@ -89,7 +121,32 @@ def _term(kind, p, t):
     return V * np.where(frac < 0.25, 4.0 * frac, np.where(frac < 0.75, 2.0 - 4.0 * frac, 4.0 * frac - 4.0))
 
 
-def _read_csv(path):
+def _term_derivative(kind, p, t, order):
+    V = p.get("V", 0.0)
+    if kind in ("dc", "step", "square"):
+        return np.zeros(t.shape)
+    if kind == "ramp":
+        inside = (t >= p["t0"]) & (t < p["t0"] + p["tr"])
+        return np.where(inside, V / p["tr"], 0.0) if order == 1 else np.zeros(t.shape)
+    if kind == "csv":
+        if order != 1:
+            return np.zeros(t.shape)
+        tp, vp = p["t"], p["v"]
+        i = np.clip(np.searchsorted(tp, t, side="right") - 1, 0, tp.size - 2)
+        slope = (vp[i + 1] - vp[i]) / (tp[i + 1] - tp[i])
+        return np.where((t >= tp[0]) & (t < tp[-1]), slope, 0.0)
+    w = 2.0 * math.pi * p["f"]
+    x = p["f"] * t + p.get("phase", 0.0) / 360.0
+    if kind == "sine":
+        return V * w**order * np.sin(2.0 * math.pi * x + 0.5 * math.pi * order)
+    # triangle: slope +-4 V f, no curvature between corners
+    if order != 1:
+        return np.zeros(t.shape)
+    frac = x - np.floor(x)
+    return np.where((frac < 0.25) | (frac >= 0.75), 4.0 * V * p["f"], -4.0 * V * p["f"])
+
+
+def _read_csv(path, parse_value=parse_voltage):
     if not os.path.exists(path):
         raise ValueError(f"waveform csv: no such file {path!r}")
     ts, vs = [], []
@@ -110,7 +167,7 @@ def _read_csv(path):
                 raise ValueError(f"waveform csv {path!r} line {i + 1}: needs two columns t, V")
             try:
                 t = parse_time("waveform csv t", row[0].strip())
-                v = parse_voltage("waveform csv V", row[1].strip())
+                v = parse_value("waveform csv V", row[1].strip())
             except ValueError:
                 if not ts and i == 0:
                     continue  # header row
@@ -128,16 +185,23 @@ def _read_csv(path):
 _TERM = re.compile(r"^\s*([a-z]+)\s*:\s*(.+?)\s*$", re.IGNORECASE)
 
 
-def parse_waveform(spec) -> Waveform:
+def parse_waveform(spec, quantity="voltage") -> Waveform:
     """Read a waveform ``SPEC`` (module docstring); ``ValueError`` naming the bad term.
+
+    ``quantity``: ``"voltage"`` (volts, capped at the drive's voltage) or ``"length"`` (metres, the
+    imposed tip displacement of sensing; its caps are the caller's: the static sense's limits).
 
     >>> parse_waveform("dc:0.2V+sine:0.5V@10Hz")(np.array([0.025]))
     array([0.7])
     """
     if isinstance(spec, Waveform):
         return spec
+    if quantity not in ("voltage", "length"):
+        raise ValueError(f"quantity must be voltage or length; got {quantity!r}")
+    unit = "V" if quantity == "voltage" else "mm"
     if not isinstance(spec, str) or not spec.strip():
-        raise ValueError("waveform must be a SPEC such as 'sine:1V@10Hz' or 'step:1V+square:0.1V@50Hz'")
+        raise ValueError(f"waveform must be a SPEC such as 'sine:1{unit}@10Hz' or 'step:1{unit}+square:0.1{unit}@50Hz'")
+    parse_value = parse_voltage if quantity == "voltage" else parse_length
     parts = [p for p in re.split(r"\+(?=\s*[a-zA-Z]+\s*:)", spec) if p.strip()]
     terms = []
     for part in parts:
@@ -148,16 +212,16 @@ def parse_waveform(spec) -> Waveform:
         name = f"waveform term {part.strip()!r}"
         try:
             if kind == "csv":
-                t, v = _read_csv(arg)
+                t, v = _read_csv(arg, parse_value)
                 terms.append((kind, {"t": t, "v": v}))
                 continue
             if kind not in WAVEFORM_KINDS:
                 raise ValueError(f"kind must be one of {', '.join(WAVEFORM_KINDS)}")
             if kind in ("dc",):
-                terms.append((kind, {"V": parse_voltage(name, arg)}))
+                terms.append((kind, {"V": parse_value(name, arg)}))
             elif kind == "step":
                 a, _, t0 = arg.partition("@")
-                terms.append((kind, {"V": parse_voltage(name, a), "t0": parse_time(name, t0) if t0 else 0.0}))
+                terms.append((kind, {"V": parse_value(name, a), "t0": parse_time(name, t0) if t0 else 0.0}))
             elif kind == "ramp":
                 a, _, rest = arg.partition("/")
                 tr, _, t0 = rest.partition("@")
@@ -166,13 +230,13 @@ def parse_waveform(spec) -> Waveform:
                 trv = parse_time(name, tr)
                 if not trv > 0:
                     raise ValueError("the ramp time TR must be > 0 s")
-                terms.append((kind, {"V": parse_voltage(name, a), "tr": trv, "t0": parse_time(name, t0) if t0 else 0.0}))
+                terms.append((kind, {"V": parse_value(name, a), "tr": trv, "t0": parse_time(name, t0) if t0 else 0.0}))
             else:
                 a, _, rest = arg.partition("@")
                 if not rest:
-                    raise ValueError(f"{kind} needs V@F, e.g. {kind}:1V@10Hz")
+                    raise ValueError(f"{kind} needs V@F, e.g. {kind}:1{unit}@10Hz")
                 fq, _, ph = rest.partition(",")
-                p = {"V": parse_voltage(name, a), "f": _freq(name, fq)}
+                p = {"V": parse_value(name, a), "f": _freq(name, fq)}
                 if ph:
                     if kind != "sine":
                         raise ValueError("a phase is only read for a sine")
@@ -189,7 +253,8 @@ def parse_waveform(spec) -> Waveform:
             msg = str(exc)
             raise ValueError(msg if msg.startswith("waveform") else f"{name}: {msg}") from None
     peak = sum(abs(p["V"]) if "V" in p else float(np.max(np.abs(p["v"]), initial=0.0)) for _, p in terms)
-    check_drive_voltage("waveform", peak)
+    if quantity == "voltage":
+        check_drive_voltage("waveform", peak)
     return Waveform(spec, terms)
 
 

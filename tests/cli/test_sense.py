@@ -46,12 +46,13 @@ def test_negative_curvature_is_the_mirror(capsys):
 
 @pytest.mark.parametrize("argv,needle", [
     (["--curvature", "2m"], "curvature: unknown unit 'm'"),
-    (["--curvature", "2", "--load", "100ohm"], "--load must be one of short, open"),
+    (["--curvature", "2", "--load", "100ohm"], "--load R: after relaxation (DC) a resistive load carries no current"),
+    (["--curvature", "2", "--load", "lots"], "--load must be short, open or a resistance"),
     (["--curvature", "2", "--nu", "0.6"], "--nu must be a drained Poisson ratio in [0, 0.5]"),
     (["--curvature", "1e4"], "curvature: (1 - 2 nu) |kappa| e/phi4"),
     (["--tip-displacement", "1mm", "--support", "pinned"], "argument --support: invalid choice"),
     (["--curvature", "2", "--tip-displacement", "1mm"], "not allowed with argument"),
-    ([], "one of the arguments --curvature --tip-displacement is required"),
+    ([], "one of the arguments --curvature --tip-displacement --waveform is required"),
     (["--curvature", "2", "--out", "x.xlsx"], "allowed: .csv, .nc"),
 ])
 def test_refusals_one_line_exit_2(capsys, argv, needle):
@@ -96,3 +97,58 @@ def test_csv_and_netcdf_outputs(capsys, tmp_path):
         assert float(ds["Q"].sel(model="affine")[0]) == float(r.Q[0])
         assert ds["Q"].attrs["units"] == "C"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["s.csv", "s.nc"]
+
+
+# ---- --waveform: the time domain -----------------------------------------------------------------
+
+def test_waveform_json_rows_are_the_library(capsys):
+    rc, out, err = _run(capsys, "--waveform", "sine:1mm@5mHz", "--duration", "400s", "--points", "41",
+                        "--support", "tip-force", "--model", "linear", "--load", "1kOhm", "--json")
+    assert rc == 0 and err == ""
+    doc = json.loads(out)
+    r = ia.sensing_transient("sine:1mm@5mHz", 400.0, 41, model="linear", load=1e3, support="tip-force")
+    rows = doc["results"]
+    assert len(rows) == 41 and doc["inputs"]["load"] == 1000.0
+    assert [x["Q"] for x in rows] == r.Q.tolist() and [x["power"] for x in rows] == r.power.tolist()
+    assert doc["summary"]["linear"]["error"] == r.error
+
+
+def test_waveform_table_columns(capsys):
+    rc, out, _ = _run(capsys, "--waveform", "step:1mm", "--duration", "2s", "--points", "5", "--model", "constant",
+                      "--load", "open")
+    assert rc == 0 and "V [V]" in out and "Q [C]" not in out and "stated relative error" in out
+    rc, out, _ = _run(capsys, "--waveform", "step:1mm", "--duration", "2s", "--points", "5", "--model", "constant",
+                      "--load", "470ohm")
+    assert rc == 0 and all(h in out for h in ("Q [C]", "V [V]", "I [A]", "power [W]", "mean power"))
+
+
+def test_waveform_csv(capsys, tmp_path):
+    p = tmp_path / "s.csv"
+    rc, _, _ = _run(capsys, "--waveform", "step:1mm", "--duration", "1s", "--points", "11", "--out", str(p))
+    assert rc == 0
+    with p.open(newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    assert len(rows) == 33 and {r["model"] for r in rows} == {"constant", "linear", "affine"}
+    r = ia.sensing_transient("step:1mm", 1.0, 11, model="affine", support="free")
+    got = [float(x["Q"]) for x in rows if x["model"] == "affine"]
+    assert got == r.Q.tolist()
+
+
+@pytest.mark.parametrize("argv,needle", [
+    (["--waveform", "step:1mm"], "--waveform needs --duration"),
+    (["--waveform", "step:1V", "--duration", "1s"], "unknown unit"),
+    (["--waveform", "step:1mm", "--duration", "1s", "--points", "2000001"], "--points must be at most"),
+    (["--waveform", "step:1mm", "--duration", "1s", "--points", "200001", "--json"], "--json holds every row"),
+    (["--waveform", "step:1mm", "--duration", "-1s"], "--duration must be > 0"),
+    (["--waveform", "step:1mm", "--duration", "1s", "--load", "-5ohm"], "--load resistance must be > 0"),
+    (["--waveform", "step:1mm", "--duration", "1s", "--fidelity", "bvp"], "--fidelity is not read with --waveform"),
+    (["--waveform", "step:5m", "--duration", "1s"], "a face would lose all its water"),
+    (["--waveform", "sine:1mm@100Hz", "--duration", "1e4s", "--points", "10001"], "steps over the duration"),
+    (["--curvature", "2", "--duration", "1s"], "--duration needs --waveform"),
+])
+def test_waveform_refusals_one_line_exit_2_and_no_file(capsys, tmp_path, argv, needle):
+    p = tmp_path / "never.csv"
+    rc, out, err = _run(capsys, *argv, "--out", str(p))
+    assert rc == 2 and out == ""
+    assert len(err.strip().splitlines()) == 1 and needle in err, err
+    assert not p.exists() and list(tmp_path.iterdir()) == []
