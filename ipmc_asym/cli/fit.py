@@ -18,6 +18,7 @@ from ipmc_asym.cli.common import (
     first_run_notice,
     fmt_num,
     model_help,
+    nu_type,
     seed_type,
     sheet_resistance_type,
     strip_and_material,
@@ -25,6 +26,7 @@ from ipmc_asym.cli.common import (
     waveform_type,
 )
 from ipmc_asym.dynamics.circuit import BEAM_CHOICES
+from ipmc_asym.forward.sensing import DEFAULT_NU, SENSE_SUPPORTS
 from ipmc_asym.io.fileio import FIGURE_FORMATS
 from ipmc_asym.model.electrode import beam_label
 from ipmc_asym.parallel.executors import check_scheduler
@@ -47,7 +49,10 @@ DESCRIPTION = (
     "(one standard deviation) in every file or in none (then one relative noise scale is estimated). Free "
     "parameters: modulus, c_moy, eps0, deps (any data), diffusion (alias D; time series or spectra), "
     "viscous_modulus (time series of deflection/force, --beam dynamic), sheet_resistance (spectra); a parameter "
-    "the data cannot see is refused naming the data that would identify it. Water transport is outside the model.")
+    "the data cannot see is refused naming the data that would identify it. SENSING data (columns t, s; w, m, the "
+    "imposed tip displacement, the strip at rest before t = 0; and Q (C), I (A) and/or V (V), rows on a uniform grid "
+    "t = k dt): the electrodes on --load (short by default; V needs open or OHMS), model: the sensing transient; "
+    "free also nu (the drained Poisson ratio; fixed by --nu, default 0). Water transport is outside the model.")
 
 #: extra starts of a multistart (each a full least-squares solve); settable with --max-multistart
 MAX_MULTISTART = 1000
@@ -72,6 +77,14 @@ def register(sub):
                    help="cation diffusion coefficient D when not free, and the start when free (1e-10m2/s)")
     p.add_argument("--sheet-resistance", dest="sheet_resistance", type=sheet_resistance_type, default=None,
                    help="electrode sheet resistance (Ohm/sq) of the spectra when not free, the start when free")
+    p.add_argument("--load", default=None, metavar="short|open|OHMS",
+                   help="sensing data: the load on the electrodes (default short; a V column needs open or a "
+                        "resistance, e.g. 10kOhm)")
+    p.add_argument("--support", default=None, choices=SENSE_SUPPORTS,
+                   help="sensing data: how the tip displacement bends the strip (default tip-force)")
+    p.add_argument("--nu", type=nu_type, default=DEFAULT_NU,
+                   help="sensing data: drained Poisson ratio when nu is not free, the start when free (default 0, "
+                        "an assumption)")
     p.add_argument("--beam", default=None, choices=BEAM_CHOICES,
                    help="mechanics of the time series (default: dynamic when viscous_modulus is free, else "
                         "quasi-static)")
@@ -93,6 +106,12 @@ def register(sub):
     p.add_argument("--json", action="store_true", help="print one JSON object")
 
 
+def _load(text):
+    from ipmc_asym.cli.sense import _load as sense_load  # the sense command's reading of --load
+
+    return sense_load(text)
+
+
 def run(args) -> int:
     # every option checked before any work (the fit of a long file takes seconds to minutes);
     # --plot with every output (add_output_option)
@@ -104,7 +123,9 @@ def run(args) -> int:
     strip, material, _ = strip_and_material(args)
     if args.sheet_resistance is not None:
         material = material.with_(sheet_resistance=args.sheet_resistance)
-    files = [read_file(d, strip, waveform=args.waveform, max_rows=args.max_rows) for d in args.data]
+    load = None if args.load is None else _load(args.load)
+    files = [read_file(d, strip, waveform=args.waveform, load=load, support=args.support, max_rows=args.max_rows)
+             for d in args.data]
     first_run_notice("fit")
     static_only = len(files) == 1 and isinstance(files[0], CalibrationData)
     if static_only:
@@ -116,7 +137,7 @@ def run(args) -> int:
     res = fit(files, args.free, model=args.model, material=material, fidelity=args.fidelity,
               multistart=args.multistart, seed=args.seed, scheduler=args.scheduler,
               progress=False if args.no_progress else None, strip=strip, beam=args.beam,
-              viscous_modulus=args.viscous_modulus, time_fidelity=args.time_fidelity)
+              viscous_modulus=args.viscous_modulus, time_fidelity=args.time_fidelity, nu=args.nu)
     source = ", ".join(d.source for d in files)
     if args.plot:
         from ipmc_asym.plotting.calibrate import plot_fit, plot_fit_dynamic  # deferred: matplotlib (start-up)

@@ -20,8 +20,9 @@ __all__ = ["Parameter", "PARAMETERS", "ALIASES", "canonical", "parse_value", "wi
            "DATA_KINDS"]
 
 #: kinds of data rows (``fit``): static deflection/blocking force at rest, a time series of the
-#: electrical response, a time series of deflection/force, an impedance spectrum
-DATA_KINDS = ("static", "time", "time_mech", "impedance")
+#: electrical response, a time series of deflection/force, an impedance spectrum, a sensing time
+#: series (imposed tip displacement, measured charge/current/voltage)
+DATA_KINDS = ("static", "time", "time_mech", "impedance", "sensing")
 
 _CONCENTRATION = {"mol/m^3": 1.0, "mol/m3": 1.0, "mM": 1.0, "M": 1e3, "mol/L": 1e3}
 _PERMITTIVITY = {"F/m": 1.0}
@@ -65,7 +66,7 @@ class Parameter:
         return None
 
 
-_ANY = ("static", "time", "time_mech", "impedance")
+_ANY = ("static", "time", "time_mech", "impedance", "sensing")
 
 #: canonical name -> Parameter (the order is the order ``fit --free`` lists them in)
 PARAMETERS = {p.name: p for p in (
@@ -76,9 +77,9 @@ PARAMETERS = {p.name: p for p in (
     Parameter("eps0", (), None, "F/m", "permittivity at C = 0, eps0", _PERMITTIVITY, (1e-10, 1.0), _ANY, "any data"),
     Parameter("deps", (), None, "F/m", "eps_moy - eps0", _PERMITTIVITY, (1e-10, 1.0), _ANY, "any data"),
     Parameter("diffusion", ("D",), "D", "m^2/s", "cation diffusion coefficient D", None, (1e-14, 1e-7),
-              ("time", "time_mech", "impedance"),
-              "a time series (t, current/charge/deflection) or an impedance spectrum (f, Z_re, Z_im): the "
-              "static state does not depend on D"),
+              ("time", "time_mech", "impedance", "sensing"),
+              "a time series (t, current/charge/deflection), an impedance spectrum (f, Z_re, Z_im) or sensing "
+              "data (t, w, Q/I/V): the static state does not depend on D"),
     Parameter("viscous_modulus", ("eta_E",), None, "Pa s",
               "viscous modulus eta_E = E tau_v of the Kelvin-Voigt law (eq. (3))", _VISCOSITY, (1.0, 1e9),
               ("time_mech",), "a time series of deflection or blocking force (the beam's damping; beam dynamic)"),
@@ -94,12 +95,25 @@ PARAMETERS = {p.name: p for p in (
               None, (1e9, 1e12), ("static", "time_mech"),
               "deflection or blocking-force data (static rows or a time series): the layers change the beam, not "
               "the electrochemistry"),
+    # sensing only: the imposed bending changes the solution fraction through tr eps = -(1 - 2 nu) kappa z; the
+    # actuation's beam does not see it (its moment is the paper's eq. (6)); no measured value was found, so
+    # the default 0 (docs/sensing.md) is an assumption; log-parameter fit, so the bounds exclude 0 and 0.5
+    Parameter("nu", ("poisson_ratio",), None, "1", "drained Poisson ratio nu of the membrane (sensing)",
+              None, (1e-3, 0.499), ("sensing",),
+              "sensing data (t, w and Q, I or V): the actuation models do not depend on it"),
 )}
 
 #: alias -> canonical name (every other name a parameter is known by)
 ALIASES = {a: p.name for p in PARAMETERS.values() for a in p.aliases}
 
-_PARSERS = {"modulus": parse_pressure, "diffusion": parse_diffusion, "sheet_resistance": parse_sheet_resistance,
+def _parse_nu(name, text):
+    v = parse_quantity(name, text, {"1": 1.0}, "Poisson ratio (dimensionless)")
+    if not 0.0 <= v < 0.5:
+        raise ValueError(f"{name}: the drained Poisson ratio must be in [0, 0.5); got {text!r}")
+    return v
+
+
+_PARSERS = {"nu": _parse_nu, "modulus": parse_pressure, "diffusion": parse_diffusion, "sheet_resistance": parse_sheet_resistance,
             "electrode_thickness": parse_length, "electrode_modulus": parse_pressure}
 
 

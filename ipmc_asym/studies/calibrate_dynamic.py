@@ -27,6 +27,17 @@ Kinds of files (the header decides; each file is one kind):
   closed form: the reference rung), with the electrodes' sheet resistance (0: ideal, exactly
   :func:`ipmc_asym.dynamics.circuit.frequency_response`).
 
+* **sensing** (a ``t`` column, s; a ``w`` column, m, the imposed tip displacement; one or more of
+  ``Q`` (C, charge of the electrode ``z = -e``), ``I`` (A, current through the load, ``-dQ/dt``),
+  ``V`` (V, across the load)): the strip of the strip options at rest before ``t = 0``, its tip
+  moved along ``w(t)`` (linear between rows, the first row's value from ``t = 0``), the electrodes
+  on the load of the ``load`` setting (``--load``: ``short``, the default without a ``V`` column;
+  ``open``, ``V`` only; a resistance).  The rows lie on a uniform grid ``t = k dt`` from 0 (the
+  model's output grid: no interpolation of the prediction).  The model is
+  :func:`ipmc_asym.dynamics.sensing_time.sensing_transient` (one rung; its stated error is the
+  model error).  The columns ``sense --waveform --out`` writes besides these (``kappa``, ``emf``,
+  ``power``, ``check_*``, ``valid``, ``model``) are the model's own and skipped.
+
 Optional ``sigma_<column>`` (one standard deviation, same unit; ``sigma_Z_phase`` in degrees)
 for every measured column of every file, or for none.  Without them one relative noise scale
 ``s`` is estimated for all values: static values relative to themselves, a time-series column
@@ -63,7 +74,7 @@ from __future__ import annotations
 
 import math
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -71,7 +82,8 @@ from ipmc_asym.base.units import parse_force, parse_length, parse_quantity, pars
 from ipmc_asym.beam.dynamics import CLAMPED_OUTPUTS, Beam, natural_frequencies, viscous_modulus_from_damping_ratio
 from ipmc_asym.dynamics.circuit import WATER_NOTE, step_response
 from ipmc_asym.dynamics.line import line_response
-from ipmc_asym.dynamics.waveforms import parse_waveform
+from ipmc_asym.dynamics.waveforms import Waveform, parse_waveform
+from ipmc_asym.forward.sensing import DEFAULT_NU, SENSE_SUPPORTS
 from ipmc_asym.model.params import NAFION_LI, Material, Strip
 from ipmc_asym.model.permittivity import get_model
 from ipmc_asym.parallel.executors import run_chunks
@@ -101,11 +113,16 @@ from ipmc_asym.studies.calibrate import (
     fit as fit_static,
 )
 
-__all__ = ["TIME_MEASURED", "IMPEDANCE_MEASURED", "TimeData", "ImpedanceData", "read_file", "fit_dynamic", "fit",
-           "predict_time", "predict_impedance", "TIME_FIDELITIES"]
+__all__ = ["TIME_MEASURED", "IMPEDANCE_MEASURED", "SENSING_MEASURED", "TimeData", "ImpedanceData", "SensingData",
+           "read_file", "fit_dynamic", "fit",
+           "predict_time", "predict_impedance", "predict_sensing", "TIME_FIDELITIES"]
 
 #: measured columns of a time series -> unit (signed values)
 TIME_MEASURED = {"current": "A", "charge": "C", "deflection": "m", "blocking_force": "N"}
+#: measured columns of a sensing time series -> unit (signed; the sensing module's conventions)
+SENSING_MEASURED = {"Q": "C", "I": "A", "V": "V"}
+#: columns of ``sense --waveform --out`` that are the model's own: not data
+SENSING_IGNORED = ("kappa", "emf", "power", "check_strain", "check_beam_regime", "check_one_way", "valid", "model")
 #: measured columns of an impedance spectrum -> unit (pairs: Z_re with Z_im, Z_abs with Z_phase)
 IMPEDANCE_MEASURED = {"Z_re": "Ohm", "Z_im": "Ohm", "Z_abs": "Ohm", "Z_phase": "deg"}
 #: columns of a ``step --out`` / ``drive --out`` CSV -> (the fit's column, factor): read as they are
@@ -191,6 +208,48 @@ class ImpedanceData(MeasuredColumns):
     @property
     def kinds(self) -> set:
         return {"impedance"}
+
+
+@dataclass
+class SensingData(MeasuredColumns):
+    """A sensing time series (SI): the tip displacement imposed, the charge/current/voltage measured.
+
+    Attributes
+    ----------
+    t : ndarray (n,)        times, s (>= 0, increasing, on the grid ``k dt``; at rest before t = 0)
+    w : ndarray (n,)        imposed tip displacement, m
+    measured : dict         ``Q`` (C), ``I`` (A), ``V`` (V) -> array (n,), NaN where not measured
+    sigma : dict            column -> array (n,) or None
+    load : str or float     ``"short"``, ``"open"`` or the load resistance (Ohm)
+    support : str           how the tip displacement bends the strip (:data:`SENSE_SUPPORTS`)
+    dt : float              the grid step, s ; index : ndarray of int (the rows' grid points)
+    nu : float              the drained Poisson ratio when it is not free (an assumption, default 0)
+    source : str
+    """
+
+    t: np.ndarray
+    w: np.ndarray
+    measured: dict
+    sigma: dict
+    load: object = "short"
+    support: str = "tip-force"
+    dt: float = 1.0
+    index: np.ndarray | None = None
+    nu: float = DEFAULT_NU
+    source: str = "sensing"
+    kind = "sensing"
+
+    @property
+    def kinds(self) -> set:
+        return {"sensing"}
+
+    @property
+    def waveform(self) -> Waveform:
+        """``w(t)`` as a csv waveform (linear between rows, the first row's value from t = 0)."""
+        t, w = self.t, self.w
+        if t[0] > 0.0:  # the csv term holds its first value before its first time: make that t = 0 explicit
+            t, w = np.concatenate(([0.0], t)), np.concatenate(([w[0]], w))
+        return Waveform(f"the file's w column ({self.source})", [("csv", {"t": t, "v": w})])
 
 
 def _kinds(data) -> set:
@@ -338,6 +397,77 @@ def _read_time(name, rows, header, waveform, base=None):
                     area=area)
 
 
+def _load_setting(name, load):
+    if load is None or (isinstance(load, str) and load.strip().lower() in ("short", "open")):
+        return None if load is None else load.strip().lower()
+    if isinstance(load, bool) or not isinstance(load, (int, float, np.floating, np.integer)) or not (
+            math.isfinite(float(load)) and float(load) > 0):
+        raise ValueError(f"{name}: load must be short, open or a resistance > 0 Ohm; got {load!r}")
+    return float(load)
+
+
+def _read_sensing(name, rows, load, support, base):
+    from ipmc_asym.dynamics.sensing_time import MAX_SENSE_POINTS  # deferred: SciPy (start-up)
+
+    header = [h.strip() for h in rows[0]]
+    drop = {k.lower() for k in SENSING_IGNORED}
+    keep = [j for j, h in enumerate(header) if h.lower() not in drop and not h.lower().startswith("check_")]
+    if len(keep) < len(header):
+        rows = [[r[j] if j < len(r) else "" for j in keep] if len(r) == len(header) else r for r in rows]
+    allowed = ["t", "w"] + list(SENSING_MEASURED) + [f"sigma_{m}" for m in SENSING_MEASURED]
+    header = _columns(name, rows, allowed)
+    unit = {"Q": lambda c, x: parse_quantity(c, x, _CHARGE, "charge"),
+            "I": lambda c, x: parse_quantity(c, x, _CURRENT, "current"), "V": parse_voltage}
+    parsers = {"t": parse_time, "w": parse_length, **unit, **{f"sigma_{m}": unit[m] for m in SENSING_MEASURED}}
+    cols = _table(name, rows, header, parsers)
+    _need(name, cols, "t", "the time")
+    _need(name, cols, "w", "the imposed tip displacement")
+    t, w = cols["t"], cols["w"]
+    if t[0] < 0 or np.any(np.diff(t) <= 0):
+        i = int(np.argmax(np.diff(t) <= 0)) + 3 if t[0] >= 0 else 2
+        raise ValueError(f"{name} row {i}, column 't': times must be >= 0 s and strictly increasing (the strip is "
+                         f"at rest before t = 0)")
+    meas = [m for m in SENSING_MEASURED if m in header]
+    if not meas:
+        raise ValueError(f"{name}: no measured column; sensing data need Q (C), I (A) and/or V (V) besides t and w")
+    if all(not np.any(np.isfinite(cols[m])) for m in meas):
+        raise ValueError(f"{name}: no measured value in any row")
+    L = (Strip() if base is None else base).length
+    big = np.abs(w) >= L
+    if np.any(big):
+        raise ValueError(f"{name} row {int(np.argmax(big)) + 2}, column 'w': |w| = {abs(w[np.argmax(big)]):.4g} m is not "
+                         f"below the strip length {L:.4g} m; w is in metres (or give a unit: 1mm)")
+    if not np.any(w != 0.0):
+        raise ValueError(f"{name}: w is 0 in every row: nothing bends the strip")
+    # the model's output grid is uniform from t = 0; the rows must lie on it (no interpolation of the model)
+    steps = np.diff(np.concatenate(([0.0], t)))
+    dt = float(np.min(steps[steps > 0]))
+    k = t / dt
+    off = np.abs(k - np.round(k)) > 1e-6 * np.maximum(1.0, k)
+    if np.any(off):
+        raise ValueError(f"{name} row {int(np.argmax(off)) + 2}, column 't': sensing rows must lie on a uniform grid "
+                         f"t = k dt from 0 (dt = {dt:.6g} s here, the smallest step); resample the file")
+    points = int(round(t[-1] / dt)) + 1
+    if points > MAX_SENSE_POINTS:
+        raise ValueError(f"{name}: the grid t = k dt up to {t[-1]:.6g} s has {points} points (at most "
+                         f"{MAX_SENSE_POINTS}); resample the file")
+    load = _load_setting(name, load)
+    if load is None:
+        if "V" in meas:
+            raise ValueError(f"{name}: a V column needs its load: --load open (open-circuit voltage) or --load OHMS")
+        load = "short"
+    if load == "open" and set(meas) & {"Q", "I"}:
+        raise ValueError(f"{name}: Q or I in open circuit (--load open) are 0; open-circuit data are a V column")
+    if load == "short" and "V" in meas:
+        raise ValueError(f"{name}: V across a short circuit is 0; give --load open or --load OHMS for a V column")
+    support = "tip-force" if support is None else support
+    if support not in SENSE_SUPPORTS:
+        raise ValueError(f"{name}: support must be one of {', '.join(SENSE_SUPPORTS)}; got {support!r}")
+    sigma = _sigmas(name, cols, meas)
+    return SensingData(t=t, w=w, measured={m: cols[m] for m in meas}, sigma=sigma, load=load, support=support,
+                       dt=dt, index=np.round(k).astype(np.int64), source=name)
+
+
 def _read_impedance(name, rows, header):
     allowed = ["f"] + list(IMPEDANCE_MEASURED) + [f"sigma_{m}" for m in IMPEDANCE_MEASURED]
     header = _columns(name, rows, allowed)
@@ -376,7 +506,8 @@ def _read_impedance(name, rows, header):
     return ImpedanceData(f=cols["f"], measured={a: cols[a], b: cols[b]}, sigma=sigma, source=name)
 
 
-def read_file(path, base: Strip | None = None, *, waveform=None, max_rows: int | None = MAX_DATA_ROWS):
+def read_file(path, base: Strip | None = None, *, waveform=None, load=None, support=None,
+              max_rows: int | None = MAX_DATA_ROWS):
     """Read one calibration file; its header decides the kind (module docstring).
 
     Parameters
@@ -387,11 +518,15 @@ def read_file(path, base: Strip | None = None, *, waveform=None, max_rows: int |
     waveform : str, optional
         The drive of a time series without a ``voltage`` column (a SPEC of
         :func:`ipmc_asym.dynamics.waveforms.parse_waveform`).
+    load : "short", "open" or float, optional
+        Sensing data: the load on the electrodes (default short; a ``V`` column needs it given).
+    support : {"tip-force", "free"}, optional
+        Sensing data: how the tip displacement bends the strip (default tip-force).
     max_rows : int or None
 
     Returns
     -------
-    CalibrationData, TimeData or ImpedanceData
+    CalibrationData, TimeData, ImpedanceData or SensingData
 
     Raises
     ------
@@ -404,6 +539,16 @@ def read_file(path, base: Strip | None = None, *, waveform=None, max_rows: int |
     header = [h.strip().lower() for h in rows[0]]
     if "t" in header and "f" in header:
         raise ValueError(f"{name}: both t and f columns; a file holds a time series (t) or a spectrum (f), not both")
+    # t and w with Q, I or V, or with nothing of a step/drive file besides (its w is a measured deflection)
+    other = {k.lower() for k in (*STEP_FILE_COLUMNS, *TIME_MEASURED, "voltage")} - {"w"}
+    sensing = "t" in header and "w" in header and bool({"q", "i", "v"} & set(header) or not other & set(header))
+    for opt, val in (("--load", load), ("--support", support)):
+        if val is not None and not sensing:
+            raise ValueError(f"{name}: {opt} is for sensing data (columns t, w and Q, I or V)")
+    if sensing:
+        if waveform is not None:
+            raise ValueError(f"{name}: sensing data carry their drive (the w column); --waveform is for time series")
+        return _read_sensing(name, rows, load, support, base)
     if "t" in header:
         return _read_time(name, rows, header, waveform, base)
     if "f" in header:
@@ -439,6 +584,25 @@ def predict_time(values, data: TimeData, strip: Strip, model, material: Material
     big = float(np.max(np.abs(r.sigma)))
     rel = float(np.nanmax(r.sigma_error)) / big if fidelity == "pnp" and big > 0 else math.nan
     return out, rel, r
+
+
+def predict_sensing(values, data: SensingData, strip: Strip, model, material: Material):
+    """The sensing columns at ``values`` (name -> SI) and the model's stated relative error.
+
+    Through :func:`ipmc_asym.dynamics.sensing_time.sensing_transient` driven by the file's ``w(t)``
+    on the grid ``k dt`` (the rows picked out exactly).  Returns ``(out, rel_error, result)``.
+    """
+    from ipmc_asym.dynamics.sensing_time import sensing_transient  # deferred: SciPy (start-up)
+
+    mat = _material(material, values)
+    perm = _perm(model, values)
+    nu = float(values.get("nu", data.nu))
+    n = int(data.index[-1]) + 1
+    with np.errstate(all="ignore"):
+        r = sensing_transient(data.waveform, max(n - 1, 1) * data.dt, max(n, 2), strip, model=perm, material=mat,
+                              load=data.load, nu=nu, support=data.support)
+    out = {"Q": r.Q[data.index], "I": r.I[data.index], "V": r.V[data.index]}
+    return out, float(r.error), r
 
 
 def predict_impedance(values, data: ImpedanceData, strip: Strip, model, material: Material):
@@ -482,7 +646,7 @@ class _Joint:
                 m = np.isfinite(v)
                 if d.has_sigma:
                     sc[k] = d.sigma[k][m]
-                elif isinstance(d, TimeData):
+                elif isinstance(d, (TimeData, SensingData)):
                     rms = math.sqrt(float(np.mean(v[m] ** 2)))
                     if not rms > 0:
                         raise ValueError(f"{d.source}: column {k!r} is 0 in every row; without sigma_ columns it "
@@ -524,6 +688,10 @@ class _Joint:
                 pr, rel, _ = predict_time(vals, d, self.strip, self.model, self.material, self.fidelity["time"],
                                           self.beam, self.viscous_modulus, self.fidelity.get("pnp_tol"))
                 e = {k: rel * np.abs(v) for k, v in pr.items()}  # NaN at the circuit (no estimate alone)
+            elif isinstance(d, SensingData):
+                pr, rel, _ = predict_sensing(vals, d, self.strip, self.model, self.material)
+                # the stated relative error applied to each value, as for the time series
+                e = {k: rel * np.abs(v) for k, v in pr.items()}
             else:
                 pr = _impedance_columns(predict_impedance(vals, d, self.strip, self.model, self.material), d)
                 e = {k: np.zeros(d.f.size) for k in pr}
@@ -588,7 +756,8 @@ def _model_error(prob, x, reference=None):
             v = np.concatenate([e[k] for k in sp.keys]) / np.concatenate([sp.scale[k] for k in sp.keys])
             kind = "static"
         else:
-            kind = "time" if isinstance(d, TimeData) else "impedance"
+            kind = ("time" if isinstance(d, TimeData) else "sensing" if isinstance(d, SensingData)
+                    else "impedance")
             if kind == "time" and refs is not None:
                 rp, re = refs[i]
                 v = np.concatenate([np.abs(pr[k] - rp[k]) + re[k] for k in d.measured])
@@ -610,7 +779,7 @@ def _bias(J, rm, s2):
     return np.where(sd > 0, b / np.where(sd > 0, sd, 1.0), 0.0)
 
 
-def _start(names, model, material, strip, viscous_modulus):
+def _start(names, model, material, strip, viscous_modulus, nu=DEFAULT_NU):
     out = []
     stat = [n for n in names if n in ("modulus", "c_moy", "eps0", "deps", "electrode_thickness", "electrode_modulus")]
     sv = dict(zip(stat, _start_values(stat, model, material)))
@@ -619,6 +788,8 @@ def _start(names, model, material, strip, viscous_modulus):
             out.append(sv[n])
         elif n == "diffusion":
             out.append(material.D)
+        elif n == "nu":  # a log-parameter: the assumed 0 is no start; the middle of [0, 0.5) is
+            out.append(nu if nu > 0 else 0.25)
         elif n == "sheet_resistance":
             out.append(material.sheet_resistance if material.sheet_resistance > 0 else 1.0)
         else:  # viscous modulus: the given one, or a damping ratio of 5 % on the first mode
@@ -632,7 +803,7 @@ def _start(names, model, material, strip, viscous_modulus):
 def fit_dynamic(datasets, free, model="constant", material: Material = NAFION_LI, strip: Strip | None = None,
                 beam: str | None = None, viscous_modulus: float = 0.0, fidelity: str | None = None,
                 time_fidelity: str | None = None, multistart: int = 0, seed: int = 0, scheduler=None,
-                progress: bool | None = False) -> CalibrationResult:
+                progress: bool | None = False, nu: float = DEFAULT_NU) -> CalibrationResult:
     """Weighted least squares of static rows, time series and impedance spectra together.
 
     Parameters
@@ -660,6 +831,9 @@ def fit_dynamic(datasets, free, model="constant", material: Material = NAFION_LI
         Force the time series' rung (its error is still checked).
     multistart, seed, scheduler, progress
         As :func:`ipmc_asym.studies.calibrate.fit`.
+    nu : float
+        Sensing data: the drained Poisson ratio when ``nu`` is not free, the start when it is
+        (default 0, an assumption: docs/sensing.md).
 
     Returns
     -------
@@ -681,9 +855,13 @@ def fit_dynamic(datasets, free, model="constant", material: Material = NAFION_LI
     if not parts:
         raise ValueError("fit: no data file")
     for d in parts:
-        if not isinstance(d, (CalibrationData, TimeData, ImpedanceData)):
-            raise ValueError(f"datasets must be read by read_file (CalibrationData, TimeData, ImpedanceData); got "
-                             f"{type(d).__name__}")
+        if not isinstance(d, (CalibrationData, TimeData, ImpedanceData, SensingData)):
+            raise ValueError(f"datasets must be read by read_file (CalibrationData, TimeData, ImpedanceData, "
+                             f"SensingData); got {type(d).__name__}")
+    if isinstance(nu, bool) or not isinstance(nu, (int, float, np.floating)) or not 0.0 <= float(nu) < 0.5:
+        raise ValueError(f"nu (drained Poisson ratio) must be a number in [0, 0.5); got {nu!r}")
+    # the fixed nu travels with the sensing data (copies: the caller's data sets are left as they were)
+    parts = [replace(d, nu=float(nu)) if isinstance(d, SensingData) else d for d in parts]
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
         raise ValueError(f"seed must be an integer >= 0; got {seed!r}")
     sig = {d.has_sigma for d in parts}
@@ -709,6 +887,13 @@ def fit_dynamic(datasets, free, model="constant", material: Material = NAFION_LI
             raise ValueError(f"{d.source}: its per-area columns were read with an electrode area {d.area:.6g} m^2, "
                              f"the fit's strip has {strip.width * strip.length:.6g} m^2; read it with the same strip")
     has_static = any(isinstance(d, CalibrationData) for d in parts)
+    for d in parts:
+        if isinstance(d, SensingData) and abs(float(np.max(np.abs(d.w)))) >= strip.length:
+            raise ValueError(f"{d.source}: |w| reaches the strip length {strip.length:.4g} m; w is in metres")
+    if any(isinstance(d, SensingData) for d in parts) and ("sheet_resistance" in names
+                                                           or material.sheet_resistance > 0):
+        raise ValueError("sensing data with an electrode sheet resistance: the sensing transient has ideal electrodes; "
+                         "fit sheet_resistance on spectra without the sensing data")
     if has_time and ("sheet_resistance" in names or material.sheet_resistance > 0):
         raise ValueError("time series with an electrode sheet resistance: the time-domain model has ideal electrodes "
                          "(the time-domain electrode line of step/drive --sheet-resistance is not a rung of the fit); fit "
@@ -725,7 +910,7 @@ def fit_dynamic(datasets, free, model="constant", material: Material = NAFION_LI
     t_ladder = list(TIME_FIDELITIES) if time_fidelity is None else [time_fidelity]
     lo = np.log([bounds[k][0] for k in names])
     hi = np.log([bounds[k][1] for k in names])
-    x0 = np.clip(np.log(_start(names, model, material, strip, viscous_modulus)), lo, hi)
+    x0 = np.clip(np.log(_start(names, model, material, strip, viscous_modulus, nu)), lo, hi)
     starts = multistart_starts(x0, lo, hi, multistart, seed)
     bar = _bar(None, "fit", enabled=progress, unit="eval")
     try:
@@ -739,7 +924,8 @@ def fit_dynamic(datasets, free, model="constant", material: Material = NAFION_LI
 def fit(data, free, model="constant", material: Material = NAFION_LI, fidelity: str | None = None,
         multistart: int = 0, seed: int = 0, scheduler=None, progress: bool | None = False, *,
         strip: Strip | None = None, waveform=None, beam: str | None = None, viscous_modulus: float = 0.0,
-        time_fidelity: str | None = None) -> CalibrationResult:
+        time_fidelity: str | None = None, load=None, support: str | None = None,
+        nu: float = DEFAULT_NU) -> CalibrationResult:
     """Weighted least squares of any data over the ``free`` parameters, with profile intervals.
 
     One entry for every kind of data, as ``ipmc-asym fit``: static rows alone are fitted by
@@ -772,6 +958,10 @@ def fit(data, free, model="constant", material: Material = NAFION_LI, fidelity: 
         Drive of time series read from paths without a voltage column (``"step:0.5V"``).
     beam, viscous_modulus, time_fidelity
         Time series only: as :func:`fit_dynamic`.
+    load, support
+        Sensing data read from paths: as :func:`read_file`.
+    nu : float
+        Sensing data: the drained Poisson ratio when not free (as :func:`fit_dynamic`).
 
     Returns
     -------
@@ -793,11 +983,12 @@ def fit(data, free, model="constant", material: Material = NAFION_LI, fidelity: 
     (True, True)
     """
     parts = list(data) if isinstance(data, (list, tuple)) else [data]
-    parts = [read_file(d, strip, waveform=waveform) if isinstance(d, (str, os.PathLike)) else d for d in parts]
+    parts = [read_file(d, strip, waveform=waveform, load=load, support=support)
+             if isinstance(d, (str, os.PathLike)) else d for d in parts]
     if not (len(parts) == 1 and isinstance(parts[0], CalibrationData)):
         return fit_dynamic(parts, free, model=model, material=material, strip=strip, beam=beam,
                            viscous_modulus=viscous_modulus, fidelity=fidelity, time_fidelity=time_fidelity,
-                           multistart=multistart, seed=seed, scheduler=scheduler, progress=progress)
+                           multistart=multistart, seed=seed, scheduler=scheduler, progress=progress, nu=nu)
     for opt, val in (("beam", beam), ("time_fidelity", time_fidelity), ("waveform", waveform)):
         if val is not None:
             raise ValueError(f"{opt}: only for time series (a file with a t column); {parts[0].source} holds static "
@@ -816,7 +1007,8 @@ def _fit_joint(parts, names, bounds, lo, hi, starts, s_ladder, t_ladder, has_sta
     first = True
     while True:
         fid = {"static": s_ladder[si] if has_static else None, "time": t_ladder[ti] if has_time else None,
-               "pnp_tol": pnp_tol}
+               "pnp_tol": pnp_tol,
+               "sensing": "transient" if any(isinstance(d, SensingData) for d in parts) else None}
         prob = _Joint(parts, names, model, material, strip, beam, viscous_modulus, fid)
         prob.bar = bar
         if first and len(starts) > 1:
@@ -875,6 +1067,8 @@ def _fit_joint(parts, names, bounds, lo, hi, starts, s_ladder, t_ladder, has_sta
         used.append(f"time series {fid['time']}" + (f" (tol {fid['pnp_tol']:.2g})" if fid["time"] == "pnp" else ""))
     if any(isinstance(d, ImpedanceData) for d in parts):
         used.append("spectra pnp-linear (exact)")
+    if any(isinstance(d, SensingData) for d in parts):
+        used.append("sensing transient (reduced circuit + leading-order EMF, one rung)")
     fidelity_used = "; ".join(used)
     msg = (f"fidelity: {fidelity_used} (cheapest with model error < 1/10 of the data's noise at every value and a "
            f"shift < 0.1 standard error on every estimate); beam {beam}; {WATER_NOTE}")
@@ -922,6 +1116,12 @@ def _time_flags(prob, x, warns):
             k = r.t.size - d.t.size
             for c in ASSUMPTION_CHECKS:
                 ok = np.asarray(r.checks[c], bool)[k:]
+                if not np.all(ok):
+                    flagged.setdefault(c, []).extend(f"{d.source} row {int(i) + 2}" for i in np.flatnonzero(~ok))
+        elif isinstance(d, SensingData):
+            _, _, r = predict_sensing(vals, d, prob.strip, prob.model, prob.material)
+            for c in ("check_strain", "check_beam_regime", "check_one_way"):
+                ok = np.asarray(getattr(r, c), bool)[d.index]
                 if not np.all(ok):
                     flagged.setdefault(c, []).extend(f"{d.source} row {int(i) + 2}" for i in np.flatnonzero(~ok))
     for c, rows in flagged.items():
