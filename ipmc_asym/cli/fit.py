@@ -107,7 +107,7 @@ def register(sub):
 
 
 def _load(text):
-    from ipmc_asym.cli.sense import _load as sense_load  # the sense command's reading of --load
+    from ipmc_asym.cli.sense import _load as sense_load  # deferred: the sense command's module (start-up)
 
     return sense_load(text)
 
