@@ -82,6 +82,7 @@ from ipmc_asym.base.units import parse_force, parse_length, parse_quantity, pars
 from ipmc_asym.beam.dynamics import CLAMPED_OUTPUTS, Beam, natural_frequencies, viscous_modulus_from_damping_ratio
 from ipmc_asym.dynamics.circuit import WATER_NOTE, step_response
 from ipmc_asym.dynamics.line import line_response
+from ipmc_asym.dynamics.sensing import WATER_ASSUMPTION
 from ipmc_asym.dynamics.waveforms import Waveform, parse_waveform
 from ipmc_asym.forward.sensing import DEFAULT_NU, SENSE_SUPPORTS
 from ipmc_asym.model.params import NAFION_LI, Material, Strip
@@ -1070,8 +1071,17 @@ def _fit_joint(parts, names, bounds, lo, hi, starts, s_ladder, t_ladder, has_sta
     if any(isinstance(d, SensingData) for d in parts):
         used.append("sensing transient (reduced circuit + leading-order EMF, one rung)")
     fidelity_used = "; ".join(used)
+    # the two sides' water assumptions differ (actuation: solvent at rest; sensing: drained at every instant)
+    sensing_only = all(isinstance(d, SensingData) for d in parts)
+    water = []
+    if not sensing_only:
+        water.append(f"beam {beam}; {WATER_NOTE}")
+    if any(isinstance(d, SensingData) for d in parts):
+        water.append(f"sensing data: {WATER_ASSUMPTION}; drained Poisson ratio "
+                     + ("fitted" if "nu" in names else f"nu = {next(d.nu for d in parts if isinstance(d, SensingData)):g} "
+                        "(an assumption)"))
     msg = (f"fidelity: {fidelity_used} (cheapest with model error < 1/10 of the data's noise at every value and a "
-           f"shift < 0.1 standard error on every estimate); beam {beam}; {WATER_NOTE}")
+           f"shift < 0.1 standard error on every estimate); {'; '.join(water)}")
     if notes:
         msg += "; " + "; ".join(notes)
     return CalibrationResult(parameters=params, correlation=corr, chi2_red=chi2_red, n_points=n,

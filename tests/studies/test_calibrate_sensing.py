@@ -56,6 +56,8 @@ def test_round_trip_short_circuit_charge_and_current(tmp_path):
     assert _inside(nu, NU) and _inside(dd, D), (nu, dd)
     assert nu["ci95"][1] - nu["ci95"][0] < 0.02 and dd["ci95"][1] / dd["ci95"][0] < 1.05
     assert 0.5 < res.chi2_red < 1.5 and "sensing transient" in res.fidelity
+    # the sensing model's water assumption, not the actuation circuit's
+    assert "instantly redistributed" in res.message and "solvent is at rest" not in res.message
 
 
 def test_open_circuit_voltage_sees_nu_and_D_not_c_moy(tmp_path):
