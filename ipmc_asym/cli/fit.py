@@ -81,7 +81,8 @@ def register(sub):
                    help="sensing data: the load on the electrodes (default short; a V column needs open or a "
                         "resistance, e.g. 10kOhm)")
     p.add_argument("--support", default=None, choices=SENSE_SUPPORTS,
-                   help="sensing data: how the tip displacement bends the strip (default tip-force)")
+                   help="sensing data: how the tip displacement bends the strip (default free, as sense: a file "
+                        "sense --out wrote reads with the same defaults)")
     p.add_argument("--nu", type=nu_type, default=DEFAULT_NU,
                    help="sensing data: drained Poisson ratio when nu is not free, the start when free (default 0, "
                         "an assumption)")
@@ -112,6 +113,12 @@ def _load(text):
     return sense_load(text)
 
 
+def _is_sensing(path):
+    from ipmc_asym.studies.calibrate_dynamic import is_sensing_file  # deferred: reads the header only
+
+    return is_sensing_file(path)
+
+
 def run(args) -> int:
     # every option checked before any work (the fit of a long file takes seconds to minutes);
     # --plot with every output (add_output_option)
@@ -124,7 +131,11 @@ def run(args) -> int:
     if args.sheet_resistance is not None:
         material = material.with_(sheet_resistance=args.sheet_resistance)
     load = None if args.load is None else _load(args.load)
-    files = [read_file(d, strip, waveform=args.waveform, load=load, support=args.support, max_rows=args.max_rows)
+    # the sense command's default support (free), so that its --out files round-trip with the same defaults
+    support = args.support
+    if support is None and any(_is_sensing(d) for d in args.data):
+        support = "free"
+    files = [read_file(d, strip, waveform=args.waveform, load=load, support=support, max_rows=args.max_rows)
              for d in args.data]
     first_run_notice("fit")
     static_only = len(files) == 1 and isinstance(files[0], CalibrationData)

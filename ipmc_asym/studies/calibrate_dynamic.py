@@ -411,6 +411,12 @@ def _read_sensing(name, rows, load, support, base):
     from ipmc_asym.dynamics.sensing_time import MAX_SENSE_POINTS  # deferred: SciPy (start-up)
 
     header = [h.strip() for h in rows[0]]
+    low = [h.lower() for h in header]
+    if "model" in low:  # sense --out's model column: one model is data of that model, several are not one strip
+        j = low.index("model")
+        if len({r[j].strip() for r in rows[1:] if j < len(r)}) > 1:
+            raise ValueError(f"{name}: column 'model': a file of several models (sense --model all); write one model "
+                             f"per file (--model NAME)")
     drop = {k.lower() for k in SENSING_IGNORED}
     keep = [j for j, h in enumerate(header) if h.lower() not in drop and not h.lower().startswith("check_")]
     if len(keep) < len(header):
@@ -433,6 +439,7 @@ def _read_sensing(name, rows, load, support, base):
         raise ValueError(f"{name}: no measured column; sensing data need Q (C), I (A) and/or V (V) besides t and w")
     if all(not np.any(np.isfinite(cols[m])) for m in meas):
         raise ValueError(f"{name}: no measured value in any row")
+    meas = [m for m in meas if np.any(np.isfinite(cols[m]))]  # an empty column measured nothing
     L = (Strip() if base is None else base).length
     big = np.abs(w) >= L
     if np.any(big):
@@ -507,6 +514,22 @@ def _read_impedance(name, rows, header):
     return ImpedanceData(f=cols["f"], measured={a: cols[a], b: cols[b]}, sigma=sigma, source=name)
 
 
+def _sensing_header(header):
+    # t and w with Q, I or V, or with nothing of a step/drive file besides (its w is a measured deflection)
+    other = {k.lower() for k in (*STEP_FILE_COLUMNS, *TIME_MEASURED, "voltage")} - {"w"}
+    return "t" in header and "w" in header and bool({"q", "i", "v"} & set(header) or not other & set(header))
+
+
+def is_sensing_file(path) -> bool:
+    """Whether the header of ``path`` makes it sensing data (False for a file that cannot be read: the
+    reader says why)."""
+    try:
+        rows = read_rows(os.fspath(path), None)
+    except (ValueError, OSError):
+        return False
+    return bool(rows) and _sensing_header([h.strip().lower() for h in rows[0]])
+
+
 def read_file(path, base: Strip | None = None, *, waveform=None, load=None, support=None,
               max_rows: int | None = MAX_DATA_ROWS):
     """Read one calibration file; its header decides the kind (module docstring).
@@ -522,7 +545,8 @@ def read_file(path, base: Strip | None = None, *, waveform=None, load=None, supp
     load : "short", "open" or float, optional
         Sensing data: the load on the electrodes (default short; a ``V`` column needs it given).
     support : {"tip-force", "free"}, optional
-        Sensing data: how the tip displacement bends the strip (default tip-force).
+        Sensing data: how the tip displacement bends the strip (default tip-force, as
+        :func:`ipmc_asym.sensing_transient`; ``ipmc-asym fit`` defaults to free, as ``ipmc-asym sense``).
     max_rows : int or None
 
     Returns
@@ -540,9 +564,7 @@ def read_file(path, base: Strip | None = None, *, waveform=None, load=None, supp
     header = [h.strip().lower() for h in rows[0]]
     if "t" in header and "f" in header:
         raise ValueError(f"{name}: both t and f columns; a file holds a time series (t) or a spectrum (f), not both")
-    # t and w with Q, I or V, or with nothing of a step/drive file besides (its w is a measured deflection)
-    other = {k.lower() for k in (*STEP_FILE_COLUMNS, *TIME_MEASURED, "voltage")} - {"w"}
-    sensing = "t" in header and "w" in header and bool({"q", "i", "v"} & set(header) or not other & set(header))
+    sensing = _sensing_header(header)
     for opt, val in (("--load", load), ("--support", support)):
         if val is not None and not sensing:
             raise ValueError(f"{name}: {opt} is for sensing data (columns t, w and Q, I or V)")
@@ -1077,7 +1099,9 @@ def _fit_joint(parts, names, bounds, lo, hi, starts, s_ladder, t_ladder, has_sta
     if not sensing_only:
         water.append(f"beam {beam}; {WATER_NOTE}")
     if any(isinstance(d, SensingData) for d in parts):
-        water.append(f"sensing data: {WATER_ASSUMPTION}; drained Poisson ratio "
+        water.append("sensing data: " + ", ".join(f"{d.source} support {d.support}, load {d.load}" for d in parts
+                                                  if isinstance(d, SensingData))
+                     + f"; {WATER_ASSUMPTION}; drained Poisson ratio "
                      + ("fitted" if "nu" in names else f"nu = {next(d.nu for d in parts if isinstance(d, SensingData)):g} "
                         "(an assumption)"))
     msg = (f"fidelity: {fidelity_used} (cheapest with model error < 1/10 of the data's noise at every value and a "

@@ -72,7 +72,9 @@ def test_open_circuit_voltage_sees_nu_and_D_not_c_moy(tmp_path):
 def test_cli_report_in_json(tmp_path, capsys):
     p = _write(tmp_path / "open.csv", "open", ("V",))
     png = tmp_path / "fit.png"
-    assert main(["fit", str(p), "--free", "nu,D", "--load", "open", "--json", "--no-progress", "--plot", str(png)]) == 0
+    # the file was written at the transient's default support (tip-force); the command's default is sense's (free)
+    assert main(["fit", str(p), "--free", "nu,D", "--load", "open", "--support", "tip-force", "--json", "--no-progress",
+                 "--plot", str(png)]) == 0
     assert png.stat().st_size > 0
     out = json.loads(capsys.readouterr().out)
     assert set(out["parameters"]) == {"nu", "diffusion"}
@@ -107,3 +109,32 @@ def test_a_parameter_sensing_does_not_see_is_refused(tmp_path, capsys):
     static.write_text("voltage,deflection\n0.5V,1mm\n")
     assert main(["fit", str(static), "--free", "modulus", "--load", "open"]) == 2
     assert "--load is for sensing data" in capsys.readouterr().err
+
+
+def test_a_file_sense_wrote_round_trips_through_the_commands(tmp_path, capsys):
+    # sense --waveform --out at its defaults (support free) and a 1 kOhm load; fit at its defaults
+    wav = tmp_path / "w.csv"
+    np.savetxt(wav, np.c_[T, W], delimiter=",")
+    out = tmp_path / "s.csv"
+    assert main(["sense", "--waveform", f"csv:{wav}", "--duration", "200s", "--points", "201", "--load", "1kOhm",
+                 "--nu", "0.2", "--model", "constant", "--out", str(out)]) == 0
+    capsys.readouterr()
+    lines = out.read_text().splitlines()
+    head = lines[0].split(",")
+    rng = np.random.default_rng(11)
+    vals = np.array([[float(x) for x in ln.split(",")[1:9]] for ln in lines[1:]])  # t .. power, after model
+    rms = {c: float(np.sqrt(np.mean(vals[:, head.index(c) - 1] ** 2))) for c in ("Q", "V")}
+    rows = ["t,w,Q,V"]
+    for r in vals:
+        q, v = (r[head.index(c) - 1] + 0.05 * rms[c] * rng.standard_normal() for c in ("Q", "V"))
+        rows.append(",".join(repr(float(x)) for x in (r[0], r[1], q, v)))
+    noisy = tmp_path / "noisy.csv"
+    noisy.write_text("\n".join(rows) + "\n")
+    assert main(["fit", str(noisy), "--free", "nu,D", "--load", "1kOhm", "--json", "--no-progress"]) == 0
+    res = json.loads(capsys.readouterr().out)
+    assert _inside(res["parameters"]["nu"], NU) and _inside(res["parameters"]["diffusion"], NAFION_LI.D), res
+    # a file of several models is not one strip
+    assert main(["sense", "--waveform", f"csv:{wav}", "--duration", "200s", "--points", "201", "--load", "1kOhm",
+                 "--out", str(tmp_path / "all.csv")]) == 0
+    assert main(["fit", str(tmp_path / "all.csv"), "--free", "nu", "--load", "1kOhm"]) == 2
+    assert "several models" in capsys.readouterr().err
