@@ -19,6 +19,7 @@ from ipmc_asym.base.units import (
     parse_length,
     parse_pressure,
     parse_quantity,
+    parse_resistance,
     parse_sheet_resistance,
     parse_time,
     parse_voltage,
@@ -79,6 +80,21 @@ def nu_type(text):
     if not 0.0 <= v <= 0.5:
         raise ValueError(f"--nu must be a drained Poisson ratio in [0, 0.5]; got {text!r}")
     return v
+
+
+def load_type(text):
+    """``--load`` of the sensing mode (sense, freq --mode sensing, fit on sensing data): ``short``,
+    ``open`` or a resistance > 0 across the electrodes (``10kOhm``, ``470ohm``; a bare number is ohms)."""
+    t = str(text).strip().lower()
+    if t in ("short", "open"):
+        return t
+    try:
+        R = parse_resistance("--load", text)
+    except ValueError:
+        R = float("nan")
+    if not R > 0.0:
+        raise ValueError(f"--load must be short, open or a resistance > 0 Ohm (e.g. 10kOhm); got {text!r}")
+    return R
 
 
 def _positive(name, parse, example, check=None):

@@ -107,18 +107,6 @@ def register(sub):
     p.add_argument("--json", action="store_true", help="print one JSON object")
 
 
-def _load(text):
-    from ipmc_asym.cli.sense import _load as sense_load  # deferred: the sense command's module (start-up)
-
-    return sense_load(text)
-
-
-def _is_sensing(path):
-    from ipmc_asym.studies.calibrate_dynamic import is_sensing_file  # deferred: reads the header only
-
-    return is_sensing_file(path)
-
-
 def run(args) -> int:
     # every option checked before any work (the fit of a long file takes seconds to minutes);
     # --plot with every output (add_output_option)
@@ -130,11 +118,8 @@ def run(args) -> int:
     strip, material, _ = strip_and_material(args)
     if args.sheet_resistance is not None:
         material = material.with_(sheet_resistance=args.sheet_resistance)
-    load = None if args.load is None else _load(args.load)
-    # the sense command's default support (free), so that its --out files round-trip with the same defaults
-    support = args.support
-    if support is None and any(_is_sensing(d) for d in args.data):
-        support = "free"
+    load = None if args.load is None else load_type(args.load)
+    support = args.support  # None: the sensing entries' one default (tip-force)
     files = [read_file(d, strip, waveform=args.waveform, load=load, support=support, max_rows=args.max_rows)
              for d in args.data]
     first_run_notice("fit")

@@ -24,6 +24,7 @@ from ipmc_asym.cli.common import (
     first_run_notice,
     fmt_num,
     frequency_type,
+    load_type,
     model_help,
     nu_type,
     print_clamped,
@@ -69,7 +70,7 @@ def register(sub):
                    help="actuation (default: a voltage drives the strip; the outputs above) or sensing (the tip is moved "
                         "sinusoidally: short-circuit charge, current and open-circuit voltage per tip displacement; with "
                         "--load R the load's voltage, current and mean power; docs/sensing.md)")
-    p.add_argument("--load", type=arg_type(_load_type, "--load"), default=None,
+    p.add_argument("--load", type=arg_type(load_type, "--load"), default=None,
                    help="--mode sensing: short (default), open, or a resistance across the electrodes (10kOhm, 1MOhm, "
                         "470ohm; a bare number is ohms) for the load columns")
     p.add_argument("--nu", type=arg_type(nu_type, "nu"), default=None,
@@ -91,16 +92,6 @@ def _tol_type(text):
         v = float("nan")
     if not 0.0 < v < 1.0:
         raise ValueError(f"--export-tol must be a number in (0, 1); got {text!r}")
-    return v
-
-
-def _load_type(text):
-    t = str(text).strip().lower()
-    if t in ("short", "open"):
-        return t
-    v = parse_resistance("--load", text)
-    if not v > 0.0:
-        raise ValueError(f"--load must be short, open or a resistance > 0 (e.g. 10kOhm); got {text!r}")
     return v
 
 

@@ -51,20 +51,6 @@ _TIME_UNITS = {"t": "s", "w": "m", "kappa": "1/m", "emf": "V", "Q": "C", "V": "V
 MAX_JSON_ROWS = 100_000
 
 
-def _load(text):
-    t = str(text).strip().lower()
-    if t in SENSE_LOADS:
-        return t
-    try:
-        R = parse_resistance("--load", text)
-    except ValueError:
-        raise ValueError(f"--load must be short, open or a resistance (e.g. 10kOhm, with --waveform); "
-                         f"got {text!r}") from None
-    if not R > 0:
-        raise ValueError(f"--load resistance must be > 0 Ohm; got {text!r}")
-    return R
-
-
 def _length_waveform(text):
     from ipmc_asym.dynamics.waveforms import parse_waveform  # deferred: start-up
 
@@ -89,10 +75,10 @@ def register(sub):
     p.add_argument("--duration", type=duration_type, default=None, help="with --waveform: end time (e.g. 100s)")
     p.add_argument("--points", type=count_type("--points", 2), default=2001,
                    help="with --waveform: output rows, uniform in [0, duration] (default 2001, at most 1e6)")
-    p.add_argument("--support", default="free", choices=SENSE_SUPPORTS,
+    p.add_argument("--support", default="tip-force", choices=SENSE_SUPPORTS,
                    help="free: an end moment, uniform curvature, w = kappa L^2/2; tip-force: a tip force on the "
-                        "cantilever, kappa(x) = kappa0 (1 - x/L), w = kappa0 L^2/3 (default free)")
-    p.add_argument("--load", type=arg_type(_load, "load"), default="short",
+                        "cantilever, kappa(x) = kappa0 (1 - x/L), w = kappa0 L^2/3 (default tip-force, as in every sensing entry)")
+    p.add_argument("--load", type=arg_type(load_type, "--load"), default="short",
                    help="short (the charge that flows between short-circuited electrodes) or open (the voltage); "
                         "both are computed, this picks the one printed first. A resistive load at DC after "
                         "relaxation carries no current: it reads the open-circuit voltage. With --waveform: short, "

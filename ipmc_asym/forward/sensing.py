@@ -124,7 +124,7 @@ def _check_array(name, value, unit):
     return a
 
 
-def sense(strip: Strip | None = None, curvature=None, tip_displacement=None, support: str = "free",
+def sense(strip: Strip | None = None, curvature=None, tip_displacement=None, support: str = "tip-force",
           load: str = "short", model="constant", fidelity: str = "leading", tol=None, *, nu: float = DEFAULT_NU,
           material: Material | None = None, pressure_term: bool = False, escalate: bool = True) -> SenseResult:
     """Charge and open-circuit voltage of a strip bent at rest (after relaxation).
@@ -135,7 +135,8 @@ def sense(strip: Strip | None = None, curvature=None, tip_displacement=None, sup
         electrodes are short-circuited or open).  Default: the nominal strip.
     curvature : float or 1-D array_like, 1/m   curvature at the clamp (``eps_xx = -kappa z``)
     tip_displacement : float or 1-D array_like, m   instead of ``curvature`` (one of the two)
-    support : {"free", "tip-force"}   how the displacement is imposed (module docstring)
+    support : {"free", "tip-force"}   how the displacement is imposed (module docstring; default tip-force,
+        the tip pushed: the default of every sensing entry)
     load : {"short", "open"}   which reading the result's summary leads with (both are computed)
     model, fidelity, tol, escalate, pressure_term : as :class:`ipmc_asym.model.request.Request`
     nu : float   drained Poisson ratio in [0, 0.5] (default 0, an assumption: docs/sensing.md)
