@@ -267,8 +267,8 @@ def run(args):
                       f"{'M_A [N m]':>11s} {'theta':>9s} {'w [mm]':>9s} {'+-':>9s} valid")
                 for i in idx:
                     print(f"{fmt_num(r.t[i], '11.4g')} {fmt_num(r.sigma[i], '14.6g')} "
-                          f"{fmt_num(r.sigma_error[i], '9.2g')} {fmt_num(r.current_density[i], '11.4g')} "
-                          f"{fmt_num(r.current_error[i], '9.2g')} {fmt_num(r.M_A[i], '11.4g')} "
+                          f"{fmt_num(r.sigma_error[i], '9.2g')} {_num(r.current_density[i], 1.0):>11s} "
+                          f"{_num(r.current_error[i], 1.0):>9s} {fmt_num(r.M_A[i], '11.4g')} "
                           f"{_num(r.theta[i], 1.0):>9s} {_num(r.w[i], 1e3):>9s} {_num(r.w_error[i], 1e3):>9s} "
                           f"{'yes' if r.valid[i] else 'no'}")
                 continue
