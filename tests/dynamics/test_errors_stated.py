@@ -74,7 +74,8 @@ def test_circuit_w_and_current_errors_bound_a_tighter_pnp(mod, th, V):
 
 
 @pytest.mark.parametrize("mod,th,V,tol", [("affine", 200e-6, 2.0, 1e-4), ("affine", 200e-6, 2.0, 1e-6),
-                                          ("linear", 200e-6, 0.5, 1e-4), ("constant", 200e-6, 1e-4, 1e-4)])
+                                          ("linear", 200e-6, 0.5, 1e-4), ("constant", 200e-6, 1e-4, 1e-4),
+                                          ("constant", 20e-6, 1.0, 1e-4)])
 def test_pnp_w_and_current_errors_bound_a_tighter_pnp(mod, th, V, tol):
     """The PNP's current error follows its charging front (affine 2 V: the pointwise Richardson estimate
     was 11x short at 0.05 tau, and its time part 200x short after the front) and w's error follows from it
@@ -87,7 +88,10 @@ def test_pnp_w_and_current_errors_bound_a_tighter_pnp(mod, th, V, tol):
     assert j.sum() >= 29 and np.array_equal(np.isfinite(p.current_density), np.isfinite(p.current_error))
     assert np.all(np.abs(p.current_density - ref.current_density)[j] <= (p.current_error + ref.current_error)[j]), \
         (np.abs(p.current_density - ref.current_density) / p.current_error).tolist()
-    assert np.all(np.abs(p.w - ref.w) <= p.w_error + ref.w_error), (np.abs(p.w - ref.w) / p.w_error).tolist()
+    # where w is given (20 um, 1 V: withheld past a full turn, as before), its error is stated
+    k = np.isfinite(p.w)
+    assert np.array_equal(np.isfinite(p.w_error), k) and k.sum() >= 15
+    assert np.all(np.abs(p.w - ref.w)[k] <= (p.w_error + ref.w_error)[k])
 
 
 @pytest.mark.parametrize("fidelity,tol", [("circuit", 1e-3), ("pnp", None)])
