@@ -202,12 +202,14 @@ def run(args):
 
     # the errors wherever they are stated: with --tol, and always for the pnp (its default tolerance)
     stated = args.tol is not None or args.fidelity == "pnp"
-    columns = COLUMNS + (("sigma_error", "current_error") if stated else ())
+    # (the deflection's error is propagated through the quasi-static beam only)
+    columns = COLUMNS + (("sigma_error", "current_error") if stated else ()) + (
+        ("w_error",) if stated and args.beam == "quasi-static" else ())
 
     def cols_of(r):
         cols = {"t": r.t, "phi0": r.phi0, "sigma": r.sigma, "sigma_error": r.sigma_error,
                 "current_density": r.current_density, "current_error": r.current_error, "M_A": r.M_A,
-                "theta": r.theta, "w": r.w}
+                "theta": r.theta, "w": r.w, "w_error": r.w_error}
         return {c: cols[c] for c in columns}
 
     def flags_of(r):
@@ -260,6 +262,16 @@ def run(args):
                   f"fidelity {r.fidelity}, beam {args.beam}: tau = {r.tau:.4g} s (R = {r.R:.4g} Ohm m^2, "
                   f"C_d(0) = {r.C_d0:.4g} F/m^2, D = {material.D:.3g} m^2/s)")
             idx = np.unique(np.linspace(0, r.t.size - 1, min(r.t.size, 11)).astype(int))
+            if "w_error" in columns:  # the stated errors beside their values
+                print(f"{'t [s]':>11s} {'sigma [C/m^2]':>14s} {'+-':>9s} {'J [A/m^2]':>11s} {'+-':>9s} "
+                      f"{'M_A [N m]':>11s} {'theta':>9s} {'w [mm]':>9s} {'+-':>9s} valid")
+                for i in idx:
+                    print(f"{fmt_num(r.t[i], '11.4g')} {fmt_num(r.sigma[i], '14.6g')} "
+                          f"{fmt_num(r.sigma_error[i], '9.2g')} {_num(r.current_density[i], 1.0):>11s} "
+                          f"{_num(r.current_error[i], 1.0):>9s} {fmt_num(r.M_A[i], '11.4g')} "
+                          f"{_num(r.theta[i], 1.0):>9s} {_num(r.w[i], 1e3):>9s} {_num(r.w_error[i], 1e3):>9s} "
+                          f"{'yes' if r.valid[i] else 'no'}")
+                continue
             print(f"{'t [s]':>11s} {'sigma [C/m^2]':>14s} {'J [A/m^2]':>11s} {'M_A [N m]':>11s} {'theta':>9s} "
                   f"{'w [mm]':>9s} valid")
             for i in idx:

@@ -293,6 +293,10 @@ class StepResult(ResultMixin):
                                   sigma's (pnp: Richardson; circuit with ``tol``: its difference from
                                   the reference PNP plus that run's estimate); NaN for the circuit
                                   without ``tol``
+    w_error : ndarray             bound on the error of ``w`` (m) that follows from the layer voltage's
+                                  (:func:`deflection_error`): circuit, from ``sigma_error`` through
+                                  ``V(sigma)``; pnp, from ``current_error`` through ``phi0 - R J``;
+                                  NaN where no error is stated and with ``beam="dynamic"``
     """
 
     _result = ResultSpec("t", "t", ("phi0", "sigma", "current_density", "layer_voltage", "M_A", "theta", "w",
@@ -331,6 +335,38 @@ class StepResult(ResultMixin):
         return out
     sigma_error: np.ndarray | None = None
     current_error: np.ndarray | None = None
+    w_error: np.ndarray | None = None
+
+
+#: samples of the layer voltage's error interval on which the deflection's range is taken
+W_ERROR_SAMPLES = 9
+
+
+def deflection_error(u_lo, u_hi, w, strip: Strip, perm: Permittivity, material: Material):
+    """Bound on ``|w(u) - w|`` for every layer voltage ``u`` in ``[u_lo, u_hi]`` (per time point).
+
+    ``w(u)`` is not monotone in general (the arc tip deflection turns back past a half turn; the
+    linear model's moment has an extremum), so the end points alone do not bound it: ``w`` is taken
+    at :data:`W_ERROR_SAMPLES` equally spaced voltages of the interval, and the largest departure
+    from ``w`` is increased by the bound on what lies between samples, ``h^2 max|w''|/8``, with
+    ``h^2 w''`` estimated by the samples' second differences and counted twice (the margin for that
+    estimate), plus the forward model's rounding (64 ulps of ``w``).  NaN where ``w``, the interval or
+    a sample is not determined (withheld): the caller withholds ``w`` there.
+    """
+    lo = np.asarray(u_lo, dtype=float)
+    hi = np.asarray(u_hi, dtype=float)
+    w = np.asarray(w, dtype=float)
+    k = np.linspace(0.0, 1.0, W_ERROR_SAMPLES)[:, None]
+    U = lo[None, :] + k * (hi - lo)[None, :]
+    bad = ~(np.isfinite(lo) & np.isfinite(hi) & np.isfinite(w))
+    U = np.where(bad[None, :], 0.0, U)
+    W = quasi_static_mechanics(U.reshape(-1), strip, perm, material)[2].reshape(U.shape)
+    dev = np.max(np.abs(W - w[None, :]), axis=0)
+    curv = np.max(np.abs(W[2:] - 2.0 * W[1:-1] + W[:-2]), axis=0)
+    # plus the forward model's rounding (a few ulps of w: two evaluations at one voltage may differ by it)
+    out = dev + 2.0 * curv / 8.0 + 64.0 * np.finfo(float).eps * np.max(np.abs(W), axis=0)
+    out[bad | ~np.all(np.isfinite(W), axis=0)] = np.nan
+    return out
 
 
 def quasi_static_forward(u, strip: Strip, perm: Permittivity, material: Material, checked_voltage=None):
@@ -503,6 +539,38 @@ def circuit_response(t, phi0_fun, strip: Strip, perm: Permittivity, material: Ma
     return sigma, u, stepper.current(t, u)
 
 
+def _applied_hull(tgrid, fun):
+    """``(lo, hi)`` per output time: the hull of 0 and the voltages applied so far (V), sampled finely
+    between the output times (a coarse grid may miss a peak)."""
+    tf = np.union1d(tgrid, np.linspace(0.0, tgrid[-1], 20001))
+    af = fun(tf)
+    k = np.searchsorted(tf, tgrid)
+    return np.minimum.accumulate(np.minimum(af, 0.0))[k], np.maximum.accumulate(np.maximum(af, 0.0))[k]
+
+
+def _pnp_layer_voltage(tgrid, fun, J, strip, material):
+    """The PNP's layer voltage ``phi0 - R J`` (V) at the output times."""
+    # the voltage left across the layers: phi0 minus the ohmic drop of the core (exact at
+    # t = 0+ and t -> infinity; the bulk's displacement current is O(lambda) of J)
+    u = fun(tgrid) - core_resistance(strip.thickness, material) * J
+    # t = 0 is the run's uncharged initial state: the layers hold no charge, so no voltage (phi0 - R J
+    # there evaluates the step's discontinuity, and its current is the rate at a jump)
+    u = np.where(tgrid == 0.0, 0.0, u)
+    # and, as in the circuit (CircuitStepper.advance), within the hull of 0 and the voltages applied
+    # so far: the current's rounding noise once charged (~1e-5 of J(0), either sign) would put
+    # phi0 - R J past phi0 and flip the checks at their limits
+    lo, hi = _applied_hull(tgrid, fun)
+    return np.clip(u, lo, hi)
+
+
+def _pnp_deflection_error(tgrid, fun, u, cur_err, w, strip, perm, material):
+    """Bound on the error of the PNP's ``w = w(phi0 - R J)`` from its current's error (V = R dJ; none at
+    t = 0, the uncharged state), the voltage interval held in the hull of 0 and the applied voltages."""
+    du = np.where(tgrid == 0.0, 0.0, core_resistance(strip.thickness, material) * np.asarray(cur_err, dtype=float))
+    lo, hi = _applied_hull(tgrid, fun)
+    return deflection_error(np.clip(u - du, lo, hi), np.clip(u + du, lo, hi), w, strip, perm, material)
+
+
 def step_response(voltage=1.0, duration=None, *, strip: Strip | None = None, model="constant",
                   fidelity="circuit", material: Material | None = None, t=None, points: int = 1000,
                   waveform_kind="step", ramp_time=None, frequency=None, pnp_options=None, beam="quasi-static",
@@ -626,20 +694,7 @@ def step_response(voltage=1.0, duration=None, *, strip: Strip | None = None, mod
         r = lad.last.result
         sig_err, cur_err = r.sigma_error, r.current_error
         sigma, J = r.sigma, r.current_density
-        # the voltage left across the layers: phi0 minus the ohmic drop of the core (exact at
-        # t = 0+ and t -> infinity; the bulk's displacement current is O(lambda) of J)
-        u = fun(tgrid) - core_resistance(s.thickness, m) * J
-        # t = 0 is the run's uncharged initial state: the layers hold no charge, so no voltage (phi0 - R J
-        # there evaluates the step's discontinuity, and its current is the rate at a jump)
-        u = np.where(tgrid == 0.0, 0.0, u)
-        # and, as in the circuit (CircuitStepper.advance), within the hull of 0 and the voltages applied
-        # so far: the current's rounding noise once charged (~1e-5 of J(0), either sign) would put
-        # phi0 - R J past phi0 and flip the checks at their limits
-        # (the applied voltage sampled finely between the output times: a coarse grid may miss a peak)
-        tf = np.union1d(tgrid, np.linspace(0.0, tgrid[-1], 20001))
-        af = fun(tf)
-        k = np.searchsorted(tf, tgrid)
-        u = np.clip(u, np.minimum.accumulate(np.minimum(af, 0.0))[k], np.maximum.accumulate(np.maximum(af, 0.0))[k])
+        u = _pnp_layer_voltage(tgrid, fun, J, s, m)
         success, message = r.success, r.message
         extra = dict(extra, **r.extra)
         notes.append("pnp: M_A(t) is the layers' quasi-static moment at the layer voltage phi0 - R J; the moment of the transient "
@@ -653,6 +708,33 @@ def step_response(voltage=1.0, duration=None, *, strip: Strip | None = None, mod
     checks = {c: a.reshape(-1) for c, a in fr.checks_mask.items()}
     warns = assumption_warnings(fr)
     M, th, w, Fb = (np.asarray(getattr(fr, k), dtype=float) for k in ("M_A", "theta", "w", "F_block"))
+    w_err = np.full(tgrid.size, np.nan)
+    stated = np.isfinite(np.asarray(sig_err, dtype=float))
+    if dyn is None and stated.any():
+        # the deflection's error from the layer voltage's, the voltage the beam was given
+        if fidelity == "circuit":
+            # as sigma's: the difference from the reference PNP run's deflection plus that one's error
+            # (the circuit's charge also holds the core's displacement charge, so V(sigma) is not its
+            # layer voltage: the bound is taken on w itself)
+            ref = pnp_ref[0]
+            u_r = _pnp_layer_voltage(tgrid, fun, ref.current_density, s, m)
+            w_r = quasi_static_mechanics(u_r, s, perm, m)[2]
+            w_err = np.abs(w - w_r) + _pnp_deflection_error(tgrid, fun, u_r, ref.current_error, w_r, s, perm, m)
+        else:
+            w_err = _pnp_deflection_error(tgrid, fun, u, cur_err, w, s, perm, m)
+        w_err = np.where(stated, w_err, np.nan)
+        lost = stated & np.isfinite(w) & ~np.isfinite(w_err)
+        if lost.any():  # the error interval reaches where w is not determined: w is withheld, not printed
+            w = np.where(lost, np.nan, w)
+            notes.append(f"w withheld at {int(lost.sum())} of {lost.size} times: its error interval reaches a "
+                         f"layer voltage where w is not determined")
+    # a current whose error is stated as not determined (the PNP's rate at the step's jump, t = 0,
+    # diverges with the mesh) is withheld, not printed without its error
+    lost_j = stated & ~np.isfinite(np.asarray(cur_err, dtype=float))
+    if lost_j.any():
+        J = np.where(lost_j, np.nan, J)
+        notes.append(f"current withheld at {int(lost_j.sum())} of {lost_j.size} times: the PNP's current there "
+                     f"(the rate at the step's jump) does not converge with the mesh")
     if dyn is not None:
         thd, wd, Fd = dyn.advance(tgrid, M, th, w, Fb)
         extra = dict(extra, theta_quasi_static=th[keep], w_quasi_static=w[keep], F_block_quasi_static=Fb[keep],
@@ -666,7 +748,7 @@ def step_response(voltage=1.0, duration=None, *, strip: Strip | None = None, mod
                       theta=th, w=w, F_block=Fb, tau=tau, R=R, C_d0=0.5 * capacitance_scale(perm, m),
                       fidelity=fidelity, model=perm.name, notes=notes, success=success, message=message,
                       extra=extra, seconds=time.perf_counter() - t0, checks=checks, warnings=warns,
-                      sigma_error=sig_err, current_error=cur_err)
+                      sigma_error=sig_err, current_error=cur_err, w_error=w_err)
 
 
 def circuit_impedance_error(f, thickness, perm: Permittivity, material: Material):
@@ -922,7 +1004,7 @@ def frequency_response(f, *, strip: Strip | None = None, model="constant", mater
         notes.append("H_w_profiles: the moment of the linearised profiles, p' = (C + A3) E, which adds the pressure "
                      "gradient of the ohmic core field (-> (1 + A3)/3 per unit psi0 at high frequency, ~1/(3 lambda) "
                      "times the static slope); with the solvent at rest nothing relaxes it -- water flow would")
-    else:
+    elif bias == 0.0:  # the closed-form error is that of the linearisation about 0 V
         notes.append(f"circuit: relative error of Z and H_w against the linearised PNP (the reference) in 'error', "
                      f"~(f/(2 f_d))/|1 + i omega tau| below the dielectric relaxation frequency f_d = {f_d:.4g} Hz, at most "
                      f"lambda/2 = {0.5 * lam:.3g} at any frequency")
