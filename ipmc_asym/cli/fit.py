@@ -17,6 +17,7 @@ from ipmc_asym.cli.common import (
     diffusion_type,
     first_run_notice,
     fmt_num,
+    load_type,
     model_help,
     nu_type,
     seed_type,

@@ -7,7 +7,7 @@ import numpy as np
 
 from ipmc_asym.base.jsonio import dumps
 from ipmc_asym.base.registry import model_names
-from ipmc_asym.base.units import fmt_length, parse_length, parse_resistance
+from ipmc_asym.base.units import fmt_length, parse_length
 from ipmc_asym.beam.dynamics import CLAMPED_OUTPUTS
 from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import (

@@ -9,7 +9,7 @@ import numpy as np
 
 from ipmc_asym.base.jsonio import dumps
 from ipmc_asym.base.registry import fidelity_names, model_choices
-from ipmc_asym.base.units import fmt_length, parse_length, parse_quantity, parse_resistance
+from ipmc_asym.base.units import fmt_length, parse_length, parse_quantity
 from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import (
     add_output_option,
@@ -18,13 +18,14 @@ from ipmc_asym.cli.common import (
     count_type,
     duration_type,
     first_run_notice,
+    load_type,
     nu_type,
     strip_and_material,
     tol_type,
     warn,
 )
 from ipmc_asym.forward.estimate import model_list
-from ipmc_asym.forward.sensing import DEFAULT_NU, SENSE_LOADS, SENSE_SUPPORTS, sense
+from ipmc_asym.forward.sensing import DEFAULT_NU, SENSE_SUPPORTS, sense
 from ipmc_asym.io.fileio import atomic_write
 
 #: curvature units (1/m); a bare number is 1/m
