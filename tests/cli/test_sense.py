@@ -129,7 +129,7 @@ def test_waveform_csv(capsys, tmp_path):
     with p.open(newline="") as fh:
         rows = list(csv.DictReader(fh))
     assert len(rows) == 33 and {r["model"] for r in rows} == {"constant", "linear", "affine"}
-    r = ia.sensing_transient("step:1mm", 1.0, 11, model="affine", support="free")
+    r = ia.sensing_transient("step:1mm", 1.0, 11, model="affine")  # the one default support
     got = [float(x["Q"]) for x in rows if x["model"] == "affine"]
     assert got == r.Q.tolist()
 
@@ -140,7 +140,7 @@ def test_waveform_csv(capsys, tmp_path):
     (["--waveform", "step:1mm", "--duration", "1s", "--points", "2000001"], "--points must be at most"),
     (["--waveform", "step:1mm", "--duration", "1s", "--points", "200001", "--json"], "--json holds every row"),
     (["--waveform", "step:1mm", "--duration", "-1s"], "--duration must be > 0"),
-    (["--waveform", "step:1mm", "--duration", "1s", "--load", "-5ohm"], "--load resistance must be > 0"),
+    (["--waveform", "step:1mm", "--duration", "1s", "--load", "-5ohm"], "--load must be short, open or a resistance > 0"),
     (["--waveform", "step:1mm", "--duration", "1s", "--fidelity", "bvp"], "--fidelity is not read with --waveform"),
     (["--waveform", "step:5m", "--duration", "1s"], "a face would lose all its water"),
     (["--waveform", "sine:1mm@100Hz", "--duration", "1e4s", "--points", "10001"], "steps over the duration"),
