@@ -90,8 +90,10 @@ def load_type(text):
         return t
     try:
         R = parse_resistance("--load", text)
-    except ValueError:
-        R = float("nan")
+    except ValueError as exc:  # the unit parser's reason (e.g. an unknown unit) kept after the rule
+        reason = str(exc).removeprefix("--load: ")
+        raise ValueError(f"--load must be short, open or a resistance > 0 Ohm (e.g. 10kOhm); got {text!r}: "
+                         f"{reason}") from None
     if not R > 0.0:
         raise ValueError(f"--load must be short, open or a resistance > 0 Ohm (e.g. 10kOhm); got {text!r}")
     return R
