@@ -88,7 +88,7 @@ def test_open_circuit_voltage_is_the_donnan_difference(model):
     """V_oc against (RT/F) ln(C_moy(+e)/C_moy(-e)) from eq (17) at each face's solution fraction."""
     th, kap = 2e-3, 5.0  # face strain 5e-3
     e = 0.5 * th
-    r = ia.sense(ia.Strip(thickness=th), curvature=kap, model=model, fidelity="exact")
+    r = ia.sense(ia.Strip(thickness=th), curvature=kap, support="free", model=model, fidelity="exact")  # uniform kappa
     # solid incompressible: (1 - phi4)(1 + tr eps) = 1 - phi4_0, tr eps = -kappa z (nu = 0)
     faces = {}
     for zf in (-e, e):
