@@ -972,10 +972,18 @@ def _solve_once(t, phi0_fun, strip, model, material, *, cells_per_debye, ratio, 
         # depleted layer and would stall the steps); the state's steps integrate it to the
         # same order
         at = np.concatenate((np.full(P.N - 1, atol), [1e300])) if energy else atol
-        sol = solve_ivp(lambda th, y: P.rhs(th, y, energy), (0.0, tt[-1] / tscale), y0, method=meth,
-                        t_eval=tt / tscale, rtol=rtol,
-                        atol=at, dense_output=False)
+        # a trial Newton iterate of the BDF may leave the state's domain (a negative
+        # concentration: NaN in the flux); the integrator rejects that step and halves it, so its
+        # arithmetic runs with floating-point errors ignored whatever the caller's errstate (under
+        # np.seterr(all="raise") the rejection itself raised, depending on rounding-level
+        # differences between runs); the accepted states are checked finite below
+        with np.errstate(all="ignore"):
+            sol = solve_ivp(lambda th, y: P.rhs(th, y, energy), (0.0, tt[-1] / tscale), y0, method=meth,
+                            t_eval=tt / tscale, rtol=rtol,
+                            atol=at, dense_output=False)
     secs = time.perf_counter() - t0
+    if sol.success and sol.y.shape[1] == tt.size and not np.all(np.isfinite(sol.y[: P.N - 1])):
+        sol.success, sol.message = False, "the integration returned a non-finite state"
     if not sol.success or sol.y.shape[1] != tt.size:
         return TransientResult(t=tt, sigma=np.full(tt.size, np.nan), current_density=np.full(tt.size, np.nan),
                                layer_voltage=np.full(tt.size, np.nan),
