@@ -171,6 +171,23 @@ def _load(load):
     return R, R
 
 
+def sensing_inputs(strip, material, model, nu, support, load):
+    """The checks shared by the small-signal and time-domain sensing entries, once at their top:
+    ``(strip, material, perm, nu, load, R)``; ``ValueError`` naming the input."""
+    check_choice("support", support, SENSE_SUPPORTS)
+    load, R = _load(load)
+    s = NOMINAL_STRIP if strip is None else strip
+    if not isinstance(s, Strip):
+        raise ValueError("strip must be an ipmc_asym.Strip")
+    m = NAFION_LI if material is None else material
+    if isinstance(nu, bool) or not isinstance(nu, (int, float, np.floating)) or not 0.0 <= float(nu) <= 0.5:
+        raise ValueError(f"nu (drained Poisson ratio) must be a number in [0, 0.5]; got {nu!r}")
+    perm = get_model(model)
+    if perm.is_custom:
+        raise ValueError("model: sensing needs one of the paper's permittivity models (constant, linear, affine)")
+    return s, m, perm, float(nu), load, R
+
+
 def sensing_response(f, strip: Strip | None = None, *, model="constant", material: Material | None = None,
                      method="pnp-linear", load="short", nu: float = DEFAULT_NU, support: str = "tip-force",
                      amplitude: float = DEFAULT_AMPLITUDE) -> SensingResponse:
@@ -207,21 +224,10 @@ def sensing_response(f, strip: Strip | None = None, *, model="constant", materia
     [True, False]
     """
     check_choice("method", method, FREQ_METHODS)
-    check_choice("support", support, SENSE_SUPPORTS)
-    load, R = _load(load)
-    s = NOMINAL_STRIP if strip is None else strip
-    if not isinstance(s, Strip):
-        raise ValueError("strip must be an ipmc_asym.Strip")
-    m = NAFION_LI if material is None else material
-    if isinstance(nu, bool) or not isinstance(nu, (int, float, np.floating)) or not 0.0 <= float(nu) <= 0.5:
-        raise ValueError(f"nu (drained Poisson ratio) must be a number in [0, 0.5]; got {nu!r}")
-    nu = float(nu)
+    s, m, perm, nu, load, R = sensing_inputs(strip, material, model, nu, support, load)
     w0 = check_finite("amplitude", amplitude, "a finite tip displacement in m, > 0")
     if w0 <= 0.0:
         raise ValueError(f"amplitude must be a finite tip displacement > 0 m; got {amplitude!r}")
-    perm = get_model(model)
-    if perm.is_custom:
-        raise ValueError("model: sensing needs one of the paper's permittivity models (constant, linear, affine)")
     f = np.asarray(f, dtype=float).reshape(-1)
     if not np.all(np.isfinite(f)) or np.any(f <= 0):
         raise ValueError("frequencies must be finite and > 0 Hz")

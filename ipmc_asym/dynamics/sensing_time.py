@@ -46,7 +46,6 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.linalg import expm
 
-from ipmc_asym.base.registry import check_choice
 from ipmc_asym.base.results import Panel, ResultMixin, ResultSpec
 from ipmc_asym.dynamics.circuit import circuit_impedance_error
 from ipmc_asym.dynamics.electrode import capacitance_scale, core_resistance
@@ -54,16 +53,16 @@ from ipmc_asym.dynamics.sensing import (
     ONE_WAY_GROWTH,
     STREAMING_NOTE,
     WATER_ASSUMPTION,
+    sensing_inputs,
     voc_hat,
     voc_hat_leading,
 )
 from ipmc_asym.dynamics.waveforms import Waveform, parse_waveform
-from ipmc_asym.forward.sensing import DEFAULT_NU, SENSE_SUPPORTS, tip_curvature
+from ipmc_asym.forward.sensing import DEFAULT_NU, tip_curvature
 from ipmc_asym.integral.sensing import B_LIMIT, sense_hat, strain_parameter
 from ipmc_asym.kernels.lti import lti_foh
 from ipmc_asym.model import groups
-from ipmc_asym.model.params import NAFION_LI, NOMINAL_STRIP, Material, Strip, check_finite
-from ipmc_asym.model.permittivity import get_model
+from ipmc_asym.model.params import Material, Strip, check_finite
 
 __all__ = ["SensingTransient", "sensing_transient", "MAX_SENSE_POINTS", "MAX_SENSE_STEPS", "INTERP_TOL"]
 
@@ -140,18 +139,6 @@ class SensingTransient(ResultMixin):
     f_stream: float
     f_top: float
     notes: list = field(default_factory=list)
-
-
-def _load(load):
-    if isinstance(load, str):
-        check_choice("load", load, ("short", "open"))
-        return load, math.nan
-    if isinstance(load, bool) or not isinstance(load, (int, float, np.floating, np.integer)):
-        raise ValueError(f"load must be 'short', 'open' or a resistance in ohms (> 0); got {load!r}")
-    R = float(load)
-    if not math.isfinite(R) or R <= 0.0:
-        raise ValueError(f"load must be 'short', 'open' or a finite resistance > 0 Ohm; got {load!r}")
-    return R, R
 
 
 def _second_derivative_scale(wave: Waveform):
@@ -240,24 +227,13 @@ def sensing_transient(waveform, duration, points: int = 2001, strip: Strip | Non
     >>> bool(abs(r.Q[-1] / static - 1) < r.error_settled)
     True
     """
-    check_choice("support", support, SENSE_SUPPORTS)
-    load, R_L = _load(load)
-    s = NOMINAL_STRIP if strip is None else strip
-    if not isinstance(s, Strip):
-        raise ValueError("strip must be an ipmc_asym.Strip")
-    m = NAFION_LI if material is None else material
-    if isinstance(nu, bool) or not isinstance(nu, (int, float, np.floating)) or not 0.0 <= float(nu) <= 0.5:
-        raise ValueError(f"nu (drained Poisson ratio) must be a number in [0, 0.5]; got {nu!r}")
-    nu = float(nu)
+    s, m, perm, nu, load, R_L = sensing_inputs(strip, material, model, nu, support, load)
     T = check_finite("duration", duration, "a finite time in s, > 0")
     if T <= 0.0:
         raise ValueError(f"duration must be > 0 s; got {duration!r}")
     if isinstance(points, bool) or not isinstance(points, (int, np.integer)) or not 2 <= points <= MAX_SENSE_POINTS:
         raise ValueError(f"points must be an integer in [2, {MAX_SENSE_POINTS}]; got {points!r}")
     points = int(points)
-    perm = get_model(model)
-    if perm.is_custom:
-        raise ValueError("model: sensing needs one of the paper's permittivity models (constant, linear, affine)")
     wave = waveform if isinstance(waveform, Waveform) else parse_waveform(waveform, quantity="length")
     L, e = s.length, s.e
     # the largest bend the drive reaches: the static sense's refusal (a face losing all its water)
