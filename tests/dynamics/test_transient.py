@@ -382,6 +382,22 @@ def test_small_signal_step_within_its_stated_error_of_the_exact_linearised_respo
     assert np.max(r.sigma_error) <= 1e-6 * np.max(np.abs(r.sigma))
 
 
+@pytest.mark.parametrize("thickness", [200e-6, 1e-3])
+def test_small_signal_step_at_a_loose_tol_within_its_stated_error_at_early_times(thickness):
+    """0.1 mV at tol 1e-4 on step's default window (log-spaced from 1e-4 tau): at the early times the
+    time integration's error of the finest mesh (rtol = tol/100) is several times the assumed
+    10 rtol |sigma| (8x at 1.4e-3 tau on 200 um); the stated error, which measures it, still bounds the
+    distance to the exact linearised response at every output time."""
+    from ipmc_asym.dynamics.circuit import step_response
+
+    s = Strip(thickness=thickness)
+    r = step_response(1e-4, strip=s, points=60, fidelity="pnp", tol=1e-4)
+    idx = np.nonzero(r.t > 0)[0][::2]
+    ref = _exact_linear_step_sigma(1e-4, r.t[idx], s)
+    err = np.abs(r.sigma[idx] - ref)
+    assert np.all(err <= r.sigma_error[idx]), (err / r.sigma_error[idx]).tolist()
+
+
 @pytest.mark.parametrize("model", ["constant", "linear", "affine"])
 def test_circuit_layer_voltage_stays_within_the_applied_hull_at_the_validated_limit(model):
     """The layers charge through the core towards phi0 with a charge increasing in their voltage, so
