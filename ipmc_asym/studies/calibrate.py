@@ -763,14 +763,15 @@ def _fit(data, bounds, names, p, n, lo, hi, x0, ladder, starts, model, material,
                              noise_scale=noise_scale, warnings=warns)
 
 
-def _report(prob, res, lo, hi, n, has_sigma, stats, notes, warns):
+def _report(prob, res, lo, hi, n, has_sigma, stats, notes, warns, ends=None):
     """Estimates, profile intervals, statuses and correlations at the optimum ``res`` of ``prob``.
 
     The one place that decides what is reported (``ok`` / ``at_bound`` / ``not_identifiable``,
     standard error only where the profile is locally quadratic) for the static fit and the
     joint fit of :mod:`ipmc_asym.studies.calibrate_dynamic`.  ``prob`` is a residual problem
-    (``names``, ``residuals``, ``sub``, ``labels``); appends to ``notes`` and ``warns``.
-    Returns ``(parameters, correlation, chi2_red, noise_scale)``.
+    (``names``, ``residuals``, ``sub``, ``labels``); appends to ``notes`` and ``warns``; a list
+    ``ends`` receives ``(j, side, x)`` per profile end found (``x`` the full log parameters there,
+    the others re-minimised).  Returns ``(parameters, correlation, chi2_red, noise_scale)``.
     """
     names = prob.names
     p = len(names)
@@ -794,7 +795,7 @@ def _report(prob, res, lo, hi, n, has_sigma, stats, notes, warns):
 
     params, quad = {}, []
     for j, nm in enumerate(names):
-        lo_ci, hi_ci, why = _profile(prob, res.x, j, lo, hi, chi2, s2, thr, sd_log[j])
+        lo_ci, hi_ci, why = _profile(prob, res.x, j, lo, hi, chi2, s2, thr, sd_log[j], ends)
         ok = lo_ci is not None and hi_ci is not None
         val = math.exp(float(res.x[j]))
         at = _at_bound(res.x[j], lo[j], hi[j])
@@ -924,13 +925,15 @@ def _bias_check(prob, res, out, errs, chi2, n, p, has_sigma):
                    f"(> 0.1)")
 
 
-def _profile(prob, xhat, j, lo, hi, chi2min, s2, thr, sd):
+def _profile(prob, xhat, j, lo, hi, chi2min, s2, thr, sd, points=None):
     """95 % profile-likelihood interval of parameter ``j`` in log space.
 
     Walks away from the optimum on each side (steps growing x1.6 from ~2 standard errors)
     until ``Delta chi^2 / s^2`` crosses ``thr`` (then brentq), the bound is reached, or the
     model has no answer (beam branch not tracked).  Returns ``(lo, hi, why)`` with None on a
-    side that never crossed.
+    side that never crossed; appends ``(j, side, x)`` to the list ``points`` for each end found
+    (``x``: the full log parameters there, the others as last re-minimised, within brentq's
+    ``xtol`` of the end).
     """
     from scipy.optimize import brentq  # deferred: heavy import (start-up)
 
@@ -983,6 +986,13 @@ def _profile(prob, xhat, j, lo, hi, chi2min, s2, thr, sd):
                 break
             x_prev = x_new
             step *= 1.6
+    if points is not None:
+        for side in (-1, +1):
+            if ends[side] is not None:
+                x = np.array(xhat, float)
+                x[j] = ends[side]
+                x[others] = warm[side]
+                points.append((j, side, x))
     if ends[-1] is None and ends[+1] is None:
         kind = "flat profile"
     elif ends[-1] is None or ends[+1] is None:

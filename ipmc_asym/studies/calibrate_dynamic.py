@@ -57,8 +57,10 @@ by ~1e-5 relative), so both free on a spectrum alone are ``not_identifiable``.
 Fidelity: static rows climb the static ladder as in the static fit; time series start with the
 reduced circuit, whose error at the optimum is its difference from the PNP solver run at a
 hundredth of the data's relative noise plus that run's own estimate; they escalate to the PNP
-rung (each model evaluation a PNP run: slow) where that error is not below a tenth of the
-data's noise at every value or shifts an estimate by more than a tenth of its standard error.
+rung where that error is not below a tenth of the data's noise at every value or shifts an
+estimate by more than a tenth of its standard error.  The PNP rung's optimum is found by defect
+correction of the circuit (:func:`_defect_solve`: a handful of PNP runs, not one per model
+evaluation), its profile-interval ends checked with the PNP (:func:`_check_ends`).
 Time series with the linear model are refused: its current stops abruptly when the anode
 layer saturates, the circuit misplaces that stop by more than a tenth of a 5 % noise, and on
 the PNP rung (:mod:`ipmc_asym.dynamics.transient` solves the linear model) a round trip took
@@ -72,6 +74,7 @@ Layer rule: studies, after :mod:`ipmc_asym.studies.calibrate`; SciPy deferred.
 
 from __future__ import annotations
 
+import itertools
 import math
 import os
 from dataclasses import dataclass, replace
@@ -665,6 +668,13 @@ class _Joint:
         self.fixed = dict(fixed or {})
         self.data = parts
         self.bar = None
+        #: the PNP rung as the circuit plus a defect correction (:func:`_defect_solve`): None, or a
+        #: dict with ``names``, ``xi0`` (log values of those names), ``d0`` and ``slope`` (residual
+        #: space: PNP minus circuit at ``xi0`` and its secant per log value), ``rel`` (the PNP's
+        #: stated relative error there) and ``serial``
+        self.defect = None
+        self.pnp_rel = math.nan  # the PNP's stated relative error at its last run (max over the time series)
+        self._last = None  # (key, predictions) of the last point
         self.static = [_Problem(d, self.names, model, material, self.fidelity.get("static"), self.fixed)
                        if isinstance(d, CalibrationData) else None for d in parts]
         self.scales = []
@@ -694,12 +704,14 @@ class _Joint:
     def __getstate__(self):
         d = dict(self.__dict__)
         d["bar"] = None
+        d["_last"] = None
         return d
 
     def sub(self, names, fixed):
         out = _Joint(self.parts, names, self.model, self.material, self.strip, self.beam, self.viscous_modulus,
                      self.fidelity, fixed)
         out.bar = self.bar
+        out.defect = self.defect
         return out
 
     def values(self, x):
@@ -710,25 +722,55 @@ class _Joint:
     def predictions(self, x):
         """Per file: ``(columns, model error per measured value)`` (dicts, measured rows only)."""
         vals = self.values(x)
+        # the PNP rung's checks ask for the same point twice (the model error and the interval
+        # ends' reference at the optimum): one PNP run is ~0.5 s, so the last point is kept
+        key = (tuple(sorted(vals.items())), None if self.defect is None else self.defect["serial"])
+        if self._last is not None and self._last[0] == key:
+            return self._last[1]
+        self.pnp_rel = math.nan
         out = []
+        dc = self._correction(vals)
+        off = 0
         for d, sp in zip(self.parts, self.static):
             if sp is not None:
                 pr, errs, valid = predict(vals, d.geometry, self.model, sp.fidelity, self.material)
                 e = {k: np.where(valid, errs[k], np.inf) * np.abs(pr[k]) for k in pr}
+                off += sum(int(np.count_nonzero(sp.masks[k])) for k in sp.keys)
             elif isinstance(d, TimeData):
-                pr, rel, _ = predict_time(vals, d, self.strip, self.model, self.material, self.fidelity["time"],
+                fid = "circuit" if dc is not None else self.fidelity["time"]
+                pr, rel, _ = predict_time(vals, d, self.strip, self.model, self.material, fid,
                                           self.beam, self.viscous_modulus, self.fidelity.get("pnp_tol"))
+                if fid == "pnp":
+                    self.pnp_rel = rel if math.isnan(self.pnp_rel) else max(self.pnp_rel, rel)
+                if dc is not None:
+                    rel = self.defect["rel"]
+                    for k, v in d.measured.items():
+                        m = np.isfinite(v)
+                        pr[k] = np.array(pr[k], float)
+                        pr[k][m] += dc[off:off + int(m.sum())] * self.scales[len(out)][k]
+                        off += int(m.sum())
                 e = {k: rel * np.abs(v) for k, v in pr.items()}  # NaN at the circuit (no estimate alone)
             elif isinstance(d, SensingData):
                 pr, rel, _ = predict_sensing(vals, d, self.strip, self.model, self.material)
                 # the stated relative error applied to each value, as for the time series
                 e = {k: rel * np.abs(v) for k, v in pr.items()}
+                off += sum(int(np.count_nonzero(np.isfinite(v))) for v in d.measured.values())
             else:
                 pr = _impedance_columns(predict_impedance(vals, d, self.strip, self.model, self.material), d)
                 e = {k: np.zeros(d.f.size) for k in pr}
+                off += sum(int(np.count_nonzero(np.isfinite(v))) for v in d.measured.values())
             keep = {k: np.isfinite(d.measured[k]) for k in d.measured}
             out.append(({k: pr[k][keep[k]] for k in d.measured}, {k: e[k][keep[k]] for k in d.measured}))
+        self._last = (key, out)
         return out
+
+    def _correction(self, vals):
+        """The defect correction (residual space) at the parameter values ``vals``, or None."""
+        if self.defect is None:
+            return None
+        df = self.defect
+        xi = np.log([vals[k] for k in df["names"]])
+        return df["d0"] + df["slope"] @ (xi - df["xi0"])
 
     def residuals(self, x):
         if self.bar is not None:
@@ -1048,7 +1090,11 @@ def _fit_joint(parts, names, bounds, lo, hi, starts, s_ladder, t_ladder, has_sta
             x = outs[best][1]
             notes.append(f"multistart: best of {len(starts)} starts is #{best}")
         first = False
-        res = _solve(prob, x, lo, hi)
+        ref = None
+        if has_time and fid["time"] == "pnp":
+            res, ref = _defect_solve(prob, x, lo, hi, has_sigma, n, notes)
+        else:
+            res = _solve(prob, x, lo, hi)
         x = res.x
         chi2 = 2.0 * float(res.cost)
         rel = 1.0 if has_sigma else math.sqrt(chi2 / max(n - p, 1))
@@ -1059,6 +1105,10 @@ def _fit_joint(parts, names, bounds, lo, hi, starts, s_ladder, t_ladder, has_sta
             ref = _Joint(parts, names, model, material, strip, beam, viscous_modulus,
                          dict(fid, time="pnp", pnp_tol=tol))
             ref.bar = bar
+            rm, worst = _model_error(prob, x, ref)
+        elif ref is not None:
+            # the corrected circuit against the PNP run at the optimum (their difference: the
+            # correction's remainder) plus the PNP's own estimate
             rm, worst = _model_error(prob, x, ref)
         else:
             rm, worst = _model_error(prob, x)
@@ -1088,14 +1138,18 @@ def _fit_joint(parts, names, bounds, lo, hi, starts, s_ladder, t_ladder, has_sta
             forced = fidelity is not None or time_fidelity is not None
             raise ValueError(f"no rung is accurate enough for data this precise ({'; '.join(notes)})"
                              + ("; leave the fidelity unset to escalate" if forced else ""))
-    params, corr, chi2_red, noise_scale = _report(prob, res, lo, hi, n, has_sigma, stats, notes, warns)
+    ends = [] if prob.defect is not None else None
+    params, corr, chi2_red, noise_scale = _report(prob, res, lo, hi, n, has_sigma, stats, notes, warns, ends)
+    if ends:
+        _check_ends(prob, ref, res, ends, params, n, has_sigma, stats, notes)
     preds = [pr for pr, _ in prob.predictions(res.x)]
     flagged = _time_flags(prob, res.x, warns)
     used = []
     if has_static:
         used.append(f"static rows {fid['static']}")
     if has_time:
-        used.append(f"time series {fid['time']}" + (f" (tol {fid['pnp_tol']:.2g})" if fid["time"] == "pnp" else ""))
+        used.append(f"time series {fid['time']}" + (f" (tol {fid['pnp_tol']:.2g})" if fid["time"] == "pnp"
+                                                     and fid["pnp_tol"] is not None else ""))
     if any(isinstance(d, ImpedanceData) for d in parts):
         used.append("spectra pnp-linear (exact)")
     if any(isinstance(d, SensingData) for d in parts):
@@ -1120,6 +1174,125 @@ def _fit_joint(parts, names, bounds, lo, hi, starts, s_ladder, t_ladder, has_sta
                              fidelity=fidelity_used, model=get_model(model).name, success=bool(res.success),
                              message=msg, names=names, predictions=preds, data=parts, flagged_rows=flagged,
                              noise_scale=noise_scale, warnings=warns)
+
+
+#: the defect correction has converged when a refit moves every estimate by less than this many
+#: standard errors (the PNP optimum is then the corrected circuit's to that fraction)
+DEFECT_STEP = 0.01
+#: refits before the direct PNP optimisation takes over
+DEFECT_ITERATIONS = 8
+#: tells one correction from the next (a cached prediction belongs to one)
+_DEFECT_SERIAL = itertools.count()
+
+
+def _sd_log(J, s2):
+    """Linearised standard errors of the log parameters."""
+    J = np.asarray(J, float)
+    return np.sqrt(np.clip(np.diag(s2 * np.linalg.pinv(J.T @ J)), 0.0, None))
+
+
+def _defect_solve(prob, x, lo, hi, has_sigma, n, notes):
+    """The optimum of ``prob`` (its time series on the PNP rung) by defect correction of the circuit.
+
+    Each PNP run costs ~0.5 s, the circuit ~3 ms (measured on the 199-row step of
+    docs/calibration.md); a direct PNP optimisation took ~700 PNP runs, mostly for the
+    profile intervals.  Here the PNP's weighted residuals are modelled as the circuit's plus
+    ``d0 + S (xi - xi0)``: ``d0`` the PNP-minus-circuit discrepancy at ``xi0`` (one PNP run), ``S``
+    its forward secant over one standard error of each log parameter (one PNP run each, redone
+    only after a step of more than a standard error).  Value and slope then match the PNP's at
+    ``xi0``, so a fixed point (a refit moving every estimate by less than :data:`DEFECT_STEP`
+    standard errors) is the PNP's stationary point to that fraction; the discrepancy's
+    curvature over a standard error is the remainder, which the ladder's model-error check at
+    the optimum and :func:`_check_ends` at the interval ends measure with the PNP itself.
+    Without convergence in :data:`DEFECT_ITERATIONS` refits the PNP is optimised directly.
+    Returns ``(res, pnp)``: the optimum (of ``prob``, which keeps the correction for the
+    profile intervals) and the uncorrected PNP problem.
+    """
+    p = len(prob.names)
+    circ = _Joint(prob.parts, prob.names, prob.model, prob.material, prob.strip, prob.beam, prob.viscous_modulus,
+                  dict(prob.fidelity, time="circuit"), prob.fixed)
+    pnp = _Joint(prob.parts, prob.names, prob.model, prob.material, prob.strip, prob.beam, prob.viscous_modulus,
+                 prob.fidelity, prob.fixed)
+    circ.bar = pnp.bar = prob.bar
+    prob.defect = None
+    x = np.clip(np.asarray(x, float), lo + 1e-12, hi - 1e-12)
+
+    def s2_of(r):
+        return 1.0 if has_sigma else float(r @ r) / max(n - p, 1)
+
+    # first standard errors: the circuit's Jacobian (cheap; sizes the secant steps)
+    rc = circ.residuals(x)
+    Jc = np.empty((rc.size, p))
+    for j in range(p):
+        h = 1e-6 if x[j] + 1e-6 < hi[j] else -1e-6
+        xs = x.copy()
+        xs[j] += h
+        Jc[:, j] = (circ.residuals(xs) - rc) / h
+    sd = _sd_log(Jc, s2_of(rc))
+    slope, runs, step = None, 0, math.inf
+    for it in range(DEFECT_ITERATIONS):
+        rp = pnp.residuals(x)
+        rc = circ.residuals(x)
+        rel = pnp.pnp_rel
+        runs += 1
+        d0 = rp - rc
+        if slope is None or step > 1.0:
+            slope = np.empty((rp.size, p))
+            for j in range(p):
+                h = float(np.clip(sd[j], 1e-4, 0.05)) if np.isfinite(sd[j]) and sd[j] > 0 else 1e-3
+                if x[j] + h > hi[j]:
+                    h = -h
+                xs = x.copy()
+                xs[j] += h
+                slope[:, j] = ((pnp.residuals(xs) - circ.residuals(xs)) - d0) / h
+                runs += 1
+        prob.defect = {"names": list(prob.names), "xi0": x.copy(), "d0": d0, "slope": slope, "rel": rel,
+                       "serial": next(_DEFECT_SERIAL)}
+        res = _solve(prob, x, lo, hi)
+        sd = _sd_log(res.jac, s2_of(np.asarray(res.fun, float)))
+        step = float(np.max(np.abs(res.x - x) / np.where(sd > 0, sd, np.inf)))
+        x = res.x
+        if step < DEFECT_STEP:
+            notes.append(f"PNP optimum by defect correction of the circuit: {it + 1} refits, {runs} PNP runs, last "
+                         f"step {step:.2g} standard errors")
+            return res, pnp
+    prob.defect = None
+    notes.append(f"defect correction of the circuit did not settle in {DEFECT_ITERATIONS} refits (last step "
+                 f"{step:.2g} standard errors): the PNP optimised directly")
+    return _solve(prob, x, lo, hi), pnp
+
+
+def _check_ends(prob, pnp, res, ends, params, n, has_sigma, stats, notes):
+    """The corrected circuit's profile-interval ends checked with the PNP run there.
+
+    At an end ``x_e`` (the others re-minimised) the PNP changes ``Delta chi^2 / s^2`` by
+    ``dd = [(chi2_pnp - chi2_corr)(x_e) - (chi2_pnp - chi2_corr)(x^)] / s^2`` (to first order
+    the profile is the same minimisation: the envelope theorem); the profile's slope there is
+    ``2 sqrt(thr) / sd`` (quadratic profile), so the end moves by ``dd / (2 sqrt(thr))`` standard
+    errors, inwards when positive.  An end that would move outwards is widened by that much
+    (a margin, not a re-solve); the largest move is stated in the notes.
+    """
+    p = len(prob.names)
+    chi2 = 2.0 * float(res.cost)
+    s2 = 1.0 if has_sigma else chi2 / max(n - p, 1)
+    thr = float(stats.chi2.ppf(0.95, 1)) if has_sigma else float(stats.t.ppf(0.975, max(n - p, 1)) ** 2)
+    sd = _sd_log(res.jac, s2)
+
+    def gap(x):
+        a, b = pnp.residuals(x), prob.residuals(x)
+        return float(a @ a - b @ b)
+
+    g0 = gap(res.x)
+    worst = 0.0
+    for j, side, xe in ends:
+        move = (gap(xe) - g0) / s2 / (2.0 * math.sqrt(thr))
+        worst = max(worst, abs(move))
+        ci = params[prob.names[j]]["ci95"]
+        k = 0 if side < 0 else 1
+        if move < 0 and ci[k] is not None and sd[j] > 0:
+            ci[k] = ci[k] * math.exp(side * abs(move) * float(sd[j]))
+    notes.append(f"profile ends checked with the PNP: they move by at most {worst:.2g} standard errors "
+                 f"(outward moves added as a margin)")
 
 
 def _pnp_tol(prob, x, rel):

@@ -335,3 +335,47 @@ def test_public_fit_takes_every_kind_of_data(tmp_path):
         ia.fit(str(static), "diffusion")
     with pytest.raises(ValueError, match="beam: only for time series"):
         ia.fit(read_data(static), "modulus", beam="dynamic")
+
+
+@pytest.mark.slow
+def test_precise_step_series_pnp_optimum_by_defect_correction(tmp_path):
+    """A long precise step series (100 rows of PNP current and deflection, 0.5 % noise) escalates to
+    the PNP rung, whose optimum the fit finds by correcting the circuit: the truth lies inside the
+    intervals, and at the estimate the PNP itself (run here, residuals built here) is stationary: its
+    Gauss-Newton step is below 0.01 standard errors (the correction's stopping rule)."""
+    t = np.linspace(0.0, 0.05, 101)[1:]
+    truth = _step_truth(t, "pnp", pnp_options={"tol": 1e-6})
+    cols = ("current", "deflection")
+    path = _step_csv(tmp_path / "step.csv", t, truth, 11, cols, noise=0.005)
+    r = fit_dynamic(read_file(path), "diffusion,c_moy,modulus", strip=STRIP)
+    assert r.fidelity.startswith("time series pnp"), r.fidelity
+    assert "defect correction of the circuit" in r.message, r.message
+    _inside(r, {**TRUE, "modulus": MAT.E}, 0.01)
+
+    tol = float(r.fidelity.split("tol ")[1].split(")")[0])
+    rows = np.loadtxt(path, delimiter=",", skiprows=1, dtype=str)
+    meas = {c: rows[:, 2 + i].astype(float) for i, c in enumerate(cols)}
+    sig = {c: rows[:, 4 + i].astype(float) for i, c in enumerate(cols)}
+    keys = ("diffusion", "c_moy", "modulus")
+    x = np.log([r.parameters[k]["value"] for k in keys])
+
+    def res(xv):
+        d, c, e = np.exp(xv)
+        out = step_response(0.5, strip=STRIP, material=NAFION_LI.with_(D=d, c_moy=c, E=e),
+                            t=np.concatenate(([0.0], t)), fidelity="pnp", pnp_options={"tol": tol})
+        a = STRIP.width * STRIP.length
+        pred = {"current": out.current_density[1:] * a, "deflection": -out.w[1:]}
+        return np.concatenate([(pred[c] - meas[c]) / sig[c] for c in cols])
+
+    r0 = res(x)
+    sd = np.array([r.parameters[k]["stderr"] / r.parameters[k]["value"] for k in keys])
+    J = np.empty((r0.size, 3))
+    for j in range(3):
+        h = np.zeros(3)
+        h[j] = 0.2 * sd[j]
+        J[:, j] = (res(x + h) - res(x - h)) / (2 * h[j])
+    step = np.linalg.lstsq(J, -r0, rcond=None)[0]
+    sd_pnp = np.sqrt(np.diag(np.linalg.inv(J.T @ J)))
+    assert np.all(np.abs(step) < 0.01 * sd_pnp), (step / sd_pnp, r.message)
+    # the reported standard errors are the PNP's own (its Jacobian here) within 1 %
+    assert np.allclose(sd, sd_pnp, rtol=0.01), (sd, sd_pnp)
