@@ -135,12 +135,14 @@ def run(args):
             "viscous_modulus": args.viscous_modulus,
             "resonances": r.resonances,
             "error_max": None if r.error is None else r.error_max,
-            "reference": "pnp-linear (exact linearised Nernst-Planck/Gauss)",
+            "reference": ("pnp-linear (exact linearised Nernst-Planck/Gauss)" if args.voltage == 0.0 else
+                          f"the Nernst-Planck/Gauss equations linearised about the static state at {args.voltage:g} V "
+                          "(graded-mesh collocation, its error included; null where not computed)"),
             "electrode_area": strip.width * strip.length, "diffusion_coefficient": material.D,
             "units": {"f": "Hz", "Z": "Ohm (strip, electrode area 2l L)", "Z_abs": "Ohm", "Z_phase": "deg",
                       "w_amp": "m/V", "w_phase": "deg",
                       "theta_amp": "rad/V (free tip)", "theta_phase": "deg", "F_amp": "N/V (blocked tip)",
-                      "F_phase": "deg", "error": "relative, of Z and w against pnp-linear"},
+                      "F_phase": "deg", "error": "relative, of Z and w against the reference"},
             "notes": r.notes + [f"about phi0 = {args.voltage:g} V; w from the layers' charge, small displacements"]}
     if support is not None or electrode is not None:
         head["support"] = support
@@ -187,10 +189,12 @@ def run(args):
         print(f"{fmt_num(f[i], '11.4g')} {fmt_num(cols['Z_re'][i], '12.5g')} {fmt_num(cols['Z_im'][i], '12.5g')} "
               f"{fmt_num(cols['Z_abs'][i], '12.5g')} {fmt_num(cols['Z_phase'][i], '13.4g')} "
               f"{fmt_num(cols['w_amp'][i] * 1e3, '13.5g')} {fmt_num(cols['w_phase'][i], '11.4g')}"
-              + (f" {fmt_num(cols['error'][i], '9.2g')}" if ecol else ""))
+              + ("" if not ecol else f" {'n/a':>9s}" if not np.isfinite(cols['error'][i]) else
+                 f" {fmt_num(cols['error'][i], '9.2g')}"))
     print("legend: Z = impedance of the strip (electrode area 2l L), Z_abs and Z_phase as `fit` reads them; "
           "|w|/V, phase = free-tip deflection per volt and its phase against the voltage"
-          + ("; error = relative error of Z and w against pnp-linear" if ecol else ""))
+          + ("; error = relative error of Z and w against " + ("pnp-linear" if args.voltage == 0.0 else
+             f"the PNP linearised about {args.voltage:g} V (n/a: not computed there)") if ecol else ""))
     if clamped:  # amplitudes per volt
         print_clamped("f [Hz]", f, {n: cols[f"{n}_amp"] for n in CLAMPED_OUTPUTS}, per="/V")
     for n in head["notes"]:

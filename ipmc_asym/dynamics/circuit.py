@@ -54,6 +54,7 @@ from ipmc_asym.beam.dynamics import (
     static_outputs,
     transfer,
 )
+from ipmc_asym.dynamics.bias import bias_reference
 from ipmc_asym.dynamics.electrode import (
     capacitance_scale,
     charge,
@@ -99,6 +100,15 @@ DYNAMIC_NOTES = (
     "the cation diffusion coefficient D is not in the paper; " + D_CATION_SOURCE,
 )
 BEAM_CHOICES = ("quasi-static", "dynamic")
+#: said by a circuit step run without a tolerance: its error bound is a reference PNP run, 100-1000
+#: times the circuit's cost (1 V step, nominal strip, to 5 tau: circuit 0.01-0.02 s CPU; with tol
+#: 1e-2 1.9 s constant, 18 s affine, 1.4 s linear), so it is run only when asked for
+CIRCUIT_NO_TOL_NOTE = ("circuit: sigma, current and w errors are stated with a tolerance (step --tol T): the bound is "
+                       "a reference PNP run, 100-1000 times the circuit's cost (nominal 1 V step: 1.4-18 s CPU "
+                       "against 0.02 s), so it is not run by default")
+#: frequencies at which the biased circuit's error is computed against the linearised PNP at most
+#: (each costs two banded solves of 10^4 - 2 10^5 nodes: 0.05 - 0.6 s CPU measured, 20 um - 1 mm)
+REFERENCE_POINTS = 12
 #: the beam of every command and entry unless asked otherwise: the paper's quasi-static beam (the moment
 #: of the static problem bends the strip at once).  The dynamic beam adds inertia and a Kelvin-Voigt
 #: damping whose viscous modulus no source gives (default 0: undamped modes that ring for ever and put
@@ -690,6 +700,8 @@ def step_response(voltage=1.0, duration=None, *, strip: Strip | None = None, mod
         success, message = True, "reduced model integrated (variable-step BDF2, 2 substeps per output interval)"
         if pnp_ref:  # tol given: the reference PNP run bounds the circuit's current too
             cur_err = np.abs(J - pnp_ref[0].current_density) + pnp_ref[0].current_error
+        else:
+            notes.append(CIRCUIT_NO_TOL_NOTE)
     else:
         r = lad.last.result
         sig_err, cur_err = r.sigma_error, r.current_error
@@ -781,6 +793,34 @@ def circuit_impedance_error(f, thickness, perm: Permittivity, material: Material
     g = np.tanh(q / lam) / q
     tau = float(time_constant(thickness, perm, m))
     return np.abs(1.0 - g) / np.abs(1j * omega * tau + g)
+
+
+def _bias_error(f, Za, C0, bias, strip, perm, material, points):
+    """The biased circuit's relative error of ``Z`` and ``H_w`` against the PNP linearised about the bias.
+
+    ``(error, note)``: ``error`` (n,) NaN where the reference was not computed, or None (with the
+    reason in ``note``) where it refuses.  ``H_w`` of either model is ``h0 sigma/C_d`` (the layers'
+    moment at their charge; ``h0`` shared), so its relative error is that of ``C_d Z``: the circuit's
+    ``C_d`` (``corrected`` rung) against the exact one the reference meets at low frequency.  With
+    the reference's stated error ``eps``: ``(|x_c - x_r|/|x_r| + eps)/(1 - eps)`` bounds ``|x_c - x|/|x|``.
+    """
+    if points <= 0:
+        return None, "no error stated against the PNP linearised about the bias (reference_points=0)"
+    n = f.size
+    idx = np.arange(n) if n <= points else np.unique(np.round(np.linspace(0, n - 1, points)).astype(int))
+    try:
+        ref = bias_reference(f[idx], bias, strip, perm, material)
+    except RuntimeError as exc:
+        return None, f"no error stated: {exc}"
+    Cd = float(charge(strip.thickness, bias, perm, "exact", material=material).C_diff)
+    eps = ref.error
+    eZ = np.abs(Za[idx] - ref.Z_area) / np.abs(ref.Z_area)
+    eH = np.abs(C0 * Za[idx] / (Cd * ref.Z_area) - 1.0)
+    err = np.full(n, np.nan)
+    err[idx] = (np.maximum(eZ, eH) + eps) / (1.0 - eps)
+    where = "every frequency" if idx.size == n else f"{idx.size} of the {n} frequencies (the others: NaN)"
+    return err, (f"circuit: relative error of Z and H_w against the PNP linearised about the static state at {bias:g} V "
+                 f"(collocation on a graded mesh, its own error <= {float(eps.max()):.2g} included) in 'error', at {where}")
 
 
 def circuit_band(f, error, tol):
@@ -879,8 +919,9 @@ class FrequencyResult(ResultMixin):
 
 def frequency_response(f, *, strip: Strip | None = None, model="constant", material: Material | None = None,
                        method="pnp-linear", beam="quasi-static", viscous_modulus=0.0, n_modes=DEFAULT_MODES,
-                       voltage=0.0, support=None, electrode=None) -> FrequencyResult:
-    """Impedance and tip-deflection/voltage transfer function about zero volts.
+                       voltage=0.0, support=None, electrode=None,
+                       reference_points=REFERENCE_POINTS) -> FrequencyResult:
+    """Impedance and tip-deflection/voltage transfer function about zero volts or a DC bias.
 
     Parameters
     ----------
@@ -904,7 +945,11 @@ def frequency_response(f, *, strip: Strip | None = None, model="constant", mater
     voltage : float
         DC bias (V): small signal about the biased static state (``method="circuit"`` only:
         ``R`` in series with the layers' differential capacitance ``C_d(V)``, ``C_g`` across the
-        core; the moment slope ``dM_A/dV`` of the forward model).
+        core; the moment slope ``dM_A/dV`` of the forward model).  Its error is stated against
+        the PNP linearised about the biased static state (:func:`ipmc_asym.dynamics.bias.bias_reference`)
+        on at most ``reference_points`` of the frequencies (all of them when there are no more;
+        else equally spaced in index, the others' ``error`` NaN); ``reference_points=0``, or a
+        reference that refuses, states none (a note says why).
     support : {None, "clamped-free", "clamped-pinned", "clamped-clamped"}
         ``None`` (default), ``clamped-free`` or ``clamped-pinned``: the free tip (``H_w``,
         ``H_theta``) and the blocked tip (``H_F``), as always reported together;
@@ -968,6 +1013,8 @@ def frequency_response(f, *, strip: Strip | None = None, model="constant", mater
         Za = (R + 1.0 / (1j * omega * C0)) / (1.0 + 1j * omega * R * Cg)
         Hprof = None
         err = circuit_impedance_error(f, s.thickness, perm, m) if bias == 0.0 else None
+        if bias != 0.0:
+            err, bias_note = _bias_error(f, Za, C0, bias, s, perm, m, reference_points)
     # the layers' moment follows their charge: u = V(sigma) = sigma/C_d = J/(i omega C_d)
     Hw = h0 / (1j * omega * C0 * Za)
     HM = Hw / w_per_M  # moment per volt, N m/V
@@ -998,7 +1045,9 @@ def frequency_response(f, *, strip: Strip | None = None, model="constant", mater
     notes = dynamic_notes(beam, viscous_modulus, m) + support_notes(support, el)
     if bias != 0.0:
         notes.append(f"small signal about the static state at {bias:g} V (circuit: R, C_d({bias:g} V), C_g; "
-                     "dM_A/dV of the forward model); its error against a linearised PNP about the bias is not computed")
+                     "dM_A/dV of the forward model)")
+        if method == "circuit":
+            notes.append(bias_note)
     f_d = m.D / (2.0 * math.pi * (lam * e) ** 2)
     if Hprof is not None:
         notes.append("H_w_profiles: the moment of the linearised profiles, p' = (C + A3) E, which adds the pressure "
@@ -1010,6 +1059,7 @@ def frequency_response(f, *, strip: Strip | None = None, model="constant", mater
                      f"lambda/2 = {0.5 * lam:.3g} at any frequency")
     return FrequencyResult(f=f, Z=Za / area, Z_area=Za, H_w=Hw, w_amp=np.abs(Hw), w_phase=np.angle(Hw), tau=tau,
                            method=method, model=perm.name, notes=notes, H_w_profiles=Hprof, error=err, f_d=f_d,
-                           error_max=0.5 * lam if err is not None else math.nan, H_theta=Htheta, H_F=HF,
+                           error_max=(math.nan if err is None else 0.5 * lam if bias == 0.0
+                                      else float(np.nanmax(err))), H_theta=Htheta, H_F=HF,
                            resonances=resonances, beam=beam, voltage=bias, support=support, electrode=el,
                            H_clamped=Hcc)

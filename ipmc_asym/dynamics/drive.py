@@ -59,7 +59,8 @@ from ipmc_asym.model.params import (
 )
 from ipmc_asym.model.permittivity import get_model
 
-__all__ = ["DRIVE_COLUMNS", "CHECK_COLUMNS", "LINE_COLUMNS", "CLAMPED_COLUMNS", "MAX_DRIVE_POINTS", "drive_info", "drive_chunks",
+__all__ = ["DRIVE_ERROR_NOTE",
+           "DRIVE_COLUMNS", "CHECK_COLUMNS", "LINE_COLUMNS", "CLAMPED_COLUMNS", "MAX_DRIVE_POINTS", "drive_info", "drive_chunks",
            "drive_response", "LINE_NOTE"]
 
 DRIVE_COLUMNS = ("t", "phi0", "sigma", "current_density", "layer_voltage", "M_A", "theta", "w", "F_block")
@@ -72,6 +73,15 @@ CLAMPED_COLUMNS = CLAMPED_OUTPUTS
 #: with a sheet resistance: the stated discretisation error of sigma (C/m^2) and w (m) of the line
 LINE_COLUMNS = ("sigma_error", "w_error")
 
+#: said by every drive run: its rows carry no error of the reduced circuit against the PNP.  The
+#: circuit's error is bounded in the frequency domain (``freq``: ``error``, at most lambda/2 about
+#: 0 V, against the PNP linearised about the bias with a bias) and in time against a PNP run
+#: (``step --tol``, 100-1000 times the circuit's cost); for an arbitrary waveform neither carries
+#: over: the large-signal charging is nonlinear, and a PNP run over a long waveform is what the
+#: streamed circuit avoids
+DRIVE_ERROR_NOTE = ("no error of the reduced circuit against the PNP is stated for these rows (an arbitrary waveform "
+                    "stepped through the circuit is not bounded): see freq --method circuit ('error', small signal) or "
+                    "step --tol T (a reference PNP run, in memory)")
 LINE_NOTE = ("electrodes: sheet resistance R_s = {Rs:g} Ohm/sq each: the RC line along the strip discretised in "
              "{n2} segments (trapezoidal ladder, a reduced circuit at each node, driven at the clamp, open at the tip); "
              "sigma, current density and layer voltage are means over the electrode; sigma_error and w_error are twice "
@@ -123,7 +133,8 @@ def drive_info(strip: Strip, model, material: Material, beam=DEFAULT_BEAM, visco
     support, el = _support(support, electrode, strip, Rs)
     info = {"tau": float(time_constant(strip.thickness, perm, material)),
             "R": float(core_resistance(strip.thickness, material)), "model": perm.name, "beam": beam,
-            "viscous_modulus": float(viscous_modulus), "notes": dynamic_notes(beam, viscous_modulus, material)}
+            "viscous_modulus": float(viscous_modulus),
+            "notes": dynamic_notes(beam, viscous_modulus, material) + [DRIVE_ERROR_NOTE]}
     if Rs > 0.0:
         info["sheet_resistance"] = Rs
         info["line_segments"] = 2 * int(line_segments)

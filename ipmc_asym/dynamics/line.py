@@ -356,13 +356,14 @@ def line_response(f, *, strip: Strip | None = None, model="constant", material: 
     Rs = check_finite("sheet_resistance", Rs, "a finite number >= 0 Ohm/sq")
     if Rs < 0.0:
         raise ValueError(f"sheet_resistance must be a finite number >= 0 Ohm/sq; got {sheet_resistance!r}")
-    u = frequency_response(f, strip=s, model=model, material=m, method=method, voltage=voltage)
+    u = frequency_response(f, strip=s, model=model, material=m, method=method, voltage=voltage,
+                           reference_points=0)
     L = s.length
     Z, Hw, Hth, HF, HM, g, be = _line(u, s, m, Rs, "quasi-static" if Rs == 0.0 else beam, viscous_modulus, n_modes)
     if Rs == 0.0 and beam == "dynamic":
         # ideal electrodes: exactly the uniform strip's modal response (no quadrature)
         d = frequency_response(f, strip=s, model=model, material=m, method=method, voltage=voltage, beam=beam,
-                               viscous_modulus=viscous_modulus, n_modes=n_modes)
+                               viscous_modulus=viscous_modulus, n_modes=n_modes, reference_points=0)
         Hw, Hth, HF = d.H_w, d.H_theta, d.H_F
     err = None
     if u.error is not None:

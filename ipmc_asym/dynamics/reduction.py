@@ -360,7 +360,8 @@ def transfer_function(f_min, f_max, *, strip: Strip | None = None, model="consta
             r = line_response(f, strip=s_, model=model, material=m, method=method, **response_kw)
         else:
             kw = {k: v for k, v in response_kw.items() if k != "sheet_resistance"}
-            r = frequency_response(f, strip=s_, model=model, material=m, method=method, **kw)
+            # the fit reads the response only (the biased circuit's error is not part of it)
+            r = frequency_response(f, strip=s_, model=model, material=m, method=method, reference_points=0, **kw)
         if output in ("charge", "current"):
             # fitted as the charge per volt Q = Y/s: the current I = s Q has a zero at s = 0 that
             # a relative fit of Y itself cannot pin

@@ -62,6 +62,9 @@ def test_freq_bias_without_method_picks_the_method_that_supports_it(capsys):
     assert main(base + ["--method", "circuit"]) == 0
     b = json.loads(capsys.readouterr().out)
     assert a["method"] == "circuit" and a == b
+    # its error against the PNP linearised about the bias (the keys of the 0 V case)
+    assert len(a["error"]) == 4 and all(e is not None and 0.0 < e < 0.1 for e in a["error"])
+    assert a["error_max"] == max(a["error"]) and "0.5 V" in a["reference"]
     assert main(base + ["--method", "pnp-linear"]) == 2
     err = capsys.readouterr().err  # the library's one refusal, named by the parameter
     assert len(err.strip().splitlines()) == 1 and "voltage" in err and "circuit" in err

@@ -191,3 +191,16 @@ def test_support_and_electrode_refusals_one_line(args, word, capsys):
     assert code == 2
     err = capsys.readouterr().err.strip()
     assert word in err and len(err.splitlines()) == 1
+
+
+def test_drive_says_in_one_line_that_its_rows_state_no_error(capsys):
+    """drive's rows carry no circuit error (an arbitrary waveform is not bounded): one note line says
+    so and where an error is stated (freq's small signal, step --tol), in the text and in --json."""
+    from ipmc_asym.dynamics.drive import DRIVE_ERROR_NOTE
+
+    base = ["drive", "--waveform", "sine:0.1V@5Hz", "--duration", "0.1s", "--points", "21", "--beam", "quasi-static"]
+    assert main(base) == 0
+    lines = [ln for ln in capsys.readouterr().out.splitlines() if "no error of the reduced circuit" in ln]
+    assert lines == [f"note: {DRIVE_ERROR_NOTE}"] and "--tol" in lines[0] and "freq" in lines[0]
+    assert main(base + ["--json"]) == 0
+    assert DRIVE_ERROR_NOTE in json.loads(capsys.readouterr().out)["notes"]

@@ -138,15 +138,28 @@ def test_cli_step_states_w_error_by_default_for_pnp_and_with_tol(capsys):
     assert "w [mm]        +-" in out
 
 
-def test_freq_about_a_bias_does_not_claim_the_zero_volt_error():
-    """About a bias no error is computed (said in a note); the closed-form error note of the
-    linearisation about 0 V is not printed there (it was, with no 'error' column to point to)."""
+def test_freq_about_a_bias_states_its_own_error():
+    """About a bias the error is against the PNP linearised about the bias (said in a note, the
+    0 V closed-form note is not printed); with reference_points=0 none is stated and the note says so."""
     from ipmc_asym.dynamics.circuit import frequency_response
 
     f = np.array([0.1, 10.0])
     r = frequency_response(f, method="circuit", voltage=1.0)
-    assert r.error is None
-    assert not any("in 'error'" in n for n in r.notes)
-    assert any("not computed" in n for n in r.notes)
+    assert r.error is not None and np.all(np.isfinite(r.error)) and r.error_max == r.error.max()
+    assert any("linearised about the static state at 1 V" in n for n in r.notes)
+    assert not any("lambda/2" in n for n in r.notes)
+    r1 = frequency_response(f, method="circuit", voltage=1.0, reference_points=0)
+    assert r1.error is None and any("no error stated" in n for n in r1.notes)
     r0 = frequency_response(f, method="circuit")
     assert r0.error is not None and any("in 'error'" in n for n in r0.notes)
+
+
+def test_circuit_step_without_tol_says_where_its_error_is():
+    """Without a tolerance the circuit states no error (its bound is a PNP run, 100-1000x its cost)
+    and a note says so and how to get one; with --tol the note is not printed."""
+    from ipmc_asym.dynamics.circuit import CIRCUIT_NO_TOL_NOTE, step_response
+
+    r = step_response(0.5, points=20)
+    assert r.fidelity == "circuit" and CIRCUIT_NO_TOL_NOTE in r.notes and "--tol" in CIRCUIT_NO_TOL_NOTE
+    r = step_response(0.5, points=20, tol=1e-2)
+    assert CIRCUIT_NO_TOL_NOTE not in r.notes

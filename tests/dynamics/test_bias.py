@@ -1,0 +1,83 @@
+"""The PNP linearised about a biased static state (dynamics/bias.py) and the biased circuit's error.
+
+Independent checks: at 0 V the closed form ``pnp-linear``; at low frequency the exact static
+differential capacitance ``dsigma/dphi0`` (``charge``, rung ``exact``); the stated error of the
+biased circuit against the reference recomputed on finer meshes."""
+
+import numpy as np
+import pytest
+
+import ipmc_asym as ia
+from ipmc_asym.dynamics import bias as B
+from ipmc_asym.dynamics.bias import bias_reference
+from ipmc_asym.dynamics.circuit import frequency_response
+from ipmc_asym.model.params import Strip
+
+F = np.geomspace(1e-3, 1e5, 7)
+
+
+@pytest.mark.parametrize("th", [20e-6, 200e-6, 1e-3])
+@pytest.mark.parametrize("model", ["constant", "linear", "affine"])
+def test_zero_volt_is_pnp_linear(th, model):
+    s = Strip(thickness=th)
+    r = bias_reference(F, 0.0, s, model)
+    p = frequency_response(F, strip=s, model=model)
+    dev = np.abs(r.Z_area / p.Z_area - 1.0)
+    assert np.all(dev <= r.error) and dev.max() < 3e-8
+    assert r.error.max() < 2e-7
+
+
+@pytest.mark.parametrize("th", [20e-6, 1e-3])
+@pytest.mark.parametrize("model", ["constant", "affine"])
+def test_small_bias_tends_to_zero_volt(th, model):
+    """Z is even in the bias: at 1 uV (A2 ~ 4e-5) it is the 0 V closed form to ~A2^2."""
+    s = Strip(thickness=th)
+    r = bias_reference(F[:4], 1e-6, s, model)
+    p = frequency_response(F[:4], strip=s, model=model)
+    assert np.all(np.abs(r.Z_area / p.Z_area - 1.0) <= r.error + 1e-8)
+
+
+@pytest.mark.parametrize("th", [20e-6, 1e-3])
+@pytest.mark.parametrize("model,V", [("constant", 0.05), ("constant", -1.0), ("constant", 5.0),
+                                     ("affine", 0.05), ("affine", -1.0), ("affine", 3.0), ("linear", 0.05),
+                                     ("linear", -0.05)])
+def test_low_frequency_is_the_static_differential_capacitance(th, model, V):
+    s = Strip(thickness=th)
+    r = bias_reference([1e-7], V, s, model)
+    Cd = float(ia.charge(th, V, model, "exact").C_diff)
+    assert abs(r.charge_transfer[0] / Cd - 1.0) <= r.error[0]
+    assert r.error[0] < 2e-5
+
+
+def test_reference_refuses_where_the_static_state_is_not_resolved():
+    """The linear model's anode concentration ~e^{-A2}: at 1 V the static limit misses dsigma/dphi0,
+    and the reference refuses in one line rather than state a bound."""
+    with pytest.raises(RuntimeError, match="differential capacitance|not resolved"):
+        bias_reference([1.0], 1.0, Strip(thickness=200e-6), "linear")
+
+
+def test_sign_of_the_bias_is_a_mirror_image():
+    s = Strip(thickness=200e-6)
+    a = bias_reference([1.0, 100.0], 0.7, s, "affine")
+    b = bias_reference([1.0, 100.0], -0.7, s, "affine")
+    assert np.array_equal(a.Z_area, b.Z_area)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("th", [20e-6, 1e-3])
+@pytest.mark.parametrize("model,V", [("constant", 0.3), ("constant", -2.0), ("affine", 0.05),
+                                     ("affine", -1.0), ("linear", 0.05)])
+def test_biased_circuit_error_bounds_a_finer_reference(th, model, V, monkeypatch):
+    """The stated error bounds the circuit's deviation from the reference on a finer mesh (every
+    interval split in 4 more): ratio actual/stated <= 1, and the bound is not loose by more than 2x."""
+    f = np.geomspace(1e-2, 1e4, 5)
+    s = Strip(thickness=th)
+    r = frequency_response(f, strip=s, model=model, method="circuit", voltage=V)
+    assert r.error is not None
+    mesh = B._graded_mesh
+    monkeypatch.setattr(B, "MAX_NODES", 10**7)
+    monkeypatch.setattr(B, "_graded_mesh", lambda ell, extra, refine=1: mesh(ell, extra, 4 * refine))
+    fine = bias_reference(f, V, s, model)
+    actual = np.abs(r.Z_area - fine.Z_area) / np.abs(fine.Z_area)
+    assert np.all(actual <= r.error)
+    assert np.all(r.error <= 2.0 * actual + 1e-6)
