@@ -61,7 +61,21 @@ def test_table_says_which_thickness(capsys):
     (["--c-moy", "lots"], "c-moy"),
     (["--length", "3 furlongs"], "length"),
 ])
-def test_bad_input_exit_2_one_line(args, word):
+def test_bad_input_exit_2_one_line(args, word, capsys):
+    # in process (the status main() returns, or argparse's exit): the same code path as the
+    # command; the process's own exit status and stderr are checked once, below
+    try:
+        rc = main(["estimate", *args])
+    except SystemExit as exc:
+        rc = exc.code
+    err = capsys.readouterr().err
+    assert rc == 2
+    assert "Traceback" not in err
+    assert len(err.strip().splitlines()) == 1 and word in err
+
+
+@pytest.mark.parametrize("args,word", [(["--thickness=-3um"], "thickness"), (["--model", "quadratic"], "model")])
+def test_bad_input_exit_2_one_line_as_a_process(args, word):
     p = run("estimate", *args)
     assert p.returncode == 2
     assert "Traceback" not in p.stderr
