@@ -171,12 +171,14 @@ def scalar_call(number: int = 20000) -> dict:
     return out
 
 
-def startup_ratio(repeats: int = 3) -> dict:
-    """Best-of wall times of warm ``estimate --fidelity leading`` and ``import numba``, fresh processes."""
+def startup_ratio(repeats: int = 3, warm: bool = True) -> dict:
+    """Best-of wall times of warm ``estimate --fidelity leading`` and ``import numba``, fresh processes
+    (``warm``: one untimed ``estimate`` run first)."""
     env = subprocess_env()
     est = [sys.executable, "-c", "from ipmc_asym.cli import main; main(['estimate', '--fidelity', 'leading'])"]
     nb = [sys.executable, "-c", "import numba"]
-    subprocess.run(est, env=env, capture_output=True, timeout=600)  # warm every cache
+    if warm:
+        subprocess.run(est, env=env, capture_output=True, timeout=600)  # warm every cache
     te = tn = math.inf
     for _ in range(max(1, int(repeats))):  # interleaved: the same machine load for both
         t0 = time.perf_counter()
@@ -199,7 +201,7 @@ def section(quick: bool = False) -> dict:
     tl = api_vs_transcendentals(n=2 * 10**5 if quick else 10**7, repeats=reps)
     tmp = temporaries_per_point(n=10**5 if quick else 10**6)
     sc = scalar_call(number=2000 if quick else 20000)
-    st = startup_ratio(repeats=1 if quick else 3)
+    st = startup_ratio(repeats=1 if quick else 3, warm=not quick)
     figs = []
     cpu = f"CPU time, load {ex['load']:.2f}"
     for model, s in ex["exact_s"].items():

@@ -100,10 +100,11 @@ def compile_seconds(fidelity_group: str):
     return out[0], out[1]
 
 
-def startup_time(repeats: int = 3) -> dict:
+def startup_time(repeats: int = 3, warm: bool = True) -> dict:
     """Wall time of ``ipmc-asym estimate --fidelity leading`` in a fresh process (cache warm).
 
-    One untimed run first fills the cache; the best of ``repeats`` timed runs is reported,
+    One untimed run first fills the cache (``warm``; without it a cold cache shows in the
+    figure); the best of ``repeats`` timed runs is reported,
     with the heavy modules that process imported (must not include SymPy, SciPy's
     ``integrate`` or matplotlib).
     """
@@ -111,7 +112,8 @@ def startup_time(repeats: int = 3) -> dict:
     code = ("import sys; from ipmc_asym.cli import main; rc = main(['estimate', '--fidelity', 'leading']); "
             "print('MODULES', ','.join(m for m in ('sympy', 'scipy.integrate', 'matplotlib') if m in sys.modules))")
     cmd = [sys.executable, "-c", code]
-    subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=600)  # warm the cache
+    if warm:
+        subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=600)  # warm the cache
     best, heavy = math.inf, ""
     for _ in range(max(1, int(repeats))):
         t0 = time.perf_counter()

@@ -137,7 +137,8 @@ def run_bench(points: int = 10**6, bvp_points: int = 5, repeats: int = 3, seed: 
         The sections' smallest sizes.
     quick : bool
         The smallest sizes throughout (what the tests run): the sections' (``quick_sections``),
-        one repeat, one compile measurement (the closed forms' driver), one start-up run.
+        one repeat, one compile measurement (the closed forms' driver), one start-up run and
+        no untimed warm-up runs of the fresh-process figures (the Numba cache is normally warm).
 
     Returns
     -------
@@ -166,7 +167,7 @@ def run_bench(points: int = 10**6, bvp_points: int = 5, repeats: int = 3, seed: 
     threads = max(1, min(int(threads), numba.config.NUMBA_NUM_THREADS))
     load0 = load()
     comp = {}
-    startup = startup_time(repeats=1 if quick else 3) if compile_times else None
+    startup = startup_time(repeats=1 if quick else 3, warm=not quick) if compile_times else None
     if compile_times:
         closed = compile_seconds("leading")
         comp = {

@@ -66,6 +66,9 @@ def test_checks_may_stop_the_climb():
 
 
 def _climbs(fn) -> int:
+    """Calls of ``climb`` during a second ``fn()``: the first, unprofiled, compiles or loads the
+    kernels it needs (Numba's compiler under the profiler is most of the cost otherwise)."""
+    fn()
     pr = cProfile.Profile()
     pr.enable()
     try:

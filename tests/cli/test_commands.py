@@ -61,7 +61,21 @@ def test_table_says_which_thickness(capsys):
     (["--c-moy", "lots"], "c-moy"),
     (["--length", "3 furlongs"], "length"),
 ])
-def test_bad_input_exit_2_one_line(args, word):
+def test_bad_input_exit_2_one_line(args, word, capsys):
+    # in process (the status main() returns, or argparse's exit): the same code path as the
+    # command; the process's own exit status and stderr are checked once, below
+    try:
+        rc = main(["estimate", *args])
+    except SystemExit as exc:
+        rc = exc.code
+    err = capsys.readouterr().err
+    assert rc == 2
+    assert "Traceback" not in err
+    assert len(err.strip().splitlines()) == 1 and word in err
+
+
+@pytest.mark.parametrize("args,word", [(["--thickness=-3um"], "thickness"), (["--model", "quadratic"], "model")])
+def test_bad_input_exit_2_one_line_as_a_process(args, word):
     p = run("estimate", *args)
     assert p.returncode == 2
     assert "Traceback" not in p.stderr
@@ -98,11 +112,30 @@ def test_strip_validation(kw, word):
         Strip(**kw)
 
 
-@pytest.mark.slow
-def test_derive_check_cli():
-    """Regenerate the kernels into a temp dir: any difference with the committed file fails
-    (the one run of the drift check)."""
-    assert main(["derive", "--check"]) == 0
+def test_derive_check_cli(monkeypatch, tmp_path):
+    """``derive --check`` runs the drift check of every generated module (``codegen.check()``, no
+    selection) and exits with its status: 0 when the regenerated text is the file's, 1 on any
+    difference.  The comparison itself runs here on one module; each module is compared to its
+    derivation once, in tests/derivations/test_codegen.py."""
+    import ipmc_asym_derivations.codegen as cg
+
+    real, seen = cg.check, []
+
+    def check(only=None):
+        seen.append(only)
+        return real(only)
+
+    monkeypatch.setattr(cg, "check", check)
+    exact = next(t for t in cg.TARGETS if t.name == "_generated_exact.py")
+    monkeypatch.setattr(cg, "TARGETS", (exact,))
+    assert main(["derive", "--check"]) == 0 and seen == [None]
+    # the same module with one character changed on disk: the check fails
+    changed = tmp_path / "kernels" / exact.name
+    changed.parent.mkdir()
+    changed.write_text(exact.path.read_text(encoding="utf-8").replace("GENERATED", "GENERATEd", 1), encoding="utf-8")
+    monkeypatch.setattr(cg, "ROOT", tmp_path)
+    monkeypatch.setattr(cg, "TARGETS", (exact._replace(path=changed),))
+    assert main(["derive", "--check"]) == 1
 
 
 def test_estimate_pressure_term(capsys):

@@ -159,15 +159,16 @@ def test_printed_powers_evaluate_as_sympy(printer):
             assert got == pytest.approx(ref(x, t, y), rel=1e-13), (ex, code)
 
 
-#: the Debye-Hueckel module needs the order-4 perturbation solution (~1 min of SymPy; its
-#: remainder constants) and the charge module ~13 s: both are checked, with every other
-#: module, by the slow ``derive --check`` test (tests/cli/test_commands.py); each other one
-#: here, in seconds
+#: the Debye-Hueckel module needs the order-4 perturbation solution (~1 min of SymPy unless kept
+#: on disk; its remainder constants) and the charge module ~13 s: slow; each other one in seconds.
+#: Every module is checked here once (``derive --check`` is this same comparison for all of them:
+#: tests/cli/test_commands.py checks that the command runs it)
 _SLOW_TARGETS = ("_generated_dh.py", "_generated_charge.py")
-_QUICK_TARGETS = sorted(t.name for t in codegen.TARGETS if t.name not in _SLOW_TARGETS)
+_TARGETS = [pytest.param(t.name, marks=pytest.mark.slow) if t.name in _SLOW_TARGETS else t.name
+            for t in codegen.TARGETS]
 
 
-@pytest.mark.parametrize("name", _QUICK_TARGETS)
+@pytest.mark.parametrize("name", _TARGETS)
 def test_generated_module_matches_its_derivation(name):
     """Regenerated in memory, the module is the committed file to the character."""
     assert codegen.check([name]) == 0
