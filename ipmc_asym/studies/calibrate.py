@@ -763,6 +763,24 @@ def _fit(data, bounds, names, p, n, lo, hi, x0, ladder, starts, model, material,
                              noise_scale=noise_scale, warnings=warns)
 
 
+def _log_covariance(J, s2):
+    """``(cov, sd_log)``: the linearised covariance ``s2 (J^T J)^+`` of the log parameters and their
+    standard errors."""
+    J = np.asarray(J, float)
+    cov = s2 * np.linalg.pinv(J.T @ J)
+    return cov, np.sqrt(np.clip(np.diag(cov), 0.0, None))
+
+
+def _interval_scale(J, chi2, n, p, has_sigma, stats):
+    """``(s2, thr, cov, sd_log)`` at an optimum with Jacobian ``J`` and ``chi2``: the residuals'
+    scale (1 with known sigma, else ``chi2/(n - p)``, NaN without a degree of freedom), the
+    threshold of ``Delta chi^2 / s2`` for a 95 % profile interval, and :func:`_log_covariance`."""
+    dof = n - p
+    s2 = 1.0 if has_sigma else (chi2 / dof if dof > 0 else float("nan"))
+    thr = float(stats.chi2.ppf(0.95, 1)) if has_sigma else float(stats.t.ppf(0.975, dof) ** 2)
+    return (s2, thr, *_log_covariance(J, s2))
+
+
 def _report(prob, res, lo, hi, n, has_sigma, stats, notes, warns, ends=None):
     """Estimates, profile intervals, statuses and correlations at the optimum ``res`` of ``prob``.
 
@@ -782,17 +800,13 @@ def _report(prob, res, lo, hi, n, has_sigma, stats, notes, warns, ends=None):
     # (s^2 = chi^2/(n - p)) and chi2/(s^2 (n - p)) = 1 identically
     chi2_red = s2_hat if has_sigma else None
     noise_scale = None if has_sigma else math.sqrt(s2_hat)
-    s2 = 1.0 if has_sigma else s2_hat
-    thr = float(stats.chi2.ppf(0.95, 1)) if has_sigma else float(stats.t.ppf(0.975, dof) ** 2)
+    s2, thr, cov, sd_log = _interval_scale(res.jac, chi2, n, p, has_sigma, stats)
     if has_sigma and dof > 0:
         pval = float(stats.chi2.sf(chi2, dof))
         if pval < 1e-3:
             warns.append(_outlier_warning(prob, res.x, chi2_red, pval, dof))
 
     J = np.asarray(res.jac, float)
-    cov = s2 * np.linalg.pinv(J.T @ J)
-    sd_log = np.sqrt(np.clip(np.diag(cov), 0.0, None))
-
     params, quad = {}, []
     for j, nm in enumerate(names):
         lo_ci, hi_ci, why = _profile(prob, res.x, j, lo, hi, chi2, s2, thr, sd_log[j], ends)

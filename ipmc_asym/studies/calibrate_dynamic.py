@@ -96,6 +96,8 @@ from ipmc_asym.studies.calibrate import (
     CalibrationData,
     CalibrationResult,
     MeasuredColumns,
+    _interval_scale,
+    _log_covariance,
     _material,
     _multistart_task,
     _perm,
@@ -1185,12 +1187,6 @@ DEFECT_ITERATIONS = 8
 _DEFECT_SERIAL = itertools.count()
 
 
-def _sd_log(J, s2):
-    """Linearised standard errors of the log parameters."""
-    J = np.asarray(J, float)
-    return np.sqrt(np.clip(np.diag(s2 * np.linalg.pinv(J.T @ J)), 0.0, None))
-
-
 def _defect_solve(prob, x, lo, hi, has_sigma, n, notes):
     """The optimum of ``prob`` (its time series on the PNP rung) by defect correction of the circuit.
 
@@ -1228,7 +1224,7 @@ def _defect_solve(prob, x, lo, hi, has_sigma, n, notes):
         xs = x.copy()
         xs[j] += h
         Jc[:, j] = (circ.residuals(xs) - rc) / h
-    sd = _sd_log(Jc, s2_of(rc))
+    sd = _log_covariance(Jc, s2_of(rc))[1]
     slope, runs, step = None, 0, math.inf
     for it in range(DEFECT_ITERATIONS):
         rp = pnp.residuals(x)
@@ -1249,7 +1245,7 @@ def _defect_solve(prob, x, lo, hi, has_sigma, n, notes):
         prob.defect = {"names": list(prob.names), "xi0": x.copy(), "d0": d0, "slope": slope, "rel": rel,
                        "serial": next(_DEFECT_SERIAL)}
         res = _solve(prob, x, lo, hi)
-        sd = _sd_log(res.jac, s2_of(np.asarray(res.fun, float)))
+        sd = _log_covariance(res.jac, s2_of(np.asarray(res.fun, float)))[1]
         step = float(np.max(np.abs(res.x - x) / np.where(sd > 0, sd, np.inf)))
         x = res.x
         if step < DEFECT_STEP:
@@ -1272,11 +1268,8 @@ def _check_ends(prob, pnp, res, ends, params, n, has_sigma, stats, notes):
     errors, inwards when positive.  An end that would move outwards is widened by that much
     (a margin, not a re-solve); the largest move is stated in the notes.
     """
-    p = len(prob.names)
-    chi2 = 2.0 * float(res.cost)
-    s2 = 1.0 if has_sigma else chi2 / max(n - p, 1)
-    thr = float(stats.chi2.ppf(0.95, 1)) if has_sigma else float(stats.t.ppf(0.975, max(n - p, 1)) ** 2)
-    sd = _sd_log(res.jac, s2)
+    # the scale, threshold and standard errors the intervals were profiled with (one home: calibrate)
+    s2, thr, _, sd = _interval_scale(res.jac, 2.0 * float(res.cost), n, len(prob.names), has_sigma, stats)
 
     def gap(x):
         a, b = pnp.residuals(x), prob.residuals(x)
