@@ -79,6 +79,8 @@ class BiasReference:
     error : ndarray (n,)            stated relative error of ``Z_area`` and ``charge_transfer``
     voltage : float                 the bias, V
     nodes : int                     nodes of the finer mesh
+    C_diff : float                  the exact static ``dsigma/dphi0`` at the bias (F/m^2) that the low-frequency
+                                    limit was checked against (NaN at 0 V: no check there)
     """
 
     f: np.ndarray
@@ -87,6 +89,7 @@ class BiasReference:
     error: np.ndarray
     voltage: float
     nodes: int
+    C_diff: float = math.nan
 
 
 def _static(strip: Strip, perm: Permittivity, material: Material, V: float):
@@ -207,7 +210,8 @@ def _solve(x, u, D, lam2, r0, W):
 def _check_static_limit(s, perm, m, V, xs, profile, lam, lam2, r0, sig_scale):
     """Refuse (``RuntimeError``) unless the charge per volt at ``W = 1e-8`` equals the exact static
     differential capacitance ``dsigma/dphi0`` (:func:`ipmc_asym.integral.charge.charge`, rung
-    ``exact``) within its stated error plus the frequency's own effect ``2 W lambda`` (``omega tau``).
+    ``exact``) within its stated error plus the frequency's own effect ``2 W lambda`` (``omega tau``);
+    returns that capacitance (F/m^2).
 
     An independent check of the static state as the reference sees it: the linear model's
     concentration falls to ``~B1 e^{-A2}`` at the anode, where the static solver's spline of
@@ -228,6 +232,7 @@ def _check_static_limit(s, perm, m, V, xs, profile, lam, lam2, r0, sig_scale):
     if not miss <= stated + 2.0 * W0 * lam:
         raise RuntimeError(f"bias reference at {V:g} V ({perm.name} model): its static limit misses the exact "
                            f"differential capacitance by {miss:.2g} (stated {stated:.2g}); no reference at this bias")
+    return Cd
 
 
 def bias_reference(f, voltage, strip: Strip | None = None, model="constant",
@@ -300,10 +305,10 @@ def bias_reference(f, voltage, strip: Strip | None = None, model="constant",
         Z[i] = (e / kappa) / (1j * Wi * d)
         ct[i] = sig_scale * d
         err[i] = 2.0 * abs(d2 - d1) / abs(d) + ROUNDING + (10.0 * BVP_STATED_ERROR if V != 0.0 else 0.0)
-    if V != 0.0:
-        _check_static_limit(s, perm, m, V, xs, profile, lam, lam2, r0, sig_scale)
+    Cd = _check_static_limit(s, perm, m, V, xs, profile, lam, lam2, r0, sig_scale) if V != 0.0 else math.nan
     bad = err > BIAS_REFERENCE_CEILING
     if np.any(bad):
         raise RuntimeError(f"bias reference at {V:g} V: stated error {err.max():.2g} above "
                            f"{BIAS_REFERENCE_CEILING:g} at {f[bad][0]:.4g} Hz (layers not resolved)")
-    return BiasReference(f=f, Z_area=Z, charge_transfer=ct, error=err, voltage=V, nodes=int(nodes))
+    return BiasReference(f=f, Z_area=Z, charge_transfer=ct, error=err, voltage=V, nodes=int(nodes),
+                         C_diff=Cd)

@@ -812,10 +812,9 @@ def _bias_error(f, Za, C0, bias, strip, perm, material, points):
         ref = bias_reference(f[idx], bias, strip, perm, material)
     except RuntimeError as exc:
         return None, f"no error stated: {exc}"
-    Cd = float(charge(strip.thickness, bias, perm, "exact", material=material).C_diff)
     eps = ref.error
     eZ = np.abs(Za[idx] - ref.Z_area) / np.abs(ref.Z_area)
-    eH = np.abs(C0 * Za[idx] / (Cd * ref.Z_area) - 1.0)
+    eH = np.abs(C0 * Za[idx] / (ref.C_diff * ref.Z_area) - 1.0)
     err = np.full(n, np.nan)
     err[idx] = (np.maximum(eZ, eH) + eps) / (1.0 - eps)
     where = "every frequency" if idx.size == n else f"{idx.size} of the {n} frequencies (the others: NaN)"
@@ -1012,8 +1011,9 @@ def frequency_response(f, *, strip: Strip | None = None, model="constant", mater
         Cg = float(groups.geometric_capacitance(s.thickness, perm.eps_moy))
         Za = (R + 1.0 / (1j * omega * C0)) / (1.0 + 1j * omega * R * Cg)
         Hprof = None
-        err = circuit_impedance_error(f, s.thickness, perm, m) if bias == 0.0 else None
-        if bias != 0.0:
+        if bias == 0.0:
+            err = circuit_impedance_error(f, s.thickness, perm, m)
+        else:
             err, bias_note = _bias_error(f, Za, C0, bias, s, perm, m, reference_points)
     # the layers' moment follows their charge: u = V(sigma) = sigma/C_d = J/(i omega C_d)
     Hw = h0 / (1j * omega * C0 * Za)
@@ -1046,8 +1046,7 @@ def frequency_response(f, *, strip: Strip | None = None, model="constant", mater
     if bias != 0.0:
         notes.append(f"small signal about the static state at {bias:g} V (circuit: R, C_d({bias:g} V), C_g; "
                      "dM_A/dV of the forward model)")
-        if method == "circuit":
-            notes.append(bias_note)
+        notes.append(bias_note)  # a bias is refused above with any method but the circuit
     f_d = m.D / (2.0 * math.pi * (lam * e) ** 2)
     if Hprof is not None:
         notes.append("H_w_profiles: the moment of the linearised profiles, p' = (C + A3) E, which adds the pressure "
