@@ -978,6 +978,8 @@ def frequency_response(f, *, strip: Strip | None = None, model="constant", mater
     el = check_electrode(electrode, s.length)
     if bias != 0.0 and method != "circuit":
         raise ValueError("voltage: a DC bias needs method 'circuit' (pnp-linear is the linearisation about 0 V)")
+    if isinstance(reference_points, bool) or not isinstance(reference_points, (int, np.integer)) or reference_points < 0:
+        raise ValueError(f"reference_points must be an integer >= 0; got {reference_points!r}")
     e = s.e
     lam = float(groups.debye_length(s.thickness, perm.eps_moy, m))
     kappa = float(groups.kappa(m))

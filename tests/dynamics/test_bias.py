@@ -81,3 +81,9 @@ def test_biased_circuit_error_bounds_a_finer_reference(th, model, V, monkeypatch
     actual = np.abs(r.Z_area - fine.Z_area) / np.abs(fine.Z_area)
     assert np.all(actual <= r.error)
     assert np.all(r.error <= 2.0 * actual + 1e-6)
+
+
+@pytest.mark.parametrize("bad", [2.5, -1, "12", True])
+def test_reference_points_must_be_a_count(bad):
+    with pytest.raises(ValueError, match="reference_points must be an integer >= 0"):
+        frequency_response([1.0], method="circuit", voltage=0.5, reference_points=bad)
