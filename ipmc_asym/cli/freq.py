@@ -131,7 +131,7 @@ def run(args):
     for n in CLAMPED_OUTPUTS if clamped else ():
         cols[f"{n}_amp"], cols[f"{n}_phase"] = np.abs(r.H_clamped[n]), np.angle(r.H_clamped[n], deg=True)
     head = {"tau": r.tau, "model": r.model, "method": r.method, "thickness_total": strip.thickness,
-            "f_d": r.f_d, "voltage": args.voltage, "beam": args.beam,
+            "f_d": r.f_d, "voltage": args.voltage, "check_voltage": r.check_voltage, "beam": args.beam,
             "viscous_modulus": args.viscous_modulus,
             "resonances": r.resonances,
             "error_max": None if r.error is None else r.error_max,

@@ -43,6 +43,7 @@ import numpy as np
 from ipmc_asym.base.ladder import climb, escalation_note, rungs_from
 from ipmc_asym.base.registry import check_choice
 from ipmc_asym.base.results import Panel, ResultMixin, ResultSpec
+from ipmc_asym.base.settings import VALIDATED_VOLTAGE
 from ipmc_asym.beam.dynamics import (
     CLAMPED_OUTPUTS,
     DEFAULT_MODES,
@@ -63,7 +64,8 @@ from ipmc_asym.dynamics.electrode import (
     time_constant,
 )
 from ipmc_asym.dynamics.transient import solve_transient
-from ipmc_asym.forward.model import assumption_warnings, forward
+from ipmc_asym.dynamics.waveforms import check_drive_voltage
+from ipmc_asym.forward.model import assumption_warnings, forward, voltage_reason
 from ipmc_asym.integral.api import paper_model_id
 from ipmc_asym.kernels import _generated_charge as GC
 from ipmc_asym.kernels.charge import GL_W, GL_X
@@ -914,6 +916,7 @@ class FrequencyResult(ResultMixin):
     support: str | None = None
     electrode: tuple | None = None
     H_clamped: dict = field(default_factory=dict)
+    check_voltage: bool = True
 
 
 def frequency_response(f, *, strip: Strip | None = None, model="constant", material: Material | None = None,
@@ -973,7 +976,7 @@ def frequency_response(f, *, strip: Strip | None = None, model="constant", mater
     f = np.asarray(f, dtype=float)
     if not np.all(np.isfinite(f)) or np.any(f <= 0):
         raise ValueError("frequencies must be finite and > 0 Hz")
-    bias = check_finite("voltage (DC bias)", voltage, "a finite number of volts")
+    bias = check_drive_voltage("voltage (DC bias)", check_finite("voltage (DC bias)", voltage, "a finite number of volts"))
     support = check_support(support)
     el = check_electrode(electrode, s.length)
     if bias != 0.0 and method != "circuit":
@@ -1049,6 +1052,8 @@ def frequency_response(f, *, strip: Strip | None = None, model="constant", mater
         notes.append(f"small signal about the static state at {bias:g} V (circuit: R, C_d({bias:g} V), C_g; "
                      "dM_A/dV of the forward model)")
         notes.append(bias_note)  # a bias is refused above with any method but the circuit
+        if not abs(bias) <= VALIDATED_VOLTAGE:  # a model assumption: the number kept, flagged
+            notes.append("warning: " + voltage_reason(bias))
     f_d = m.D / (2.0 * math.pi * (lam * e) ** 2)
     if Hprof is not None:
         notes.append("H_w_profiles: the moment of the linearised profiles, p' = (C + A3) E, which adds the pressure "
@@ -1063,4 +1068,4 @@ def frequency_response(f, *, strip: Strip | None = None, model="constant", mater
                            error_max=(math.nan if err is None else 0.5 * lam if bias == 0.0
                                       else float(np.nanmax(err))), H_theta=Htheta, H_F=HF,
                            resonances=resonances, beam=beam, voltage=bias, support=support, electrode=el,
-                           H_clamped=Hcc)
+                           H_clamped=Hcc, check_voltage=bool(abs(bias) <= VALIDATED_VOLTAGE))

@@ -144,3 +144,23 @@ def test_freq_z_abs_phase_read_by_fit(capsys, tmp_path):
     # and they are |Z| and arg Z of the Z_re, Z_im columns
     Z = np.array(out["Z_re"]) + 1j * np.array(out["Z_im"])
     np.testing.assert_allclose(out["Z_phase"], np.degrees(np.angle(Z)), atol=1e-12)
+
+
+def test_freq_bias_beyond_the_validated_range_is_flagged_and_capped(capsys):
+    """A bias past settings.VALIDATED_VOLTAGE is a model assumption: the spectrum is kept, finite, with
+    check_voltage false and a warning naming the limit; past MAX_DRIVE_VOLTAGE (where the kernels are
+    not checked finite) it is refused in one line, exit 2, as a drive's voltage is."""
+    from ipmc_asym.base.settings import MAX_DRIVE_VOLTAGE, VALIDATED_VOLTAGE
+
+    assert main(["freq", "--from", "1Hz", "--to", "10Hz", "--points", "2", f"--voltage={-MAX_DRIVE_VOLTAGE}V",
+                 "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["check_voltage"] is False
+    assert any("VALIDATED_VOLTAGE" in n for n in doc["notes"])
+    assert np.all(np.isfinite(doc["Z_re"])) and np.all(np.isfinite(doc["w_amp"]))
+    assert main(["freq", "--from", "1Hz", "--to", "10Hz", "--points", "2", f"--voltage={VALIDATED_VOLTAGE}V",
+                 "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["check_voltage"] is True
+    assert main(["freq", "--from", "1Hz", "--to", "10Hz", "--points", "2", "--voltage=1e5V"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "voltage (DC bias)" in err[0]
