@@ -773,10 +773,9 @@ def solve_transient(t, phi0_fun, strip: Strip, model="constant", material: Mater
     (pre-asymptotic points, e.g. the initial layer of a step on a thin strip), plus the
     time integration's ``10 rtol |sigma|`` (``rtol <= tol/100``) or twice its measured part where
     larger (the finest level rerun at a tenth of ``rtol``, the largest change within a factor 2 of
-    each time).
-    ``current_density`` and
-    ``M_A_profiles`` are extrapolated alike (``current_error``: the current's estimate from the same
-    three levels); ``c`` is the finest mesh's.
+    each time).  ``current_density`` and ``M_A_profiles`` are extrapolated alike
+    (``current_error``: the current's estimate from the same three levels); ``c`` is the finest
+    mesh's.
     """
     if tol is None:
         r = _solve_once(t, phi0_fun, strip, model, material, cells_per_debye=cells_per_debye, ratio=ratio,
@@ -795,6 +794,12 @@ def solve_transient(t, phi0_fun, strip: Strip, model="constant", material: Mater
     # the time integration's share of the error is 10 rt |sigma| = tol/10 (a looser tolerance
     # takes longer steps); an explicit rtol is kept when tighter
     rt = 1e-2 * tol if rtol is None else min(rtol, 1e-2 * tol)
+
+    def allowance(a, peak=False):
+        # the time integration's assumed part: rtol on the state (~ sigma); the current is its rate,
+        # whose time error follows the largest current (peak), not the current at each time
+        return 10.0 * rt * (np.max(np.abs(a)) if peak else np.abs(a))
+
     runs = []
     # the first mesh level: the mesh error falls like h^2 and is ~1e-6 at refine 1 (measured on
     # the nominal strip, 20 um - 2 mm alike), so a looser tolerance starts coarser, by
@@ -822,13 +827,13 @@ def solve_transient(t, phi0_fun, strip: Strip, model="constant", material: Mater
             if not 1.5 <= p <= 2.5 and max(d12, d24) <= 0.1 * tol * scale:
                 # the mesh changes sigma by less than tol/10 (rounding level: no order to observe,
                 # e.g. phi0 = 0): the finest run, its error bounded by both changes
-                err = np.full(r.t.size, d12 + d24) + 10.0 * rt * np.abs(r.sigma)
+                err = np.full(r.t.size, d12 + d24) + allowance(r.sigma)
                 if moment:
                     r.layer_voltage = _layer_voltage(r.sigma, err, get_model(model), material)
                 r.sigma_error = err
                 j1, j2, j4 = (x.current_density for _, x in runs[-3:])
                 r.current_error = (np.full(r.t.size, float(np.max(np.abs(j1 - j2)) + np.max(np.abs(j2 - j4))))
-                                   + 10.0 * rt * np.max(np.abs(r.current_density)))
+                                   + allowance(r.current_density, peak=True))
                 r.extra = dict(r.extra, refinement=levels, observed_order=p, tol=tol,
                                sigma_error_max_rel=float(np.max(err)) / scale if scale > 0 else 0.0,
                                seconds=time.perf_counter() - t_start)
@@ -852,10 +857,7 @@ def solve_transient(t, phi0_fun, strip: Strip, model="constant", material: Mater
                     with np.errstate(divide="ignore", invalid="ignore"):
                         rpt = np.clip(np.where(a24 > 0.0, a12 / a24, 4.0), 2.0**1.5, 2.0**2.5)
                     spread = a24 * np.abs(fac - 1.0 / (rpt - 1.0))
-                    # the time integration's part: rtol on the state (~ sigma); the current is its rate,
-                    # whose time error follows the largest current (peak), not the current at each time
-                    tim = 10.0 * rt * (np.max(np.abs(E24)) if peak else np.abs(E24))
-                    return E24, 2.0 * np.abs(E24 - E12) / 7.0 + spread + tim
+                    return E24, 2.0 * np.abs(E24 - E12) / 7.0 + spread + allowance(E24, peak)
 
                 E24, err = estimate(s1, s2, s4)
                 if float(np.max(err)) <= tol * scale:
@@ -898,11 +900,11 @@ def solve_transient(t, phi0_fun, strip: Strip, model="constant", material: Mater
                             # response at 1.4e-3 tau where 10 rtol |sigma| is 1.3e-10).  The larger
                             # of the assumed and twice the measured part (the window keeps a time
                             # where two runs happen to agree from reading as exact)
-                            err = err + np.maximum(0.0, 2.0 * _log_window_max(t, ds) - 10.0 * rt * np.abs(E24))
+                            err = err + np.maximum(0.0, 2.0 * _log_window_max(t, ds) - allowance(E24))
                             out.sigma_error = err
                             break
                     if jt is None:  # not measured: the allowance of the time integration's tolerance
-                        jt = np.full(r0.t.size, 10.0 * rt * float(np.max(np.abs(js[2]))))
+                        jt = np.full(r0.t.size, float(allowance(js[2], peak=True)))
                         out.extra = dict(out.extra, current_time_error="assumed (10 rtol max|J|): the rerun at a "
                                                                      "tighter rtol failed")
                     # the sum counted twice: the margin of an estimate that is not a proven bound
