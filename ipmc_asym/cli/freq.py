@@ -131,7 +131,7 @@ def run(args):
     for n in CLAMPED_OUTPUTS if clamped else ():
         cols[f"{n}_amp"], cols[f"{n}_phase"] = np.abs(r.H_clamped[n]), np.angle(r.H_clamped[n], deg=True)
     head = {"tau": r.tau, "model": r.model, "method": r.method, "thickness_total": strip.thickness,
-            "f_d": r.f_d, "voltage": args.voltage, "check_voltage": r.check_voltage, "beam": args.beam,
+            "f_d": r.f_d, "voltage": args.voltage, "beam": args.beam,
             "viscous_modulus": args.viscous_modulus,
             "resonances": r.resonances,
             "error_max": None if r.error is None else r.error_max,
@@ -144,6 +144,8 @@ def run(args):
                       "theta_amp": "rad/V (free tip)", "theta_phase": "deg", "F_amp": "N/V (blocked tip)",
                       "F_phase": "deg", "error": "relative, of Z and w against the reference"},
             "notes": r.notes + [f"about phi0 = {args.voltage:g} V; w from the layers' charge, small displacements"]}
+    if args.voltage != 0.0:  # about 0 V the output stays as it was, key for key
+        head["check_voltage"] = r.check_voltage
     if support is not None or electrode is not None:
         head["support"] = support
         head["electrode"] = None if electrode is None else list(electrode)

@@ -263,6 +263,11 @@ class LineResult(ResultMixin):
     voltage: float = 0.0
     beam_error: object = None
 
+    @property
+    def check_voltage(self) -> bool:
+        """The bias within the validated range (the uniform strip's flag: one bias for both)."""
+        return self.uniform.check_voltage
+
     def modal_forcing(self, curvature, **kw):
         """``int_0^L M(x) phi''(x) dx`` per volt at the clamp, for each frequency (see
         :func:`moment_modal_integral`, whose keywords it takes; N m/V times the unit of ``phi''``
