@@ -97,7 +97,7 @@ def test_no_untested_python_in_literal_blocks():
 README_TEXT = (ROOT / "README.md").read_text(encoding="utf-8")
 INSTALL_MAIN = "python3 -m venv .venv && . .venv/bin/activate && pip install . && ipmc-asym estimate"
 INSTALL_TESTS = ('python3 -m venv .venv && . .venv/bin/activate && pip install -e ".[test]" && '
-                 "python -m pytest -q --durations=10")
+                 "python -m pytest -q -n auto --durations=10")
 
 
 def test_readme_is_a_landing_page():
