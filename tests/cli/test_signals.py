@@ -23,9 +23,32 @@ from ipmc_asym.io.fileio import atomic_path, atomic_write
 ENV = {**os.environ, "PYTHONPATH": str(REPO)}
 
 
+#: the child starts as a terminal's foreground job does: the three signals at their defaults and
+#: unblocked.  A child inherits an ignored disposition and the blocked mask of the process that
+#: starts it, and a test worker's may differ (a SIGINT ignored or blocked there reaches no handler,
+#: and the CLI keeps an ignored signal ignored on purpose: ``nohup``)
+CHILD = ("import runpy, signal, sys\n"
+         "signal.signal(signal.SIGINT, signal.default_int_handler)\n"
+         "for s in (signal.SIGTERM, signal.SIGHUP):\n"
+         "    signal.signal(s, signal.SIG_DFL)\n"
+         "signal.pthread_sigmask(signal.SIG_UNBLOCK, (signal.SIGINT, signal.SIGTERM, signal.SIGHUP))\n"
+         "sys.argv[0] = 'ipmc-asym'\n"
+         "runpy.run_module('ipmc_asym', run_name='__main__', alter_sys=True)\n")
+
+
+def _signal_state(pid):
+    """The child's blocked, ignored and caught signal masks (``/proc``), for a failure's message."""
+    try:
+        with open(f"/proc/{pid}/status", encoding="ascii") as fh:
+            return " ".join(line.strip() for line in fh if line.startswith(("SigBlk", "SigIgn", "SigCgt")))
+    except OSError:
+        return "(no /proc)"
+
+
 def _signalled_run(argv, tmp_path, sig, wait_for):
-    """Start ``ipmc-asym argv`` in ``tmp_path``, send ``sig`` once ``wait_for()`` holds; (rc, stderr)."""
-    p = subprocess.Popen([sys.executable, "-m", "ipmc_asym", *argv], cwd=tmp_path, env=ENV,
+    """Start ``ipmc-asym argv`` in ``tmp_path``, send ``sig`` once ``wait_for()`` holds;
+    (rc, stderr + the child's signal masks when it was signalled)."""
+    p = subprocess.Popen([sys.executable, "-c", CHILD, *argv], cwd=tmp_path, env=ENV,
                          stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
     try:
         t0 = time.monotonic()
@@ -33,13 +56,14 @@ def _signalled_run(argv, tmp_path, sig, wait_for):
             time.sleep(0.05)
         assert p.poll() is None, f"finished before the signal: {p.stderr.read()[-2000:]}"
         time.sleep(0.3)  # inside the streaming loop
+        state = _signal_state(p.pid)
         p.send_signal(sig)
         _, err = p.communicate(timeout=120)
     finally:
         if p.poll() is None:
             p.kill()
             p.wait()
-    return p.returncode, err
+    return p.returncode, err + f"\n[child signal masks when signalled: {state}]"
 
 
 def _parts(d):
