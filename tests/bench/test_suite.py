@@ -23,6 +23,8 @@ def with_bench(monkeypatch):
     monkeypatch.setattr(cli, "entry_points", lambda **kw: [BENCH_EP] if kw.get("group") == cli.PLUGIN_GROUP else [])
 
 
+# the default invocation compiles the kernels in fresh processes with a cold cache (~40 s): its tests
+# are slow (run by CI); the refusals and the yardstick stay in the dev loop
 @pytest.fixture(scope="module")
 def res(tmp_path_factory):
     """``ipmc-asym bench --json --quick --figure F.png``: the default invocation at its smallest
@@ -45,6 +47,7 @@ def res(tmp_path_factory):
     return out
 
 
+@pytest.mark.slow
 def test_default_invocation_structure(res):
     assert res["points"] == 2000 and res["bvp_points"] == 1
     for k in ("targets", "results", "compile", "all_pass", "ranges", "threads", "sections", "clock", "load", "startup"):
@@ -63,6 +66,7 @@ def test_default_invocation_structure(res):
             assert (r["seconds_per_point_parallel"] is None) == (f == "exact")
 
 
+@pytest.mark.slow
 def test_printed_targets_are_the_goals(res):
     """The targets are the project's goals (README "Speed"), not looser ones."""
     assert res["targets"]["exact"]["seconds_per_point"] == 10e-6
@@ -75,6 +79,7 @@ def test_printed_targets_are_the_goals(res):
     assert figs["uq end to end at leading (sampling + 5 outputs + Sobol')"]["target"] == 1e6
 
 
+@pytest.mark.slow
 def test_error_ordering(res):
     rows = {(r["model"], r["fidelity"]): r for r in res["results"]}
     for m in MODELS:
@@ -87,6 +92,7 @@ def test_error_ordering(res):
             assert rows[(m, f)]["rel_error_max"] <= 10 * max(rows[(m, f)]["error_estimate_max"], 1e-12)
 
 
+@pytest.mark.slow
 def test_table_and_plot(res, tmp_path):
     t = format_table(res)
     assert "leading" in t and "quadrature" in t and "[exact_api]" in t and "[charge]" in t and "load average" in t
@@ -94,6 +100,7 @@ def test_table_and_plot(res, tmp_path):
     assert (tmp_path / "sa.png").stat().st_size > 1000 and str(p).endswith("sa.png")
 
 
+@pytest.mark.slow
 def test_saved_result_is_read_back(res, tmp_path):
     f = tmp_path / "b.json"
     f.write_text(json.dumps(res), encoding="utf-8")
@@ -103,6 +110,7 @@ def test_saved_result_is_read_back(res, tmp_path):
         load_bench(f)
 
 
+@pytest.mark.slow
 def test_sections_report_their_figures(res):
     """Every figure is finite where measured and carries its target or none (reported, not judged)."""
     whats = " | ".join(f["what"] for f in res["sections"]["exact_api"]["figures"])

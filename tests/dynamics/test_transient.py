@@ -363,7 +363,8 @@ def _exact_linear_step_sigma(V, t, strip, model="constant", current=False):
         return np.array([float(mp.invertlaplace(F, float(x), method="talbot")) for x in t])
 
 
-@pytest.mark.parametrize("model,V", [("constant", 1e-4), ("constant", 1e-5), ("linear", 1e-5)])
+@pytest.mark.parametrize("model,V", [("constant", 1e-4), ("constant", 1e-5),
+                                     pytest.param("linear", 1e-5, marks=pytest.mark.slow)])  # ~14 s
 def test_small_signal_step_within_its_stated_error_of_the_exact_linearised_response(model, V):
     """At 0.1 mV and 10 uV the PNP at tol 1e-6 is within its own per-time error of the exact
     linearised step response (sigma is odd in V by the strip's mirror symmetry, so the nonlinear
