@@ -49,8 +49,32 @@ def test_low_frequency_is_the_static_differential_capacitance(th, model, V):
     assert r.error[0] < 2e-5
 
 
+@pytest.mark.parametrize("th", [20e-6, 1e-3])
+@pytest.mark.parametrize("V", [0.3, -0.5, 0.7])
+def test_linear_model_depleted_anode(th, V, monkeypatch):
+    """The linear model past 0.2 V (its anode depleted to ~B1 e^{-A2}, dsigma/dphi0 down to 7e-9 F/m^2 at
+    0.7 V): the low-frequency limit is the exact static differential capacitance within the stated
+    error, and (up to 0.5 V) the stated error bounds the reference on meshes split 4 times finer."""
+    s = Strip(thickness=th)
+    f = np.array([1e-7, 1e-1, 1e2])
+    r = bias_reference(f, V, s, "linear")
+    Cd = float(ia.charge(th, V, "linear", "exact").C_diff)
+    assert abs(r.charge_transfer[0] / Cd - 1.0) <= r.error[0]
+    assert r.error.max() <= B.BIAS_REFERENCE_CEILING
+    if abs(V) > 0.5:
+        # at 0.7 V, 1 mm the finer reference itself refuses: its mesh error (7e-5) falls below the
+        # static state's (1.9e-4, the miss the low-frequency check measures and adds to the error)
+        return
+    mesh = B._graded_mesh
+    monkeypatch.setattr(B, "MAX_NODES", 10**7)
+    monkeypatch.setattr(B, "_graded_mesh", lambda ell, extra, refine=1: mesh(ell, extra, 4 * refine))
+    fine = bias_reference(f, V, s, "linear")
+    actual = np.abs(r.Z_area / fine.Z_area - 1.0)
+    assert np.all(actual <= r.error)
+
+
 def test_reference_refuses_where_the_static_state_is_not_resolved():
-    """The linear model's anode concentration ~e^{-A2}: at 1 V the static limit misses dsigma/dphi0,
+    """The linear model at 1 V (dsigma/dphi0 ~ 6e-14 F/m^2): the static limit misses dsigma/dphi0,
     and the reference refuses in one line rather than state a bound."""
     with pytest.raises(RuntimeError, match="differential capacitance|not resolved"):
         bias_reference([1.0], 1.0, Strip(thickness=200e-6), "linear")
@@ -66,21 +90,25 @@ def test_sign_of_the_bias_is_a_mirror_image():
 @pytest.mark.slow
 @pytest.mark.parametrize("th", [20e-6, 1e-3])
 @pytest.mark.parametrize("model,V", [("constant", 0.3), ("constant", -2.0), ("affine", 0.05),
-                                     ("affine", -1.0), ("linear", 0.05)])
+                                     ("affine", -1.0), ("linear", 0.05), ("linear", 0.5)])
 def test_biased_circuit_error_bounds_a_finer_reference(th, model, V, monkeypatch):
     """The stated error bounds the circuit's deviation from the reference on a finer mesh (every
-    interval split in 4 more): ratio actual/stated <= 1, and the bound is not loose by more than 2x."""
+    interval split in 4 more): ratio actual/stated <= 1, and the bound is not loose by more than 2x
+    plus the reference's own stated error."""
     f = np.geomspace(1e-2, 1e4, 5)
     s = Strip(thickness=th)
     r = frequency_response(f, strip=s, model=model, method="circuit", voltage=V)
     assert r.error is not None
+    ref = bias_reference(f, V, s, model)  # the reference the circuit's error is stated against
     mesh = B._graded_mesh
     monkeypatch.setattr(B, "MAX_NODES", 10**7)
     monkeypatch.setattr(B, "_graded_mesh", lambda ell, extra, refine=1: mesh(ell, extra, 4 * refine))
     fine = bias_reference(f, V, s, model)
     actual = np.abs(r.Z_area - fine.Z_area) / np.abs(fine.Z_area)
     assert np.all(actual <= r.error)
-    assert np.all(r.error <= 2.0 * actual + 1e-6)
+    # not loose by more than 2x beyond the reference's own error (which the stated error carries:
+    # ~4e-4 for the linear model's depleted anode at 0.5 V, below 2e-5 elsewhere)
+    assert np.all(r.error <= 2.0 * actual + ref.error + 1e-6)
 
 
 @pytest.mark.parametrize("bad", [2.5, -1, "12", True])
