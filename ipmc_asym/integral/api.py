@@ -63,7 +63,7 @@ from ipmc_asym.base.settings import (
 from ipmc_asym.base.units import parse_length, parse_voltage
 from ipmc_asym.kernels.closed import closed_b1, closed_finish, layer_closed, moment_closed
 from ipmc_asym.kernels.debye import DH_A2, dh_exact, dh_layer
-from ipmc_asym.kernels.exact import moment_exact
+from ipmc_asym.kernels.exact import exact_frozen, moment_exact
 from ipmc_asym.kernels.jit import interpreted, jit, jit_parallel, prange
 from ipmc_asym.kernels.quadrature import moment_quadrature
 from ipmc_asym.model import groups
@@ -179,8 +179,10 @@ def _core_error(core, lam):
 
 
 @jit
-def _point(lam, A2, A3, rho, model_id, order):
+def _point(lam, A2, A3, rho, model_id, order, fz=None):
     """(I for ``|phi0|``, error, B1, core) of one point; ``order`` 0 = quadrature, 3 = exact.
+
+    ``fz``: for ``exact``, the frozen cores of the caller's sweep (:func:`exact_frozen`), or None.
 
     ``error`` bounds the relative error of the returned ``I`` (not of one term of it).
     Zero volts: no field, I = 0 exactly (the odd extension; no 0/0).
@@ -190,7 +192,7 @@ def _point(lam, A2, A3, rho, model_id, order):
     if A2 < DH_A2:  # small voltage: the Debye-Hueckel series, no eps/A2 rounding
         return _dh_point(lam, A2, A3, rho, order)
     if order == 3:
-        Ii, b1, ell, c, niter = moment_exact(lam, A2, A3, rho)
+        Ii, b1, ell, c, niter = moment_exact(lam, A2, A3, rho, fz)
         if niter < 0:  # thickness constraint not met: no number, and invalid
             return math.nan, math.inf, b1, c
         return Ii, EXACT_STATED_ERROR, b1, c
@@ -281,8 +283,9 @@ def _sweep(lam, A2, A3, rho, model_id, order, sign, I, err, B1, core):
             for i in range(i0, i1):
                 I[i] = sign[i] * I[i]
     else:
+        fz = exact_frozen(rho, order == 3)
         for i in prange(n):
-            Ii, e_i, b1, c = _point(lam[i], A2[i], A3, rho, model_id, order)
+            Ii, e_i, b1, c = _point(lam[i], A2[i], A3, rho, model_id, order, fz)
             I[i] = sign[i] * Ii
             err[i] = e_i
             B1[i] = b1
@@ -421,6 +424,7 @@ def _fused_points(th, v, lamc, a2c, A3, rho, model_id, order, any_thickness, lim
     sth = th.size > 1
     sv = v.size > 1
     full = err.size == n  # bookkeeping outputs wanted (all or none)
+    fz = exact_frozen(rho, order == 3)  # the thick points' shared core nodes, once
     bad_th = 0
     bad_v = 0
     n_invalid = 0
@@ -430,7 +434,7 @@ def _fused_points(th, v, lamc, a2c, A3, rho, model_id, order, any_thickness, lim
         lam = A2 = Ii = e_i = b1 = c = math.nan
         if not _input_code(t, vv):  # else no kernel call at all
             lam, A2 = _groups_point(t, vv, lamc, a2c)
-            Ii, e_i, b1, c = _point(lam, A2, A3, rho, model_id, order)
+            Ii, e_i, b1, c = _point(lam, A2, A3, rho, model_id, order, fz)
         code = _put(i, t, vv, lam, A2, Ii, e_i, b1, c, limit, any_thickness, nan_invalid, full,
                     I, err, B1, core, lam_o, A2_o, valid)
         bad_th += code == 2
@@ -440,10 +444,11 @@ def _fused_points(th, v, lamc, a2c, A3, rho, model_id, order, any_thickness, lim
 
 
 @jit
-def _scalar_point(t, vv, lamc, a2c, A3, rho, model_id, order, any_thickness, limit):
-    """``(I, valid)`` of one point (the scalar fast path of :func:`moment_integral`)."""
+def _scalar_point(t, vv, lamc, a2c, A3, rho, model_id, order, any_thickness, limit, fz=None):
+    """``(I, valid)`` of one point (the scalar fast path of :func:`moment_integral`); ``fz`` as
+    :func:`_point` (kept between calls by the caller)."""
     lam, A2 = _groups_point(t, vv, lamc, a2c)
-    Ii, e_i, b1, c = _point(lam, A2, A3, rho, model_id, order)
+    Ii, e_i, b1, c = _point(lam, A2, A3, rho, model_id, order, fz)
     return (Ii if vv >= 0.0 else -Ii), (e_i < limit) and (c > 0.0 or any_thickness)
 
 
@@ -750,7 +755,10 @@ def moment_integral(thickness, voltage, model="constant", fidelity="quadrature",
             and not material_kw and type(model) is str):
         consts = _SCALAR_CACHE.get((model, fidelity))
         if consts is None and model in _MODEL_SPECS and is_compiled(fidelity):
-            consts = _SCALAR_CACHE[(model, fidelity)] = _driver_constants(get_model(model), NAFION_LI, fidelity)
+            consts = _driver_constants(get_model(model), NAFION_LI, fidelity)
+            if _FIDELITY_SPECS[fidelity].kernel_code == 3:  # exact: the frozen cores, once a process
+                consts += (exact_frozen(consts[3], True),)
+            _SCALAR_CACHE[(model, fidelity)] = consts
         t, vv = float(thickness), float(voltage)
         if consts is not None and t >= MIN_THICKNESS and math.isfinite(t) and math.isfinite(vv):
             Ii, ok = _run_driver(_scalar_point, 1, fidelity, (t, vv, *consts))

@@ -189,7 +189,7 @@ def _outer_point(y, par):
 
 
 #: the exact rung's driver with the pressure term: moment weight ``P(y)``, ``par = (rho, b0, A3, g0)``
-_core_fill, _outer_fill, _solve = make_exact_driver(_core_point, _outer_point)
+_core_fill, _outer_fill, _solve, _frozen_cores = make_exact_driver(_core_point, _outer_point)
 
 
 @jit

@@ -260,3 +260,38 @@ def test_core_nodes_match_previous_values():
         I, _, _, _, niter = moment_exact(lam, A2, A3, rho)
         assert niter > 0
         assert abs(I / ref - 1.0) <= 1e-14, (model, th, v, I, ref)
+
+
+# ---- the sweep's shared frozen cores and the neutral-core start -------------------------------
+def _sample(n, seed):
+    r = np.random.default_rng(seed)
+    th = np.exp(r.uniform(np.log(1e-6), np.log(1e-2), n))
+    v = np.exp(r.uniform(np.log(1e-4), np.log(20.0), n)) * r.choice([-1.0, 1.0], n)
+    return th, v
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_frozen_cores_change_no_bit(model):
+    """The cores and outer nodes a sweep computes once give, bit for bit, what each point fills
+    itself (I, B1, ell, core, passes), thick strips and thin ones, both signs."""
+    from ipmc_asym.kernels.exact import exact_frozen
+
+    th, v = _sample(300, 11)
+    fz = exact_frozen(_groups(model, 1e-4, 1.0)[3], True)
+    for t, x in zip(th, v):
+        lam, A2, A3, rho, _ = _groups(model, t, x)
+        a = moment_exact(lam, A2, A3, rho)
+        b = moment_exact(lam, A2, A3, rho, fz)
+        assert a == b
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_thick_strips_take_one_pass_thin_ones_few(model):
+    """From the neutral-core start (the layers' width at kappa = 0), a frozen core (the paper's
+    thick strips) is solved in one pass: the length is linear in ell there, and the moments are
+    moved to the root.  Everywhere else at most six passes (the bare 1/lam start took up to eight)."""
+    th, v = _sample(400, 12)
+    for t, x in zip(th, v):
+        lam, A2, A3, rho, _ = _groups(model, t, x)
+        niter = moment_exact(lam, A2, A3, rho)[4]
+        assert 0 < niter <= (1 if lam < 0.01 else 6), (t, x, niter)
