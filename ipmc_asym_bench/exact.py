@@ -196,7 +196,9 @@ def section(quick: bool = False) -> dict:
     """The ``exact_api`` bench section (see the module docstring)."""
     T = TARGETS
     reps = 3 if quick else 5
-    ex = exact_timing(n=200 if quick else 3000, bvp_n=1 if quick else 2, repeats=reps)
+    # one repeat is ~25 ms of CPU: three times the repeats, so that the least of them is an
+    # undisturbed one on a shared machine (consecutive runs of 5 differed by up to 1.4x)
+    ex = exact_timing(n=200 if quick else 3000, bvp_n=1 if quick else 2, repeats=3 * reps)
     ak = api_threads(n=2 * 10**5 if quick else 10**7, repeats=reps)
     tl = api_vs_transcendentals(n=2 * 10**5 if quick else 10**7, repeats=reps)
     tmp = temporaries_per_point(n=10**5 if quick else 10**6)
