@@ -202,9 +202,9 @@ def run(args):
 
     # the errors wherever they are stated: with --tol, and always for the pnp (its default tolerance)
     stated = args.tol is not None or args.fidelity == "pnp"
-    # (the deflection's error is propagated through the quasi-static beam only)
+    # (the deflection's error: through the quasi-static beam, or through the beam's modes with --beam dynamic)
     columns = COLUMNS + (("sigma_error", "current_error") if stated else ()) + (
-        ("w_error",) if stated and args.beam == "quasi-static" else ())
+        ("w_error",) if stated else ())
 
     def cols_of(r):
         cols = {"t": r.t, "phi0": r.phi0, "sigma": r.sigma, "sigma_error": r.sigma_error,

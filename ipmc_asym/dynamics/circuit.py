@@ -108,6 +108,9 @@ BEAM_CHOICES = ("quasi-static", "dynamic")
 CIRCUIT_NO_TOL_NOTE = ("circuit: sigma, current and w errors are stated with a tolerance (step --tol T): the bound is "
                        "a reference PNP run, 100-1000 times the circuit's cost (nominal 1 V step: 1.4-18 s CPU "
                        "against 0.02 s), so it is not run by default")
+DYNAMIC_W_ERROR_NOTE = ("w_error with beam dynamics: the quasi-static errors of M_A and w through the beam's modes "
+                        "(each mode's impulse response bounded by its envelope): without damping (viscous modulus 0) "
+                        "the bound grows like omega_1 t, as an undamped mode keeps every error it was given")
 #: frequencies at which the biased circuit's error is computed against the linearised PNP at most
 #: (each costs two banded solves of 10^4 - 2 10^5 nodes: 0.05 - 0.6 s CPU measured, 20 um - 1 mm)
 REFERENCE_POINTS = 12
@@ -220,6 +223,46 @@ class BeamDynamics:
         b = self.blocked.advance(t, M, {"F": F_block})
         return a["theta"], a["w"], b["F"]
 
+    def w_error(self, t, M, M_err, w_err):
+        """Bound on the error of the dynamic tip deflection :meth:`advance` gives at the times ``t`` (s,
+        from 0) from bounds on the errors of the moment ``M`` (``M_err``, N m) and of the quasi-static
+        deflection (``w_err``, m) at those times.
+
+        The beam is linear in its inputs: ``w = creep(w_qs) + sum_n phi_n(L) (q_n - q_n^qs)``
+        (:class:`ipmc_asym.beam.dynamics.ModalIntegrator`).  The creep filter (gain 1, a positive
+        impulse response) passes at most the running maximum of ``w_err``.  Mode n's departure from its
+        quasi-static value is ``c_n M`` (``c_n = phi_n(L) P_n/(rho A L omega_n^2)``, its static tip
+        deflection per unit moment) through the unit-gain oscillator minus the creep filter, an impulse
+        response of L1 norm at most ``1 + omega_n^2 int_0^t |h_n|``: ``|h_n(u)| <= e^{-a u}/nu_n``
+        underdamped (``a = tau_v omega_n^2/2``, ``nu_n^2 = omega_n^2 - a^2``), so the integral is at
+        most ``(1 - e^{-a t})/(a nu_n)`` (``t/nu_n`` undamped: an undamped mode keeps every error it was
+        given, and the bound grows like ``omega_1 t``); ``h_n >= 0`` overdamped (at most ``1/omega_n^2``).
+        ``M`` is held linear between the times (the integrator's first-order hold): the hold's error
+        ``h^2 |M''|/8``, estimated by the second differences and counted twice (as
+        :func:`deflection_error`), is added to ``M_err``; the modes past the kept ones (~1e-11 of the
+        static deflection, :data:`TIME_MODES`) are covered by ``1e-10`` of it.  NaN from the first time
+        whose errors are not stated.
+        """
+        t = np.asarray(t, dtype=float)
+        M = np.asarray(M, dtype=float)
+        md, b = self.free.md, self.beam
+        c = np.abs(md.phi_L * md.P / (b.rhoA * b.length * md.omega**2))
+        gain = np.zeros(t.size)  # sum_n c_n (1 + omega_n^2 int_0^t |h_n|), a mode at a time (memory: t only)
+        for om, cn in zip(md.omega, c):
+            a = 0.5 * b.tau_v * om * om
+            if a < om:  # underdamped
+                nu = math.sqrt(om * om - a * a)
+                gain += cn * (1.0 + om * om * (-np.expm1(-a * t) / (a * nu) if a > 0.0 else t / nu))
+            else:
+                gain += 2.0 * cn
+        hold = np.zeros(t.size)
+        if t.size > 2:
+            hold[1:-1] = 2.0 * np.abs(M[2:] - 2.0 * M[1:-1] + M[:-2]) / 8.0
+            hold[-1] = hold[-2]
+        dM = np.maximum.accumulate(np.asarray(M_err, dtype=float) + hold)
+        dw = np.maximum.accumulate(np.asarray(w_err, dtype=float))
+        return dw + dM * gain + 1e-10 * np.abs(M) * float(np.sum(c))
+
     def advance_clamped(self, t, M, statics):
         """Clamped-clamped outputs (dict, :data:`CLAMPED_OUTPUTS`) from their quasi-static values ``statics``."""
         return self.clamped.advance(t, M, statics)
@@ -308,7 +351,8 @@ class StepResult(ResultMixin):
     w_error : ndarray             bound on the error of ``w`` (m) that follows from the layer voltage's
                                   (:func:`deflection_error`): circuit, from ``sigma_error`` through
                                   ``V(sigma)``; pnp, from ``current_error`` through ``phi0 - R J``;
-                                  NaN where no error is stated and with ``beam="dynamic"``
+                                  with ``beam="dynamic"`` through the beam's modes
+                                  (:meth:`BeamDynamics.w_error`); NaN where no error is stated
     """
 
     _result = ResultSpec("t", "t", ("phi0", "sigma", "current_density", "layer_voltage", "M_A", "theta", "w",
@@ -365,20 +409,32 @@ def deflection_error(u_lo, u_hi, w, strip: Strip, perm: Permittivity, material: 
     estimate), plus the forward model's rounding (64 ulps of ``w``).  NaN where ``w``, the interval or
     a sample is not determined (withheld): the caller withholds ``w`` there.
     """
+    return output_errors(u_lo, u_hi, {2: w}, strip, perm, material)[2]
+
+
+def output_errors(u_lo, u_hi, values: dict, strip: Strip, perm: Permittivity, material: Material) -> dict:
+    """:func:`deflection_error` for several outputs of :func:`quasi_static_mechanics` at once (its
+    indices: 0 ``M_A``, 2 ``w``), from the same samples of the voltage interval; ``values`` maps an
+    index to the output's value at each time point, the result an index to its bound."""
     lo = np.asarray(u_lo, dtype=float)
     hi = np.asarray(u_hi, dtype=float)
-    w = np.asarray(w, dtype=float)
     k = np.linspace(0.0, 1.0, W_ERROR_SAMPLES)[:, None]
     U = lo[None, :] + k * (hi - lo)[None, :]
-    bad = ~(np.isfinite(lo) & np.isfinite(hi) & np.isfinite(w))
+    bad = ~(np.isfinite(lo) & np.isfinite(hi))
+    for v in values.values():
+        bad |= ~np.isfinite(np.asarray(v, dtype=float))
     U = np.where(bad[None, :], 0.0, U)
-    W = quasi_static_mechanics(U.reshape(-1), strip, perm, material)[2].reshape(U.shape)
-    dev = np.max(np.abs(W - w[None, :]), axis=0)
-    curv = np.max(np.abs(W[2:] - 2.0 * W[1:-1] + W[:-2]), axis=0)
-    # plus the forward model's rounding (a few ulps of w: two evaluations at one voltage may differ by it)
-    out = dev + 2.0 * curv / 8.0 + 64.0 * np.finfo(float).eps * np.max(np.abs(W), axis=0)
-    out[bad | ~np.all(np.isfinite(W), axis=0)] = np.nan
-    return out
+    outs = quasi_static_mechanics(U.reshape(-1), strip, perm, material)
+    res = {}
+    for j, v in values.items():
+        W = outs[j].reshape(U.shape)
+        dev = np.max(np.abs(W - np.asarray(v, dtype=float)[None, :]), axis=0)
+        curv = np.max(np.abs(W[2:] - 2.0 * W[1:-1] + W[:-2]), axis=0)
+        # plus the forward model's rounding (a few ulps: two evaluations at one voltage may differ by it)
+        out = dev + 2.0 * curv / 8.0 + 64.0 * np.finfo(float).eps * np.max(np.abs(W), axis=0)
+        out[bad | ~np.all(np.isfinite(W), axis=0)] = np.nan
+        res[j] = out
+    return res
 
 
 def quasi_static_forward(u, strip: Strip, perm: Permittivity, material: Material, checked_voltage=None):
@@ -575,12 +631,14 @@ def _pnp_layer_voltage(tgrid, fun, J, strip, material):
     return np.clip(u, lo, hi)
 
 
-def _pnp_deflection_error(tgrid, fun, u, cur_err, w, strip, perm, material):
-    """Bound on the error of the PNP's ``w = w(phi0 - R J)`` from its current's error (V = R dJ; none at
-    t = 0, the uncharged state), the voltage interval held in the hull of 0 and the applied voltages."""
+def _pnp_output_errors(tgrid, fun, u, cur_err, M, w, strip, perm, material):
+    """Bounds ``(M_A, w)`` on the errors of the PNP's ``M_A``, ``w`` at ``phi0 - R J`` from its current's
+    error (V = R dJ; none at t = 0, the uncharged state), the voltage interval held in the hull of 0 and
+    the applied voltages."""
     du = np.where(tgrid == 0.0, 0.0, core_resistance(strip.thickness, material) * np.asarray(cur_err, dtype=float))
     lo, hi = _applied_hull(tgrid, fun)
-    return deflection_error(np.clip(u - du, lo, hi), np.clip(u + du, lo, hi), w, strip, perm, material)
+    e = output_errors(np.clip(u - du, lo, hi), np.clip(u + du, lo, hi), {0: M, 2: w}, strip, perm, material)
+    return e[0], e[2]
 
 
 def step_response(voltage=1.0, duration=None, *, strip: Strip | None = None, model="constant",
@@ -723,20 +781,25 @@ def step_response(voltage=1.0, duration=None, *, strip: Strip | None = None, mod
     warns = assumption_warnings(fr)
     M, th, w, Fb = (np.asarray(getattr(fr, k), dtype=float) for k in ("M_A", "theta", "w", "F_block"))
     w_err = np.full(tgrid.size, np.nan)
+    M_err = np.full(tgrid.size, np.nan)
     stated = np.isfinite(np.asarray(sig_err, dtype=float))
-    if dyn is None and stated.any():
-        # the deflection's error from the layer voltage's, the voltage the beam was given
+    if stated.any():
+        # the deflection's (and the moment's) error from the layer voltage's, the voltage the beam was given
         if fidelity == "circuit":
-            # as sigma's: the difference from the reference PNP run's deflection plus that one's error
-            # (the circuit's charge also holds the core's displacement charge, so V(sigma) is not its
-            # layer voltage: the bound is taken on w itself)
+            # as sigma's: the difference from the reference PNP run's plus that one's error (the circuit's
+            # charge also holds the core's displacement charge, so V(sigma) is not its layer voltage: the
+            # bound is taken on w and M_A themselves)
             ref = pnp_ref[0]
             u_r = _pnp_layer_voltage(tgrid, fun, ref.current_density, s, m)
-            w_r = quasi_static_mechanics(u_r, s, perm, m)[2]
-            w_err = np.abs(w - w_r) + _pnp_deflection_error(tgrid, fun, u_r, ref.current_error, w_r, s, perm, m)
+            M_r, _, w_r, _ = quasi_static_mechanics(u_r, s, perm, m)
+            eM, ew = _pnp_output_errors(tgrid, fun, u_r, ref.current_error, M_r, w_r, s, perm, m)
+            w_err = np.abs(w - w_r) + ew
+            M_err = np.abs(M - M_r) + eM
         else:
-            w_err = _pnp_deflection_error(tgrid, fun, u, cur_err, w, s, perm, m)
+            M_err, w_err = _pnp_output_errors(tgrid, fun, u, cur_err, M, w, s, perm, m)
         w_err = np.where(stated, w_err, np.nan)
+        M_err = np.where(stated, M_err, np.nan)
+    if dyn is None and stated.any():
         lost = stated & np.isfinite(w) & ~np.isfinite(w_err)
         if lost.any():  # the error interval reaches where w is not determined: w is withheld, not printed
             w = np.where(lost, np.nan, w)
@@ -751,11 +814,14 @@ def step_response(voltage=1.0, duration=None, *, strip: Strip | None = None, mod
                      f"(the rate at the step's jump) does not converge with the mesh")
     if dyn is not None:
         thd, wd, Fd = dyn.advance(tgrid, M, th, w, Fb)
+        if stated.any():  # the quasi-static errors through the beam's dynamics
+            w_err = dyn.w_error(tgrid, M, M_err, w_err)
+            notes.append(DYNAMIC_W_ERROR_NOTE)
         extra = dict(extra, theta_quasi_static=th[keep], w_quasi_static=w[keep], F_block_quasi_static=Fb[keep],
                      beam_frequencies={"clamped-free": natural_frequencies("clamped-free", dyn.beam, 3).tolist(),
                                        "clamped-pinned": natural_frequencies("clamped-pinned", dyn.beam, 3).tolist()})
-        sigma, J, u, M, th, w, Fb, applied, sig_err, cur_err = (
-            a[keep] for a in (sigma, J, u, M, thd, wd, Fd, applied, np.asarray(sig_err), np.asarray(cur_err)))
+        sigma, J, u, M, th, w, Fb, applied, sig_err, cur_err, w_err = (
+            a[keep] for a in (sigma, J, u, M, thd, wd, Fd, applied, np.asarray(sig_err), np.asarray(cur_err), w_err))
         checks = {c: v[keep] for c, v in checks.items()}
         tgrid = tout
     return StepResult(t=tgrid, phi0=applied, sigma=sigma, current_density=J, layer_voltage=u, M_A=M,
