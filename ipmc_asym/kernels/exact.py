@@ -289,8 +289,8 @@ def make_exact_driver(core_point, outer_point):
         ``|y| = 1/2`` its length at ``kappa = 0``, ``o = int ehat dy/sqrt(s2)`` on the outer nodes
         (the paper's model: :func:`ipmc_asym.kernels.charge_exact.kappa_neutral_log` in closed
         form).  The layers' width is what the bare ``1/lam`` misses: ell ~ 10 against 20 at
-        ``lam = 0.05``, ``A2 = 190``; from here Newton needs one or two passes where it needed
-        three to six.
+        ``lam = 0.05``, ``A2 = 190``; from here Newton needs one or two passes, from ``1/lam``
+        three to six (measured on 1 um - 10 mm x 1e-4 - 20 V).
         """
         n = X.shape[0]
         total = 0.0
@@ -360,7 +360,7 @@ def make_exact_driver(core_point, outer_point):
                 npo[s] = outer_fill(ends[s], sgns[s], par, X, split, OE[s], OS2[s], OY[s], OH[s], OE, 0)
         ell = _neutral_guess(lam, ends, sgns, par, X, Wt, npo, OE, OS2, OH, fz)
         lo_done = False
-        ell = min(max(ell, lo), 1e7)
+        ell = min(max(ell, lo), 1e7) if ell == ell else lo  # a start that is not a number: the bound
         hi = math.inf
         niter = -1
         moments = False

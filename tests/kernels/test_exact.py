@@ -289,7 +289,7 @@ def test_frozen_cores_change_no_bit(model):
 def test_thick_strips_take_one_pass_thin_ones_few(model):
     """From the neutral-core start (the layers' width at kappa = 0), a frozen core (the paper's
     thick strips) is solved in one pass: the length is linear in ell there, and the moments are
-    moved to the root.  Everywhere else at most six passes (the bare 1/lam start took up to eight)."""
+    moved to the root.  Everywhere else at most six passes (from the bare 1/lam start: up to eight)."""
     th, v = _sample(400, 12)
     for t, x in zip(th, v):
         lam, A2, A3, rho, _ = _groups(model, t, x)
