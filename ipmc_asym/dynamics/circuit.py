@@ -421,18 +421,18 @@ def output_errors(u_lo, u_hi, values: dict, strip: Strip, perm: Permittivity, ma
     k = np.linspace(0.0, 1.0, W_ERROR_SAMPLES)[:, None]
     U = lo[None, :] + k * (hi - lo)[None, :]
     bad = ~(np.isfinite(lo) & np.isfinite(hi))
-    for v in values.values():
-        bad |= ~np.isfinite(np.asarray(v, dtype=float))
     U = np.where(bad[None, :], 0.0, U)
     outs = quasi_static_mechanics(U.reshape(-1), strip, perm, material)
     res = {}
     for j, v in values.items():
+        v = np.asarray(v, dtype=float)
         W = outs[j].reshape(U.shape)
-        dev = np.max(np.abs(W - np.asarray(v, dtype=float)[None, :]), axis=0)
+        dev = np.max(np.abs(W - v[None, :]), axis=0)
         curv = np.max(np.abs(W[2:] - 2.0 * W[1:-1] + W[:-2]), axis=0)
         # plus the forward model's rounding (a few ulps: two evaluations at one voltage may differ by it)
         out = dev + 2.0 * curv / 8.0 + 64.0 * np.finfo(float).eps * np.max(np.abs(W), axis=0)
-        out[bad | ~np.all(np.isfinite(W), axis=0)] = np.nan
+        # each output's bound is undetermined where that output is (not where another one is)
+        out[bad | ~np.isfinite(v) | ~np.all(np.isfinite(W), axis=0)] = np.nan
         res[j] = out
     return res
 
