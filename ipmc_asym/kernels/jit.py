@@ -143,6 +143,18 @@ class _PackageCacheLocator(caching.UserProvidedCacheLocator):
         self._cache_path = os.path.join(CACHE_DIR, self.get_suitable_cache_subpath(py_file))
 
     @classmethod
+    def get_suitable_cache_subpath(cls, py_file):
+        """The module's folder relative to the package (Numba's default hashes its absolute path):
+        :data:`CACHE_DIR` is keyed on the sources' content already, so two installs of the same
+        sources (a clone and a site-packages copy, two venvs) share the compiled code."""
+        root = Path(__file__).resolve().parents[1]
+        try:
+            rel = Path(py_file).resolve().parent.relative_to(root)
+        except ValueError:  # not a module of this package: Numba's own layout
+            return super().get_suitable_cache_subpath(py_file)
+        return "_".join((root.name, *rel.parts))
+
+    @classmethod
     def from_function(cls, py_func, py_file):
         # skip UserProvidedCacheLocator's test of numba.config.CACHE_DIR: ours is always set
         return super(caching.UserProvidedCacheLocator, cls).from_function(py_func, py_file)

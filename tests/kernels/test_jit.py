@@ -81,6 +81,38 @@ def test_compiled_code_is_cached_in_the_package_cache_dir():
     assert moment_closed._cache._impl.locator.get_cache_path().startswith(_jit.CACHE_DIR)
 
 
+def test_a_copy_of_the_package_elsewhere_shares_the_compiled_code(tmp_path):
+    """Another install of the same sources (a site-packages copy beside a clone, say) computes the
+    same cache directory and the same per-module folders, so it loads what this one compiled; a
+    copy whose sources differ does not."""
+    import shutil
+    import subprocess
+    import sys
+
+    from ipmc_asym.kernels.closed import moment_closed
+
+    src = Path(ipmc_asym.__file__).resolve().parent
+    code = ("import ipmc_asym.kernels.jit as j, ipmc_asym.kernels.closed as c; "
+            "print(c.moment_closed._cache._impl.locator.get_cache_path())")
+    env = {k: v for k, v in __import__("os").environ.items() if k != "PYTHONPATH"}
+
+    def path_in_copy(edit=False):
+        dst = tmp_path / ("edited" if edit else "same") / "ipmc_asym"
+        shutil.copytree(src, dst, ignore=shutil.ignore_patterns("__pycache__"))
+        if edit:
+            with open(dst / "kernels" / "closed.py", "a", encoding="utf-8") as f:
+                f.write("\n# an edit\n")
+        env["PYTHONPATH"] = str(dst.parent)
+        p = subprocess.run([sys.executable, "-c", code], env=env, cwd=tmp_path, capture_output=True, text=True,
+                           timeout=120)
+        assert p.returncode == 0, p.stderr
+        return p.stdout.strip()
+
+    here = moment_closed._cache._impl.locator.get_cache_path()
+    assert path_in_copy() == here
+    assert path_in_copy(edit=True) != here
+
+
 # --------------------------------------------------------------------------------------
 # Interpreted twins (start-up of one-shot commands): same source, same numbers
 # --------------------------------------------------------------------------------------
