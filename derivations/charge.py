@@ -43,6 +43,8 @@ cathode carries ``-D_z(e) = -sigma`` since ``D_z(e) = D_z(-e)``).  In the paper'
 
 from __future__ import annotations
 
+import functools
+
 import sympy as sp
 from sympy import QQ
 from sympy.polys.rings import ring
@@ -269,12 +271,18 @@ def small_voltage_kernel():
     return ratio, bound
 
 
+@functools.lru_cache(maxsize=None)
 def small_signal():
     """Linearised PNP about zero volts: (Zhat(W), moment transfer Mhat(W)) per unit psi0.
 
     d'' = k^2 d - J, d(+-1) = J/(iW) (blocking: N = J - iW d = 0 at the faces), d even.
     Zhat = psi0/J with psi0 = int d dx / lambda^2.  The moment integral per unit psi0 in
     thermal units: ``m = (1 + A3)/lambda^2 int d (1 - x^2)/2 dx / psi0``.
+
+    The integrals skip the Risch algorithm (``risch=False``): it rewrites ``cosh`` in ``exp``,
+    and integrating and simplifying that form takes ~4 times longer than the ``sinh``/``cosh``
+    antiderivatives the other methods give.  Cached: the kernels and
+    ``derivations/sensing_dynamic.py`` both start from it.
     """
     k = sp.symbols("k")
     A = (Jc / (sp.I * W) - Jc / k**2) / sp.cosh(k)
@@ -282,14 +290,14 @@ def small_signal():
     # checks: the ODE and the boundary values
     assert sp.simplify(sp.diff(d, x, 2) - (k**2 * d - Jc)) == 0
     assert sp.simplify(d.subs(x, 1) - Jc / (sp.I * W)) == 0
-    psi0 = sp.simplify(sp.integrate(d, (x, -1, 1), conds="none") / lam**2)
+    psi0 = sp.simplify(sp.integrate(d, (x, -1, 1), conds="none", risch=False) / lam**2)
     Zhat = sp.simplify(psi0 / Jc)
     ref = (2 / lam**2) * (1 / k**2 + (1 / (sp.I * W) - 1 / k**2) * sp.tanh(k) / k)
     for kv, lv, wv in ((sp.Rational(3, 2) + sp.I / 3, sp.Rational(1, 5), sp.Rational(7, 3)),
                        (sp.Integer(4) + 2 * sp.I, sp.Rational(1, 9), sp.Rational(1, 2))):
         r = (Zhat - ref).subs({k: kv, lam: lv, W: wv})
         assert abs(complex(sp.N(r, 30))) < 1e-20
-    mom = sp.simplify(sp.integrate(d * (1 - x**2) / 2, (x, -1, 1), conds="none") / lam**2 / psi0)
+    mom = sp.simplify(sp.integrate(d * (1 - x**2) / 2, (x, -1, 1), conds="none", risch=False) / lam**2 / psi0)
     # the same in tanh form (no e^{2k} overflow for k ~ 1/lambda ~ 1e3): a = A cosh(k)/J
     a = 1 / (sp.I * W) - 1 / k**2
     mom_stable = ((sp.Rational(2, 3) / k**2 + 2 * a * (1 / k**2 - sp.tanh(k) / k**3))

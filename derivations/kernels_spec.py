@@ -103,10 +103,18 @@ def model_kernels():
 
 
 @functools.lru_cache(maxsize=1)
-def all_kernels():
-    """(kernels, constants, tables) of ``_generated.py``; cached: the derivation takes seconds
-    and both ``codegen.check`` and the kernel-vs-SymPy tests need it (treat as read-only)."""
+def kernels_and_constants():
+    """(kernels, constants) of ``_generated.py``, without its tables; cached: the derivation
+    takes seconds and both ``codegen.check`` and the kernel-vs-SymPy tests need it (treat as
+    read-only)."""
     kernels = list(base_kernels()) + model_kernels()
-    ck, constants, tables = closed_forms.kernels()
+    ck, constants = closed_forms.kernels()
     kernels.extend(ck)
-    return kernels, constants, tables
+    return kernels, constants
+
+
+@functools.lru_cache(maxsize=1)
+def all_kernels():
+    """(kernels, constants, tables) of ``_generated.py``; cached as :func:`kernels_and_constants`."""
+    kernels, constants = kernels_and_constants()
+    return kernels, constants, closed_forms.tables()

@@ -27,6 +27,8 @@ what its own sections 3-4 imply (:func:`factor_three`).  We use sections 3-4.
 
 from __future__ import annotations
 
+import functools
+
 import sympy as sp
 
 F, Cm, E, phi0, L, l, e, eps0, deps, phi4, R, Tk, rho2, Z3 = sp.symbols(
@@ -94,14 +96,23 @@ def exponents(expr):
 
 
 def laws():
-    """List of dicts: model, regime, quantity, expression, exponents (all leading order)."""
+    """List of dicts: model, regime, quantity, expression, exponents (all leading order).
+
+    Fresh dicts on every call (the caller may change them) around one cached derivation: it
+    takes a second of SymPy, and ``ipmc-asym laws`` asks for it once per model.
+    """
+    return [{**r, "exponents": dict(r["exponents"])} for r in _laws()]
+
+
+@functools.lru_cache(maxsize=None)
+def _laws():
     rows = []
     for (model, regime), Iexpr in leading_I().items():
         Iexpr = sp.simplify(Iexpr)
         qs = {"I": Iexpr, **mechanics(Iexpr)}
         for q, ex in qs.items():
             rows.append({"model": model, "regime": regime, "quantity": q, "expr": ex, "exponents": exponents(ex)})
-    return rows
+    return tuple(rows)
 
 
 def main():

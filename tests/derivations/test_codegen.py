@@ -97,8 +97,7 @@ _Y_DOMAIN = {"depletion": (-200.0, -31.0), "accumulation": (9.0, 30.0), "dhat_fr
 def _kernel_cases():
     from derivations import kernels_spec
 
-    kernels, constants, _ = kernels_spec.all_kernels()
-    return kernels, constants
+    return kernels_spec.kernels_and_constants()  # not the tables: the kernels are checked here
 
 
 @pytest.mark.slow
