@@ -217,7 +217,10 @@ def test_linear_model_long_time_limit_is_the_exact_static_charge(V, thickness):
     charge within the run's own estimate, at the default tolerance, both signs, thin to thick strips."""
     s = Strip(thickness=thickness)
     tau = float(time_constant(thickness, "linear"))
-    r = solve_transient(np.array([0.0, tau, 30 * tau]), waveform("step", V), s, "linear", NAFION_LI)
+    # 15 tau: the slowest relaxation (0.05 V) is within 1e-11 of the relaxed charge by 12 tau (measured),
+    # far below the stated error (2e-7); past it the run integrates the relaxed state only (-0.05 V: 8 s
+    # of BDF steps from 15 to 30 tau in the rerun that measures the time integration's error)
+    r = solve_transient(np.array([0.0, tau, 15 * tau]), waveform("step", V), s, "linear", NAFION_LI)
     assert r.success, r.message
     ref = float(charge(thickness, V, "linear", "exact").sigma)
     assert abs(r.sigma[-1] - ref) <= r.sigma_error[-1] <= 1e-6 * abs(ref)
@@ -319,10 +322,13 @@ def test_step_tol_escalates_a_thin_affine_strip_at_2V():
     assert r.extra["valid_from"] is None or r.extra["valid_from"] > 0
 
 
+# the corners of 0.05 - 5 V x 20 um - 1 mm and their centre, each model: every voltage and thickness at
+# least once, and for the linear and affine models both outcomes (the circuit kept, the PNP escalated to).
+# A point left out repeats the outcome of a kept one at its voltage, but for the thin strip at 1 V, which
+# escalates (linear, affine) as the dev loop's thin strips do (affine at 2 V, linear at -1 V)
 @pytest.mark.slow
 @pytest.mark.parametrize("model", ["constant", "linear", "affine"])
-@pytest.mark.parametrize("V", [0.05, 1.0, 5.0])
-@pytest.mark.parametrize("thickness", [20e-6, 200e-6, 1e-3])
+@pytest.mark.parametrize("V,thickness", [(0.05, 20e-6), (0.05, 1e-3), (5.0, 20e-6), (5.0, 1e-3), (1.0, 200e-6)])
 def test_step_tol_grid(model, V, thickness):
     _ladder_case(model, V, thickness, 1e-2)
 

@@ -178,6 +178,18 @@ def test_grid_against_bvp_coarse():
     _grid([1e-6, 2e-3], [1e-4, 20.0])
 
 
+#: half-decades where the answer changes with the thickness (below ~30 um the layers reach the core:
+#: the ladder escalates to ``exact``, the error estimate leaves its floor), decades above it, where
+#: the core is neutral and every model answers alike (the nominal 200 um lies between 100 um and
+#: 10 mm); both ends of the range
+FINE_THICKNESSES = [*np.geomspace(1e-6, 1e-4, 5), 1e-2]
+#: one voltage per layer scheme (A2 = F V/RT, the drop across both layers in thermal units): one
+#: quadrature panel at each face (|Y| < 1/2, as at every voltage below ~20 mV; the smallest voltage),
+#: a few doubling panels (A2 ~ 6), the anode deep in its depletion zone (A2 ~ 67), the largest
+#: voltage (A2 ~ 775); both signs of each
+FINE_VOLTAGES = [1e-4, 0.152, 1.74, 20.0]
+
+
 @pytest.mark.slow
 def test_grid_against_bvp_fine():
-    _grid(list(np.geomspace(1e-6, 1e-2, 9)), list(np.geomspace(1e-4, 20.0, 6)))
+    _grid(FINE_THICKNESSES, FINE_VOLTAGES)

@@ -38,7 +38,13 @@ def test_public_functions_have_doctests():
         assert name in names or (name == "scene" and "run_scene" in names), name
 
 
-@pytest.mark.parametrize("test", DOCTESTS, ids=[t.name for t in DOCTESTS])
+#: doctests that draw every figure of the paper (~10 s): run in CI; the dev loop draws them in
+#: tests/plotting/test_figures.py
+_SLOW_DOCTESTS = ("figures",)
+
+
+@pytest.mark.parametrize("test", [pytest.param(t, marks=pytest.mark.slow) if t.name in _SLOW_DOCTESTS else t
+                                  for t in DOCTESTS], ids=[t.name for t in DOCTESTS])
 def test_doctest(test):
     runner = doctest.DocTestRunner(optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE)
     runner.run(test)

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import ast
 import fnmatch
+import functools
 import re
 import sys
 from pathlib import Path
@@ -15,6 +16,17 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
+
+
+@functools.lru_cache(maxsize=None)
+def _parsed(text: str) -> ast.Module:
+    # every test walks the same ~200 files: each text is parsed once per process (a changed file,
+    # such as the checker's own upward-import fakes, is a new text and parsed anew)
+    return ast.parse(text)
+
+
+def parse(path: Path) -> ast.Module:
+    return _parsed(path.read_text(encoding="utf-8"))
 
 
 def read_layers(text: str) -> list[tuple[str, list[str]]]:
@@ -37,8 +49,13 @@ def module_name(path: Path) -> str:
 
 def imports_of(path: Path, mod: str) -> set[str]:
     """Modules of the project imported by ``path`` (absolute names)."""
-    tree = ast.parse(path.read_text(encoding="utf-8"))
-    pkg = mod if path.name == "__init__.py" else mod.rpartition(".")[0]
+    return set(_imports(path.read_text(encoding="utf-8"), path.name, mod))
+
+
+@functools.lru_cache(maxsize=None)
+def _imports(text: str, filename: str, mod: str) -> frozenset:
+    tree = _parsed(text)
+    pkg = mod if filename == "__init__.py" else mod.rpartition(".")[0]
     found = set()
     for node in ast.walk(tree):
         if isinstance(node, ast.Import):
@@ -60,7 +77,7 @@ def imports_of(path: Path, mod: str) -> set[str]:
                 n = "derivations" + n[len("ipmc_asym_derivations"):]
             if n.split(".")[0] in ("ipmc_asym", "derivations"):
                 found.add(n)
-    return found
+    return frozenset(found)
 
 
 def project_modules() -> dict[str, Path]:
@@ -215,7 +232,7 @@ def test_only_plotting_imports_matplotlib():
     for m, p in project_modules().items():
         if m.startswith("ipmc_asym.plotting") or m == RESULT_FIGURES:
             continue
-        tree = ast.parse(p.read_text(encoding="utf-8"))
+        tree = parse(p)
         for node in ast.walk(tree):
             names = ([a.name for a in node.names] if isinstance(node, ast.Import)
                      else [node.module or ""] if isinstance(node, ast.ImportFrom) else [])
@@ -260,7 +277,7 @@ def local_imports(path: Path) -> list[tuple[int, str]]:
     text = path.read_text(encoding="utf-8")
     lines = text.splitlines()
     out = []
-    for node in ast.walk(ast.parse(text)):
+    for node in ast.walk(_parsed(text)):
         if not isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
             continue
         for sub in ast.walk(node):

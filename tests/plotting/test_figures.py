@@ -1,8 +1,11 @@
 import numpy as np
+import pytest
 
 from ipmc_asym.plotting.figures import make_all
 
 
+# the dev loop draws the same figures once, as PDF, in the test below; this PNG pass runs in CI
+@pytest.mark.slow
 def test_figures_produced_and_nontrivial(tmp_path):
     import matplotlib.image as mpimg
 
