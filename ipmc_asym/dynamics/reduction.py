@@ -232,12 +232,13 @@ def vector_fit(s, H, order, iterations=12, proper=True):
         M = np.hstack([Phi, np.ones((s.size, 1)), -H[:, None] * Phi]) * w[:, None]
         x, *_ = np.linalg.lstsq(M, H * w, rcond=None)
         poles = _symmetric(np.linalg.eigvals(np.diag(poles) - np.outer(np.ones(n), x[n + 1:])))
-    return (poles, *_residues(s, H, w, poles, proper))
+    return _residues(s, H, w, poles, proper)
 
 
 def _residues(s, H, w, poles, proper):
-    """Residues (conjugate-symmetric: real at a real pole, ``r`` and ``conj(r)`` at a pair) and the real
-    direct term of the weighted least-squares fit with the poles fixed.
+    """``(poles, residues, d)`` of the weighted least-squares fit with the poles fixed: the poles as
+    real ones, upper ones, their conjugates in the same order (``_symmetric``'s layout), the residues
+    conjugate-symmetric (real at a real pole, ``r`` and ``conj(r)`` at a pair), ``d`` real.
 
     Solved for real unknowns (a real pole's residue; ``Re r`` and ``Im r`` of a pair: ``r/(s - p) +
     conj(r)/(s - conj p) = Re r (1/(s - p) + 1/(s - conj p)) + Im r (i/(s - p) - i/(s - conj p))``)
@@ -262,19 +263,8 @@ def _residues(s, H, w, poles, proper):
     x, *_ = np.linalg.lstsq(np.vstack([M.real, M.imag]), np.concatenate([y.real, y.imag]), rcond=None)
     nr, nu = pr.size, up.size
     ru = x[nr:nr + nu] + 1j * x[nr + nu:nr + 2 * nu]
-    # the order of ``poles`` (real ones, upper, lower: _symmetric's)
-    res = np.empty(poles.size, complex)
-    res[real] = x[:nr]
-    res[poles.imag > 0.0] = ru
-    res[poles.imag < 0.0] = _conj_in_order(poles, up, ru)
-    return res, (float(x[-1]) if proper else 0.0)
-
-
-def _conj_in_order(poles, up, ru):
-    """The residues ``conj(ru)`` in the order of the lower poles of ``poles`` (each the conjugate of one of ``up``)."""
-    lower = poles[poles.imag < 0.0]
-    idx = [int(np.argmin(np.abs(up.conj() - q))) for q in lower]
-    return ru.conj()[idx]
+    return (np.concatenate([pr, up, up.conj()]), np.concatenate([x[:nr], ru, ru.conj()]),
+            float(x[-1]) if proper else 0.0)
 
 
 def _forms_error(fit, f, H):
