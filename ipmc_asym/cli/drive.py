@@ -16,6 +16,7 @@ from ipmc_asym.cli.common import (  # noqa: F401  (CLAMPED_UNITS, viscous_modulu
     add_beam_options,
     add_line_options,
     add_output_option,
+    add_solver_option,
     add_strip_options,
     add_support_options,
     count_type,
@@ -26,17 +27,20 @@ from ipmc_asym.cli.common import (  # noqa: F401  (CLAMPED_UNITS, viscous_modulu
     sidecar_path,
     strip_and_material,
     support_from_args,
+    tol_type,
     viscous_modulus_type,
     waveform_type,
 )
+from ipmc_asym.dynamics.circuit import STEP_FIDELITIES
 from ipmc_asym.dynamics.drive import (
     CHECK_COLUMNS,
     CLAMPED_COLUMNS,
     DRIVE_COLUMNS,
     LINE_COLUMNS,
     MAX_DRIVE_POINTS,
+    MAX_STATED_POINTS,
 )
-from ipmc_asym.dynamics.entry import time_response
+from ipmc_asym.dynamics.entry import ERROR_COLUMNS, time_path, time_response
 from ipmc_asym.io.fileio import atomic_path, atomic_write, check_output_path
 from ipmc_asym.io.textfmt import format_table
 
@@ -56,11 +60,20 @@ def register(sub):
     p.add_argument("--model", default="constant", choices=list(model_names()), help="permittivity model")
     p.add_argument("--diffusion", type=diffusion_type(), default=None,
                    help="cation diffusion coefficient D (1e-10m2/s, 1e-6cm2/s; a bare number is m^2/s)")
+    add_solver_option(p, "drive", dest="fidelity", default="circuit", choices=STEP_FIDELITIES,
+                      help="circuit (reduced nonlinear capacitor, stepped chunk by chunk) or pnp (transient "
+                           "Nernst-Planck/Gauss, in memory, at most %d points; its errors stated)" % MAX_STATED_POINTS)
+    p.add_argument("--tol", type=tol_type, default=None,
+                   help="relative accuracy required of sigma at every output time, e.g. 1e-2 or 1%% (in [1e-8, 0.5)): "
+                        "the circuit's error is bounded against a PNP run over the same waveform and the PNP is used "
+                        "where it fails, as in step; adds the columns " + ", ".join(ERROR_COLUMNS) + " (in memory, at "
+                        f"most {MAX_STATED_POINTS} points; default: no error stated for the circuit)")
     add_beam_options(p)
     add_line_options(p)
     add_support_options(p)
     add_output_option(p, "--out", formats=(".csv",), default=None, help="CSV file, written as computed (columns " + ", ".join(DRIVE_COLUMNS)
-                   + ", then the forward model's check_* and valid per time point, 1 or 0)")
+                   + ", then the forward model's check_* and valid per time point, 1 or 0; with --tol or --solver "
+                   "pnp then " + ", ".join(ERROR_COLUMNS) + ")")
     p.add_argument("--json", action="store_true", help=f"print one JSON object (at most {MAX_JSON_POINTS:g} points)")
 
 
@@ -90,29 +103,41 @@ def run(args):
         raise ValueError(f"--points must be at most {MAX_DRIVE_POINTS:g}; got {args.points}")
     if args.json and args.points > MAX_JSON_POINTS:
         raise ValueError(f"--json holds every row in memory: --points at most {MAX_JSON_POINTS:g} (use --out F.csv)")
+    stated = args.tol is not None or args.fidelity == "pnp"
+    if stated and args.points > MAX_STATED_POINTS:
+        raise ValueError(f"--points with --tol or --solver pnp (solved in memory, the PNP's profiles at every output "
+                         f"time) must be at most {MAX_STATED_POINTS}; got {args.points}")
     if args.out:
         check_output_path(args.out, "file", formats=(".csv",))
         check_output_path(sidecar_path(args.out), "file")
     support, electrode = support_from_args(args)
+    # the choice's refusals first (a tolerance with the electrode line or a support), before any work
+    time_path(fidelity=args.fidelity, tol=args.tol, beam=args.beam, sheet_resistance=args.sheet_resistance,
+              support=support, electrode=electrode, stream=True, beam_grid="output")
     strip, material, _ = strip_and_material(args)
     clamped = support == "clamped-clamped"
     # the rows stepped on the output grid and streamed (the dynamic beam too: the grid must resolve the
-    # first mode), whatever --out or --json do with them
+    # first mode), whatever --out or --json do with them; with --tol or the PNP, solved in memory
+    first_run_notice("step-pnp" if stated else None)
     resp = time_response(strip, args.waveform, duration=args.duration, points=args.points, model=args.model,
-                         material=material, beam=args.beam, viscous_modulus=args.viscous_modulus,
-                         sheet_resistance=args.sheet_resistance, line_segments=args.line_segments, support=support,
-                         electrode=electrode, stream=True, beam_grid="output")
+                         material=material, fidelity=args.fidelity, tol=args.tol, beam=args.beam,
+                         viscous_modulus=args.viscous_modulus, sheet_resistance=args.sheet_resistance,
+                         line_segments=args.line_segments, support=support, electrode=electrode, stream=True,
+                         beam_grid="output")
     info = resp.info
-    columns = COLUMNS + (LINE_COLUMNS if args.sheet_resistance > 0.0 else ()) + (CLAMPED_COLUMNS if clamped else ())
+    columns = COLUMNS + (LINE_COLUMNS if args.sheet_resistance > 0.0 else ()) + (CLAMPED_COLUMNS if clamped else ()) + (
+        ERROR_COLUMNS if stated else ())
+    what = "electrode line" if args.sheet_resistance > 0.0 else "circuit against the PNP, or the PNP's own"
     head = dict(info, waveform=args.waveform.spec, duration=args.duration, points=args.points,
                 thickness_total=strip.thickness, half_thickness_e=strip.e, diffusion_coefficient=material.D,
                 units={"t": "s", "phi0": "V", "sigma": "C/m^2 (face z = -e)", "current_density": "A/m^2",
                        "layer_voltage": "V", "M_A": "N m", "theta": "rad (free tip)", "w": "m (free tip)",
-                       "F_block": "N (blocked tip)", "sigma_error": "C/m^2 (electrode line, stated)",
-                       "w_error": "m (electrode line, stated)", **(CLAMPED_UNITS if clamped else {})})
-    first_run_notice()
-    gen = resp.chunks
-    shown_cols = DRIVE_COLUMNS + (CLAMPED_COLUMNS if clamped else ())
+                       "F_block": "N (blocked tip)", "sigma_error": f"C/m^2 ({what}, stated)",
+                       "w_error": f"m ({what}, stated)",
+                       **({"current_error": f"A/m^2 ({what}, stated)"} if stated else {}),
+                       **(CLAMPED_UNITS if clamped else {})})
+    gen = resp.iter_chunks()
+    shown_cols = DRIVE_COLUMNS + (CLAMPED_COLUMNS if clamped else ()) + (ERROR_COLUMNS if stated else ())
     show = set(np.unique(np.linspace(0, args.points - 1, min(args.points, 11)).astype(int)).tolist())
     shown, kept = [], []
     seen, counts = {}, {}
@@ -160,16 +185,22 @@ def run(args):
               f"blocked tip {', '.join(f'{v:.4g}' for v in info['resonances']['clamped-pinned'])} Hz"
               + (f"; clamped-clamped {', '.join(f'{v:.4g}' for v in info['resonances']['clamped-clamped'])} Hz"
                  if clamped else ""))
-    print(f"{'t [s]':>11s} {'phi0 [V]':>9s} {'sigma [C/m^2]':>14s} {'J [A/m^2]':>11s} {'M_A [N m]':>11s} "
-          f"{'theta':>9s} {'w [mm]':>9s} {'F_block [mN]':>12s}")
+    pm = f" {'+-':>9s}" if stated else ""  # the stated errors beside their values
+    print(f"{'t [s]':>11s} {'phi0 [V]':>9s} {'sigma [C/m^2]':>14s}{pm} {'J [A/m^2]':>11s}{pm} {'M_A [N m]':>11s} "
+          f"{'theta':>9s} {'w [mm]':>9s}{pm} {'F_block [mN]':>12s}")
+
+    def num(x, scale, spec):  # undefined or not stated: n/a, never a bare nan
+        return f"{x * scale:{spec}}" if np.isfinite(x) else f"{'n/a':>{spec.split('.')[0]}s}"
+
     for r in shown:
         r = {k: v + 0.0 for k, v in r.items()}  # no "-0" in the table
         # w and F_block are undefined past a quarter turn / on the multi-turn branch (the forward
-        # model's beam regime, as `estimate` prints it): n/a, never a bare nan
-        w = f"{r['w'] * 1e3:9.4g}" if np.isfinite(r["w"]) else f"{'n/a':>9s}"
-        fb = f"{r['F_block'] * 1e3:12.4g}" if np.isfinite(r["F_block"]) else f"{'n/a':>12s}"
-        print(f"{r['t']:11.4g} {r['phi0']:9.4g} {r['sigma']:14.6g} {r['current_density']:11.4g} {r['M_A']:11.4g} "
-              f"{r['theta']:9.4g} {w} {fb}")
+        # model's beam regime, as `estimate` prints it)
+        e = {c: " " + num(r[c], 1e3 if c == "w_error" else 1.0, "9.2g") for c in ERROR_COLUMNS} if stated else \
+            dict.fromkeys(ERROR_COLUMNS, "")
+        print(f"{r['t']:11.4g} {r['phi0']:9.4g} {r['sigma']:14.6g}{e['sigma_error']} "
+              f"{num(r['current_density'], 1.0, '11.4g')}{e['current_error']} {r['M_A']:11.4g} "
+              f"{num(r['theta'], 1.0, '9.4g')} {num(r['w'], 1e3, '9.4g')}{e['w_error']} {num(r['F_block'], 1e3, '12.4g')}")
     if clamped:
         print_clamped("t [s]", [r["t"] for r in shown], {c: [r[c] for r in shown] for c in CLAMPED_COLUMNS})
     for n in info["notes"]:

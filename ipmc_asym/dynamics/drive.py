@@ -59,7 +59,7 @@ from ipmc_asym.model.params import (
 )
 from ipmc_asym.model.permittivity import get_model
 
-__all__ = ["DRIVE_ERROR_NOTE",
+__all__ = ["DRIVE_ERROR_NOTE", "MAX_STATED_POINTS",
            "DRIVE_COLUMNS", "CHECK_COLUMNS", "LINE_COLUMNS", "CLAMPED_COLUMNS", "MAX_DRIVE_POINTS", "drive_info", "drive_chunks",
            "drive_response", "LINE_NOTE"]
 
@@ -73,15 +73,20 @@ CLAMPED_COLUMNS = CLAMPED_OUTPUTS
 #: with a sheet resistance: the stated discretisation error of sigma (C/m^2) and w (m) of the line
 LINE_COLUMNS = ("sigma_error", "w_error")
 
-#: said by every drive run: its rows carry no error of the reduced circuit against the PNP.  The
-#: circuit's error is bounded in the frequency domain (``freq``: ``error``, at most lambda/2 about
-#: 0 V, against the PNP linearised about the bias with a bias) and in time against a PNP run
-#: (``step --tol``, 100-1000 times the circuit's cost); for an arbitrary waveform neither carries
-#: over: the large-signal charging is nonlinear, and a PNP run over a long waveform is what the
-#: streamed circuit avoids
-DRIVE_ERROR_NOTE = ("no error of the reduced circuit against the PNP is stated for these rows (an arbitrary waveform "
-                    "stepped through the circuit is not bounded): see freq --method circuit ('error', small signal) or "
-                    "step --tol T (a reference PNP run, in memory)")
+#: cap on the output times of a drive run with a tolerance or the PNP (solved in memory; the PNP keeps
+#: the profiles of every output time, ~10 kB each: about 100 MB)
+MAX_STATED_POINTS = 10_001
+
+#: said by a drive run of the circuit without a tolerance: its rows carry no error against the PNP.
+#: The circuit's error is bounded in the frequency domain (``freq``: ``error``, at most lambda/2 about
+#: 0 V, against the PNP linearised about the bias with a bias) and in time against a PNP run over the
+#: same waveform (``drive --tol T``, as ``step --tol``: in memory, 100-1000 times the circuit's cost);
+#: a streamed run over a long waveform is what the circuit is for, so the reference is not run by default
+DRIVE_ERROR_NOTE = ("no error of the reduced circuit against the PNP is stated for these rows (the circuit stepped "
+                    "through an arbitrary waveform carries no bound of its own): drive --tol T states it against a PNP "
+                    "run over the same waveform (in memory, at most "
+                    f"{MAX_STATED_POINTS} points); freq --method circuit states it in "
+                    "the small signal ('error')")
 LINE_NOTE = ("electrodes: sheet resistance R_s = {Rs:g} Ohm/sq each: the RC line along the strip discretised in "
              "{n2} segments (trapezoidal ladder, a reduced circuit at each node, driven at the clamp, open at the tip); "
              "sigma, current density and layer voltage are means over the electrode; sigma_error and w_error are twice "

@@ -31,19 +31,24 @@ from ipmc_asym.dynamics.circuit import (
     step_response,
     waveform,
 )
-from ipmc_asym.dynamics.drive import drive_chunks, drive_info, drive_response
+from ipmc_asym.dynamics.drive import DRIVE_COLUMNS, drive_chunks, drive_info, drive_response
 from ipmc_asym.dynamics.line import line_response
 from ipmc_asym.dynamics.line_time import DEFAULT_SEGMENTS
 from ipmc_asym.dynamics.waveforms import Waveform, check_drive_voltage, parse_waveform
+from ipmc_asym.forward.model import CHECKS
 from ipmc_asym.model.params import NAFION_LI, Material, Strip, check_finite
 
-__all__ = ["DEFAULT_BEAM", "TIME_PATHS", "Drive", "TimeResponse", "time_path", "time_response", "spectrum"]
+__all__ = ["DEFAULT_BEAM", "TIME_PATHS", "ERROR_COLUMNS", "Drive", "TimeResponse", "time_path", "time_response", "spectrum"]
 
 #: solvers of a time response: ``memory`` (step_response: circuit or PNP, optional tolerance, the dynamic
 #: beam on a refined grid), ``stream`` (the circuit stepped on the output grid, chunk by chunk, memory
 #: independent of the number of points; supports and partial electrodes), ``line`` (the electrode line:
 #: the same stepper with resistive electrodes, its discretisation error stated)
 TIME_PATHS = ("memory", "stream", "line")
+
+#: the stated errors of the in-memory solve (with a tolerance, or the PNP): sigma (C/m^2), its current
+#: density (A/m^2) and the tip deflection (m), each a bound at every output time
+ERROR_COLUMNS = ("sigma_error", "current_error", "w_error")
 
 #: how the dynamic beam meets the output grid: ``refined`` (the transient is solved on a grid of >= 40
 #: points per period of the first mode and sampled at the output times) or ``output`` (the modes are
@@ -124,8 +129,9 @@ class TimeResponse(ResultMixin):
     path : {"memory", "stream", "line"}   the solver (:data:`TIME_PATHS`)
     drive : Drive
     duration : float or None    end time, s (None: the in-memory solve's default, 5 tau)
-    info : dict or None         header of the stepped paths (:func:`ipmc_asym.dynamics.drive.drive_info`:
-                                tau, R, notes, resonances, line segments)
+    info : dict                 header of the run (:func:`ipmc_asym.dynamics.drive.drive_info`: tau, R,
+                                notes, resonances, line segments; the in-memory solve adds its
+                                ``fidelity``, the ``tol`` it met and ``valid_from``)
     result : StepResult or None the in-memory solve (path ``memory``)
     chunks : iterator of dict or None   the stepped paths with ``stream=True``: dicts of column arrays
                                 (:data:`ipmc_asym.dynamics.drive.DRIVE_COLUMNS`, checks, line columns)
@@ -149,6 +155,28 @@ class TimeResponse(ResultMixin):
     result: StepResult | None = None
     chunks: Iterator | None = None
     columns: dict | None = field(default=None, repr=False)
+
+    def iter_chunks(self):
+        """The rows as dicts of column arrays, whatever the path: the stepped paths' chunks, or one chunk
+        of the in-memory solve (the same columns, :data:`ipmc_asym.dynamics.drive.DRIVE_COLUMNS` and the
+        checks, with its stated errors :data:`ERROR_COLUMNS` and ``warnings``)."""
+        if self.chunks is not None:
+            yield from self.chunks
+            return
+        if self.columns is not None:
+            yield self.columns
+            return
+        r = self.result
+        ch = {c: np.asarray(getattr(r, c), dtype=float) for c in DRIVE_COLUMNS}
+        for c in CHECKS:
+            ch[f"check_{c}"] = np.asarray(r.checks[c], dtype=float)
+        ch["valid"] = np.asarray(r.valid, dtype=float)
+        nan = np.full(r.t.shape, np.nan)
+        for c in ERROR_COLUMNS:
+            v = getattr(r, c)
+            ch[c] = nan if v is None else np.asarray(v, dtype=float)
+        ch["warnings"] = list(r.warnings)
+        yield ch
 
     def _arrays(self):
         if self.result is not None:
@@ -250,7 +278,10 @@ def time_response(strip: Strip | None = None, drive=None, *, duration=None, poin
         r = step_response(d.voltage if d.kind == "step" else s.voltage, duration, strip=s, model=model,
                           fidelity=fidelity, material=m, points=points, waveform_kind=kind, beam=beam,
                           viscous_modulus=viscous_modulus, n_modes=n_modes, tol=tol, pnp_options=pnp_options)
-        return TimeResponse(path, d, duration, result=r)
+        # the header of the stepped paths, with the run's own notes (what it states and what it leaves out)
+        info = dict(drive_info(s, model, m, beam, viscous_modulus), notes=list(r.notes), fidelity=r.fidelity,
+                    tol=tol if tol is not None else r.extra.get("tol"), valid_from=r.extra.get("valid_from"))
+        return TimeResponse(path, d, duration, info=info, result=r)
     # the stepped paths: the uniform strip streams with the quasi-static beam unless the output grid
     # carries the modes (time_path); the line and the supports with either beam
     vm = viscous_modulus

@@ -204,3 +204,42 @@ def test_drive_says_in_one_line_that_its_rows_state_no_error(capsys):
     assert lines == [f"note: {DRIVE_ERROR_NOTE}"] and "--tol" in lines[0] and "freq" in lines[0]
     assert main(base + ["--json"]) == 0
     assert DRIVE_ERROR_NOTE in json.loads(capsys.readouterr().out)["notes"]
+
+
+def test_drive_with_a_tolerance_states_errors_that_hold_against_a_finer_pnp(capsys):
+    """drive --tol: the circuit's rows with a stated error (against a PNP run over the same waveform);
+    the error holds against an independent PNP run at a tolerance 100 times tighter (its own error
+    added), and the circuit's rows are those of the streamed run (the same circuit) within it."""
+    base = ["drive", "--waveform", "dc:0.2V+sine:1V@10Hz", "--duration", "0.1s", "--points", "21",
+            "--beam", "quasi-static", "--json"]
+    assert main(base + ["--tol", "1e-2"]) == 0
+    c = json.loads(capsys.readouterr().out)
+    assert c["fidelity"] == "circuit" and c["tol"] == 1e-2
+    assert not any("no error of the reduced circuit" in n for n in c["notes"])
+    assert main(base + ["--solver", "pnp", "--tol", "1e-4"]) == 0
+    ref = json.loads(capsys.readouterr().out)
+    assert ref["fidelity"] == "pnp"
+    for k in ("sigma", "w"):
+        v, e, r, re = (np.asarray(x, float) for x in (c[k], c[f"{k}_error"], ref[k], ref[f"{k}_error"]))
+        assert np.all(np.isfinite(e)) and np.all(np.abs(v - r) <= e + re), k
+        assert np.max(e) <= 1e-2 * np.max(np.abs(v)) or k == "w"  # sigma's bound meets the tolerance
+    assert main(base) == 0
+    streamed = json.loads(capsys.readouterr().out)
+    assert "sigma_error" not in streamed
+    s, v, e = (np.asarray(x, float) for x in (streamed["sigma"], c["sigma"], c["sigma_error"]))
+    assert np.all(np.abs(s - v) <= e)
+
+
+@pytest.mark.parametrize("args,word", [
+    (["--tol", "1e-2", "--points", "20002"], "--points"),
+    (["--solver", "pnp", "--sheet-resistance", "2.5"], "sheet_resistance"),
+    (["--tol", "1e-2", "--support", "clamped-clamped"], "tol"),
+])
+def test_drive_tolerance_refusals_before_the_work(args, word, capsys):
+    try:
+        code = main(["drive", "--waveform", "sine:1V@10Hz", "--duration", "0.1s"] + args)
+    except SystemExit as e:
+        code = e.code
+    assert code == 2
+    err = capsys.readouterr().err.strip()
+    assert word in err and len(err.splitlines()) == 1

@@ -69,6 +69,7 @@ def test_bvp_at_minus_18_4_volts_no_overflow():
     assert math.isfinite(float(r.B1)) and float(r.B1) > 1
 
 
+@pytest.mark.slow  # ~5 s: test_bvp_at_minus_18_4_volts_no_overflow holds a negative extreme in the quick loop
 def test_cli_bvp_at_minus_19_volts(capsys):
     assert main(["estimate", "--voltage=-19V", "--fidelity", "bvp", "--model", "linear", "--json"]) == 0
     d = json.loads(capsys.readouterr().out)
@@ -581,6 +582,7 @@ def test_step_text_has_no_negative_zero(capsys):
     assert " -0 " not in out and not any(f.strip() == "-0" for f in out.split())
 
 
+@pytest.mark.slow  # ~5 s, mostly drawing the six figures: test_every_figure builds the profiles figure
 def test_profiles_prints_no_nan(tmp_path, capsys):
     assert main(["profiles", "--out", str(tmp_path / "p"), "--model", "constant"]) == 0
     table = [ln for ln in capsys.readouterr().out.splitlines() if not ln.startswith("wrote ")]
@@ -706,3 +708,20 @@ def test_warmup_runs_each_group_and_marks_the_cache(monkeypatch, tmp_path, capsy
     assert (tmp_path / "cache" / WARM_MARKER).exists()
     first_run_notice("step-pnp")
     assert capsys.readouterr().err == ""
+
+
+@pytest.mark.slow  # every group in two fresh processes (~10 s with a warm cache)
+def test_warmup_jobs_runs_every_group_in_processes_side_by_side(tmp_path):
+    import subprocess
+    import sys
+
+    import ipmc_asym.cli.warmup as warmup
+
+    p = subprocess.run([sys.executable, "-m", "ipmc_asym", "warmup", "--jobs", "2", "--json"], capture_output=True,
+                       text=True, timeout=900)
+    assert p.returncode == 0, p.stderr
+    out = json.loads(p.stdout)
+    labels = [label for label, _ in warmup._steps()]
+    assert list(out["seconds"]) == labels and out["jobs"] == 2
+    assert all(v >= 0.0 for v in out["seconds"].values()) and out["wall_seconds"] > 0.0
+    assert p.stderr.count(": done") == len(labels)

@@ -159,10 +159,11 @@ def test_printed_powers_evaluate_as_sympy(printer):
 
 
 #: the Debye-Hueckel module needs the order-4 perturbation solution (~1 min of SymPy unless kept
-#: on disk; its remainder constants) and the charge module ~13 s: slow; each other one in seconds.
+#: on disk; its remainder constants), the charge module ~13 s, the closed-form moment module ~11 s
+#: and the sensing module ~5 s: slow (the full run checks them); each other one in seconds.
 #: Every module is checked here once (``derive --check`` is this same comparison for all of them:
 #: tests/cli/test_commands.py checks that the command runs it)
-_SLOW_TARGETS = ("_generated_dh.py", "_generated_charge.py")
+_SLOW_TARGETS = ("_generated_dh.py", "_generated_charge.py", "_generated.py", "_generated_sensing.py")
 _TARGETS = [pytest.param(t.name, marks=pytest.mark.slow) if t.name in _SLOW_TARGETS else t.name
             for t in codegen.TARGETS]
 

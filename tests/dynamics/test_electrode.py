@@ -54,7 +54,8 @@ def test_layer_capacitance_kernel_matches_sympy(i):
     assert GC.layer_capacitance(yv, r) == pytest.approx(float(d), rel=1e-11)
 
 
-@pytest.mark.parametrize("model", MODELS3)
+# the affine case (~7 s) with the slow tests: the constant and linear ones run the same comparison
+@pytest.mark.parametrize("model", ["constant", "linear", pytest.param("affine", marks=pytest.mark.slow)])
 def test_debye_hueckel_limit_exact(model):
     """C_d -> eps_core/(2 lambda_D) and sigma -> the SymPy series in A2 at small voltage."""
     perm = MODELS[model]

@@ -148,7 +148,8 @@ def test_dynamic_beam_against_the_discretised_line_and_an_exact_beam(Rs):
     assert r.resonances["clamped-free"][0] == pytest.approx(22.546, rel=1e-3)
 
 
-@pytest.mark.parametrize("bias", [0.5, -0.3])
+# +0.5 V with the slow tests (~5 s each): the quick loop keeps a negative bias
+@pytest.mark.parametrize("bias", [pytest.param(0.5, marks=pytest.mark.slow), -0.3])
 def test_biased_line_against_the_discretised_line(bias):
     # the shunt admittance about the biased static state (circuit: R, C_d(V), C_g) along the ladder
     s = Strip()
@@ -254,7 +255,8 @@ def test_derivation_checks():
     assert DL.check_all()
 
 
-@pytest.mark.parametrize("betaL", [4.694091, 30.0])  # second cantilever root; a mode of order ~10
+# second cantilever root; a mode of order ~10 (~4 s: with the slow tests)
+@pytest.mark.parametrize("betaL", [4.694091, pytest.param(30.0, marks=pytest.mark.slow)])
 def test_modal_integral_against_independent_quadrature(betaL):
     L = 0.02
     beta = betaL / L

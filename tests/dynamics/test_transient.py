@@ -333,6 +333,7 @@ def test_step_tol_grid(model, V, thickness):
     _ladder_case(model, V, thickness, 1e-2)
 
 
+@pytest.mark.slow  # ~5 s: tests/cli/test_step.py runs the same bound at 0.5 V through the command
 def test_step_tol_bounds_the_circuit_for_the_linear_model():
     """The circuit's stated error (against the PNP rung) holds for the linear model too."""
     _ladder_case("linear", -1.0, 20e-6, 1e-2)

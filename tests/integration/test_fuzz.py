@@ -251,7 +251,8 @@ def test_every_command_is_covered():
     assert len(listed) >= 14
 
 
-@pytest.mark.parametrize("argv", [["warmup", "--nope"], ["warmup", "--json", "x"]])
+@pytest.mark.parametrize("argv", [["warmup", "--nope"], ["warmup", "--json", "x"], ["warmup", "--jobs", "0"],
+                                  ["warmup", "--jobs", "99"], ["warmup", "--jobs", "1.5"]])
 def test_warmup_refuses_in_one_line(argv):
     """warmup compiles every kernel (minutes on a cold cache): only its refusals are fuzzed here."""
     rc, out, err = run_cli(argv)

@@ -34,6 +34,7 @@ def _drawn(line):
     return line.get_visible() and bool(np.any(np.isfinite(x) & np.isfinite(y)))
 
 
+@pytest.mark.slow  # ~11 s, every figure of the command: test_every_figure builds each one in the quick loop
 def test_figures_command_writes_print_ready_vector_files(tmp_path, monkeypatch, capsys):
     """``figures --format pdf``: PDF files with no raster image in them; every figure one column
     (8.5 cm) or one page (17 cm) wide with every text >= 7 pt, and every legend entry the style of
