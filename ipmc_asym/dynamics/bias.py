@@ -92,12 +92,64 @@ class BiasReference:
     C_diff: float = math.nan
 
 
+#: the linear model's closed-form static state is used where ``lambda`` is at most this
+#: (``e^{-1/lambda} <= 1e-11``, the overlap of the two layers' tails at the centre: the neutral core it
+#: assumes holds to that; 2e >= 24 um with the paper's set); the check of its static limit against the
+#: exact capacitance (:func:`_check_static_limit`) tests it at every bias
+CLOSED_FORM_LAYERS = 1.0 / (11.0 * math.log(10.0))
+#: ... and where its anode concentration ``u_f ~ 2 e^{-v}`` is below this (from ~0.6 V): above, the
+#: BVP's static state resolves the anode (to 0.7 V, measured) and serves every model alike
+CLOSED_FORM_BELOW = 1e-10
+
+
+def _linear_profile(lam: float, v: float):
+    """The linear model's static state (``eps = alpha C``, ``r0 = 0``) about a neutral core, in closed
+    form, as ``profile(xi) -> (u, D_bar)`` at the distance ``xi = x + 1`` from the anode face.
+
+    With ``eps_hat = u`` the zero flux gives ``u' = D_bar/lambda^2`` and Gauss ``D_bar' = u - 1``, so
+    ``D_bar^2 - lambda^2 (u - 1)^2`` is constant, 0 in the neutral core: ``D_bar = lambda |1 - u|`` and
+    ``u = 1 -+ (1 - u_f) e^{-s/lambda}`` at the distance ``s`` from the anode (-) or the cathode (+)
+    face.  The potential drop of a layer is ``-ln u_f`` (anode) and ``ln u_c`` (cathode), with
+    ``u_c = 2 - u_f`` (the faces' charges opposite), so ``ln((2 - u_f)/u_f) = v`` (the bias in thermal
+    volts): ``u_f = 2/(1 + e^v)``.  ``u`` near the anode is formed from ``u_f`` and ``expm1``: its
+    relative accuracy holds where ``u ~ u_f ~ 2 e^{-v}`` (the BVP's spline of ``A0 C`` is accurate in
+    absolute terms only, 97 % off there at 1 V)."""
+    uf = 2.0 / (1.0 + math.exp(v)) if v < 700.0 else 2.0 * math.exp(-v)
+    a = 1.0 - uf
+
+    def profile(xi):
+        xi = np.asarray(xi, dtype=float)
+        an = xi <= 1.0
+        sa = np.where(an, xi, 1.0) / lam
+        sc = np.where(an, 1.0, 2.0 - xi) / lam
+        u = np.where(an, uf - a * np.expm1(-sa), 1.0 + a * np.exp(-sc))
+        D = np.where(an, lam * a * np.exp(-sa), lam * a * np.exp(-sc))
+        return u, D
+
+    return uf, profile
+
+
 def _static(strip: Strip, perm: Permittivity, material: Material, V: float):
-    """``(lambda^2, r0, x_mesh, profile)``: ``profile(x) -> (u, D_bar)`` of the static state at ``|V|``."""
+    """``(lambda^2, r0, lo, mesh, profile)``: ``profile(x) -> (u, D_bar)`` of the static state at ``|V|``
+    on ``[lo, lo + 2]`` (the anode face at ``lo``).  ``lo = -1`` (``x = z/e``), but ``lo = 0`` for the
+    linear model's closed form (the distance from the anode face): its anode layer's scale
+    (``~2 e^{-v} lambda``, 1e-19 at 1 V) is far below the resolution of ``x`` near -1."""
     lam = float(groups.debye_length(strip.thickness, perm.eps_moy, material))
     r0 = perm.eps0 / perm.eps_moy
     if V == 0.0:
-        return lam * lam, r0, np.array([-1.0, 1.0]), lambda x: (np.ones_like(x), np.zeros_like(x))
+        return lam * lam, r0, -1.0, np.array([-1.0, 1.0]), lambda x: (np.ones_like(x), np.zeros_like(x))
+    lam2 = lam * lam
+    v = abs(V) * groups.inverse_thermal_voltage(material)
+    if r0 == 0.0 and lam <= CLOSED_FORM_LAYERS and 2.0 * math.exp(-v) < CLOSED_FORM_BELOW:
+        uf, profile = _linear_profile(lam, v)
+        if uf < 1e-57:  # the anode layer below the mesh's floor (_face_mesh): refused before any solve
+            raise RuntimeError(f"bias reference at {V:g} V ({perm.name} model): the depleted anode's concentration "
+                               f"({uf:.2g} of C_moy) is below what the mesh resolves; no reference at this bias")
+        # each layer graded from its face (the anode's scale u_f lambda: u = u_f + xi/lambda there), then
+        # lambda/40 through the layer's 40 lambda (e^{-40}: the static layer's tail below 1e-17)
+        body = lam + np.arange(1, 1601) * (lam / 40.0)
+        xs = np.concatenate([_face_mesh(1e-3 * uf * lam, lam), body, 2.0 - _face_mesh(1e-3 * lam, lam), 2.0 - body])
+        return lam2, r0, 0.0, xs, profile
     st = Strip(thickness=strip.thickness, width=strip.width, length=strip.length, voltage=abs(V))
     r = solve_static(st, perm, material)
     if not r.success or r.sol is None:
@@ -111,12 +163,11 @@ def _static(strip: Strip, perm: Permittivity, material: Material, V: float):
         return u, D
 
     # the static layers' scale at each face, lambda^2 eps_hat/|D_bar| (u'/u = D_bar/(lambda^2 eps_hat))
-    lam2 = lam * lam
     uf, Df = profile(np.array([-1.0, 1.0]))
     face = lam2 * (r0 + (1.0 - r0) * uf) / np.maximum(np.abs(Df), 1e-300)
     xs = np.concatenate([np.asarray(r.z, dtype=float), -1.0 + _face_mesh(1e-3 * face[0], lam),
                          1.0 - _face_mesh(1e-3 * face[1], lam)])
-    return lam2, r0, xs, profile
+    return lam2, r0, -1.0, xs, profile
 
 
 def _face_mesh(h0: float, ell: float) -> np.ndarray:
@@ -124,7 +175,9 @@ def _face_mesh(h0: float, ell: float) -> np.ndarray:
     scale ``lambda^2 eps_hat/|D_bar|`` at the face, ``u``'s logarithmic length; the linear model's
     ``u`` falls to ``~e^{-A2}`` there and ``psi'`` follows ``1/u``)."""
     steps = []
-    h, s = max(h0, 1e-20 * ell), 0.0  # an underflowed face concentration: the grading stops at 1e-20
+    # an underflowed face concentration: the grading stops at 1e-60 of ell (the static limit's check
+    # against the exact capacitance then refuses what this leaves unresolved)
+    h, s = max(h0, 1e-60 * ell), 0.0
     while s < ell:
         steps.append(s)
         s += h
@@ -132,8 +185,8 @@ def _face_mesh(h0: float, ell: float) -> np.ndarray:
     return np.array(steps)
 
 
-def _graded_mesh(ell: float, extra: np.ndarray, refine: int = 1) -> np.ndarray:
-    """Mesh of ``[-1, 1]``: spacing ``1e-3 ell`` at each face growing by 8 % a node up to ``ell``,
+def _graded_mesh(ell: float, extra: np.ndarray, refine: int = 1, lo: float = -1.0) -> np.ndarray:
+    """Mesh of ``[lo, lo + 2]`` (``lo``: see :func:`_static`): spacing ``1e-3 ell`` at each face growing by 8 % a node up to ``ell``,
     merged with ``extra`` (the static solver's mesh, which resolves the static layers); each
     interval then split in ``refine``.
 
@@ -149,9 +202,10 @@ def _graded_mesh(ell: float, extra: np.ndarray, refine: int = 1) -> np.ndarray:
         s += h
         h = min(1.08 * h, ell)
     half = np.array(steps)
-    x = np.unique(np.concatenate([-1.0 + half, 1.0 - half, [-1.0, 1.0], np.clip(extra, -1.0, 1.0)]))
-    # drop points closer than 1e-16 (rounding duplicates of the merge)
-    x = x[np.concatenate([[True], np.diff(x) > 1e-16])]
+    hi = lo + 2.0
+    x = np.unique(np.concatenate([lo + half, hi - half, [lo, hi], np.clip(extra, lo, hi)]))
+    # drop points closer than 1e-16, or a few units of the last place near 0 (rounding duplicates of the merge)
+    x = x[np.concatenate([[True], np.diff(x) > np.minimum(1e-16, 4.0 * np.spacing(x[1:]))])]
     if refine > 1:
         t = np.arange(refine) / refine
         x = np.concatenate([(x[:-1, None] + np.diff(x)[:, None] * t[None, :]).ravel(), x[-1:]])
@@ -201,7 +255,7 @@ def _solve(x, u, D, lam2, r0, W):
     return y[3]
 
 
-def _check_static_limit(s, perm, m, V, xs, profile, lam, lam2, r0, sig_scale):
+def _check_static_limit(s, perm, m, V, lo, xs, profile, lam, lam2, r0, sig_scale):
     """Refuse (``RuntimeError``) unless the charge per volt at ``W = 1e-8`` equals the exact static
     differential capacitance ``dsigma/dphi0`` (:func:`ipmc_asym.integral.charge.charge`, rung
     ``exact``) within its stated error plus the frequency's own effect ``2 W lambda`` (``omega tau``);
@@ -211,8 +265,8 @@ def _check_static_limit(s, perm, m, V, xs, profile, lam, lam2, r0, sig_scale):
     concentration falls to ``~B1 e^{-A2}`` at the anode, where the static solver's spline of
     ``A0 C`` has absolute, not relative, accuracy (measured: 97 % off at 1 V, 20 um)."""
     W0 = 1e-8
-    x1 = _graded_mesh(lam, xs)
-    x2 = _graded_mesh(lam, xs, refine=2)
+    x1 = _graded_mesh(lam, xs, lo=lo)
+    x2 = _graded_mesh(lam, xs, refine=2, lo=lo)
     p1, p2 = profile(x1), profile(x2)
     if np.any(p2[0] <= 0.0) or not np.all(np.isfinite(p2[0])):
         raise RuntimeError(f"bias reference at {V:g} V ({perm.name} model): the static concentration is not "
@@ -267,7 +321,7 @@ def bias_reference(f, voltage, strip: Strip | None = None, model="constant",
     if not np.all(np.isfinite(f)) or np.any(f <= 0):
         raise ValueError("frequencies must be finite and > 0 Hz")
     e = s.e
-    lam2, r0, xs, profile = _static(s, perm, m, V)
+    lam2, r0, lo, xs, profile = _static(s, perm, m, V)
     W = 2.0 * math.pi * f * e * e / m.D
     kappa = float(groups.kappa(m))
     # sigma per volt from d(-1) per thermal volt: phi4 F C_moy e (F/(R T))
@@ -282,7 +336,7 @@ def bias_reference(f, voltage, strip: Strip | None = None, model="constant",
     def level(q, ell_q, r):
         """The mesh of the layer scale ``ell_q`` with each interval split in ``r`` (and its static profile)."""
         if (q, r) not in meshes:
-            x = _graded_mesh(ell_q, xs, refine=r)
+            x = _graded_mesh(ell_q, xs, refine=r, lo=lo)
             meshes[q, r] = (x, profile(x))
         return meshes[q, r]
 
@@ -314,7 +368,7 @@ def bias_reference(f, voltage, strip: Strip | None = None, model="constant",
         ct[i] = sig_scale * d
         err[i] = 2.0 * abs(d2 - d1) / abs(d) + ROUNDING + (10.0 * BVP_STATED_ERROR if V != 0.0 else 0.0)
     if V != 0.0:
-        Cd, miss = _check_static_limit(s, perm, m, V, xs, profile, lam, lam2, r0, sig_scale)
+        Cd, miss = _check_static_limit(s, perm, m, V, lo, xs, profile, lam, lam2, r0, sig_scale)
         # the static state's own error reaches every frequency; its effect is measured at the low-frequency
         # end only (the linear model's depleted anode: 1.9e-4 at 0.7 V, 1 mm, against a mesh estimate of
         # 7e-5 there): the measured miss is added to every frequency's error

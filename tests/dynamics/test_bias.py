@@ -68,17 +68,74 @@ def test_linear_model_depleted_anode(th, V, monkeypatch):
         return
     mesh = B._graded_mesh
     monkeypatch.setattr(B, "MAX_NODES", 10**7)
-    monkeypatch.setattr(B, "_graded_mesh", lambda ell, extra, refine=1: mesh(ell, extra, 4 * refine))
+    monkeypatch.setattr(B, "_graded_mesh", lambda ell, extra, refine=1, lo=-1.0: mesh(ell, extra, 4 * refine, lo))
     fine = bias_reference(f, V, s, "linear")
     actual = np.abs(r.Z_area / fine.Z_area - 1.0)
     assert np.all(actual <= r.error)
 
 
 def test_reference_refuses_where_the_static_state_is_not_resolved():
-    """The linear model at 1 V (dsigma/dphi0 ~ 6e-14 F/m^2): the static limit misses dsigma/dphi0,
-    and the reference refuses in one line rather than state a bound."""
+    """The linear model at 1 V on a 20 um strip (its layers too close for the closed-form static
+    state; the BVP's spline of ``A0 C`` is 97 % off at the anode): the static limit misses
+    dsigma/dphi0 and the reference refuses in one line rather than state a bound; on a thick strip
+    past 3.4 V (the anode at ~1e-59 of C_moy) it refuses before any solve."""
     with pytest.raises(RuntimeError, match="differential capacitance|not resolved"):
-        bias_reference([1.0], 1.0, Strip(thickness=200e-6), "linear")
+        bias_reference([1.0], 1.0, Strip(thickness=20e-6), "linear")
+    with pytest.raises(RuntimeError, match="below what the mesh resolves"):
+        bias_reference([1.0], 3.5, Strip(thickness=200e-6), "linear")
+
+
+def test_linear_closed_form_static_state_is_the_bvp():
+    """The linear model's static state in closed form (``u = 1 -+ (1 - u_f) e^{-s/lambda}``,
+    ``u_f = 2/(1 + e^v)``) against the BVP's profiles at 0.3 V, where the BVP's anode is still
+    resolved (u_f = 1.8e-5): u and D_bar agree across the thickness to the BVP's accuracy."""
+    from ipmc_asym.bvp.solver import solve
+    from ipmc_asym.model import groups
+    from ipmc_asym.model.params import NAFION_LI
+    from ipmc_asym.model.permittivity import get_model
+
+    s = Strip(thickness=200e-6, voltage=0.3)
+    perm = get_model("linear")
+    lam = float(groups.debye_length(s.thickness, perm.eps_moy, NAFION_LI))
+    uf, prof = B._linear_profile(lam, 0.3 * groups.inverse_thermal_voltage(NAFION_LI))
+    r = solve(s, perm, NAFION_LI)
+    x = np.concatenate([[-1.0], -1.0 + np.geomspace(1e-6, 1.0, 200), 1.0 - np.geomspace(1e-6, 1.0, 200)])
+    sb, Db = r.sol(x)[:2]
+    u, D = prof(x + 1.0)
+    assert np.max(np.abs(u - sb / float(r.groups.A0))) < 1e-8
+    assert np.max(np.abs(D - Db)) < 1e-8 * lam
+    assert abs(u[0] / uf - 1.0) < 1e-2  # the face value (the BVP's relative accuracy at 1e-5)
+
+
+def test_linear_closed_form_reference_is_the_bvp_reference(monkeypatch):
+    """At 0.5 V both static states serve: the reference on the closed form (used from ~0.6 V) and on the
+    BVP agree within the sum of their stated errors."""
+    f = np.array([1e-3, 1.0, 1e2, 1e4])
+    s = Strip(thickness=200e-6)
+    b = bias_reference(f, 0.5, s, "linear")
+    monkeypatch.setattr(B, "CLOSED_FORM_BELOW", 1.0)  # the closed form at any bias
+    a = bias_reference(f, 0.5, s, "linear")
+    assert not np.array_equal(a.Z_area, b.Z_area)  # two computations
+    assert np.all(np.abs(a.Z_area / b.Z_area - 1.0) <= a.error + b.error)
+
+
+@pytest.mark.parametrize("th", [200e-6, 1e-3])
+@pytest.mark.parametrize("V", [1.0, -2.0])
+def test_linear_model_past_the_depletion(th, V, monkeypatch):
+    """The linear model at 1-2 V (dsigma/dphi0 6e-14 and 1e-30 F/m^2, the anode at 3e-17 and 1e-34 of
+    C_moy): the low-frequency limit is the exact static differential capacitance within the stated
+    error, and the stated error bounds the reference on meshes split 4 times finer."""
+    s = Strip(thickness=th)
+    f = np.array([1e-7, 1e-1, 1e2])
+    r = bias_reference(f, V, s, "linear")
+    Cd = float(ia.charge(th, V, "linear", "exact").C_diff)
+    assert abs(r.charge_transfer[0] / Cd - 1.0) <= r.error[0]
+    assert r.error.max() <= B.BIAS_REFERENCE_CEILING
+    mesh = B._graded_mesh
+    monkeypatch.setattr(B, "MAX_NODES", 10**7)
+    monkeypatch.setattr(B, "_graded_mesh", lambda ell, extra, refine=1, lo=-1.0: mesh(ell, extra, 4 * refine, lo))
+    fine = bias_reference(f, V, s, "linear")
+    assert np.all(np.abs(r.Z_area / fine.Z_area - 1.0) <= r.error)
 
 
 def test_sign_of_the_bias_is_a_mirror_image():
@@ -112,7 +169,7 @@ def test_biased_circuit_error_bounds_a_finer_reference(th, model, V, monkeypatch
     ref = refs[0]
     mesh = B._graded_mesh
     monkeypatch.setattr(B, "MAX_NODES", 10**7)
-    monkeypatch.setattr(B, "_graded_mesh", lambda ell, extra, refine=1: mesh(ell, extra, 4 * refine))
+    monkeypatch.setattr(B, "_graded_mesh", lambda ell, extra, refine=1, lo=-1.0: mesh(ell, extra, 4 * refine, lo))
     fine = bias_reference(f, V, s, model)
     actual = np.abs(r.Z_area - fine.Z_area) / np.abs(fine.Z_area)
     assert np.all(actual <= r.error)
