@@ -51,7 +51,7 @@ def _steps():
         return run
 
     def per_point():
-        from ipmc_asym.forward.model import forward  # the options no public function exposes alone
+        from ipmc_asym.forward.model import forward  # deferred: heavy module, start-up (and options no public function has)
 
         # C_moy per point (eq. (17) over a sweep of materials) and the moment with the pressure term
         for fid in ("corrected", "quadrature"):
@@ -125,8 +125,8 @@ def run(args):
             fn()
             took[label] = time.perf_counter() - t0
     else:
-        import multiprocessing
-        from concurrent.futures import ProcessPoolExecutor
+        import multiprocessing  # deferred: only --jobs > 1 needs it
+        from concurrent.futures import ProcessPoolExecutor  # deferred: only --jobs > 1 needs it
 
         # fresh interpreters (spawn): no fork of a process that has loaded Numba's compiler
         with ProcessPoolExecutor(args.jobs, mp_context=multiprocessing.get_context("spawn")) as pool:
