@@ -50,19 +50,22 @@ def test_low_frequency_is_the_static_differential_capacitance(th, model, V):
     assert r.error[0] < 2e-5
 
 
-@pytest.mark.parametrize("th", [20e-6, 1e-3])
-@pytest.mark.parametrize("V", [0.3, -0.5, 0.7])
+# 1 and -2 V on the thick strips only: their static state is the closed form (the 20 um strip refuses
+# there, test_reference_refuses_where_the_static_state_is_not_resolved)
+@pytest.mark.parametrize("th,V", [(th, V) for th in (20e-6, 1e-3) for V in (0.3, -0.5, 0.7)]
+                         + [(th, V) for th in (200e-6, 1e-3) for V in (1.0, -2.0)])
 def test_linear_model_depleted_anode(th, V, monkeypatch):
-    """The linear model past 0.2 V (its anode depleted to ~B1 e^{-A2}, dsigma/dphi0 down to 7e-9 F/m^2 at
-    0.7 V): the low-frequency limit is the exact static differential capacitance within the stated
-    error, and (up to 0.5 V) the stated error bounds the reference on meshes split 4 times finer."""
+    """The linear model past 0.2 V (its anode depleted to ~2 e^{-v} of C_moy, dsigma/dphi0 down to 7e-9
+    F/m^2 at 0.7 V, 6e-14 at 1 V, 1e-30 at 2 V): the low-frequency limit is the exact static
+    differential capacitance within the stated error, and (up to 0.5 V, and on the closed-form static
+    state past ~0.6 V) the stated error bounds the reference on meshes split 4 times finer."""
     s = Strip(thickness=th)
     f = np.array([1e-7, 1e-1, 1e2])
     r = bias_reference(f, V, s, "linear")
     Cd = float(ia.charge(th, V, "linear", "exact").C_diff)
     assert abs(r.charge_transfer[0] / Cd - 1.0) <= r.error[0]
     assert r.error.max() <= B.BIAS_REFERENCE_CEILING
-    if abs(V) > 0.5:
+    if 0.5 < abs(V) < 0.8:
         # at 0.7 V, 1 mm the finer reference itself refuses: its mesh error (7e-5) falls below the
         # static state's (1.9e-4, the miss the low-frequency check measures and adds to the error)
         return
@@ -117,25 +120,6 @@ def test_linear_closed_form_reference_is_the_bvp_reference(monkeypatch):
     a = bias_reference(f, 0.5, s, "linear")
     assert not np.array_equal(a.Z_area, b.Z_area)  # two computations
     assert np.all(np.abs(a.Z_area / b.Z_area - 1.0) <= a.error + b.error)
-
-
-@pytest.mark.parametrize("th", [200e-6, 1e-3])
-@pytest.mark.parametrize("V", [1.0, -2.0])
-def test_linear_model_past_the_depletion(th, V, monkeypatch):
-    """The linear model at 1-2 V (dsigma/dphi0 6e-14 and 1e-30 F/m^2, the anode at 3e-17 and 1e-34 of
-    C_moy): the low-frequency limit is the exact static differential capacitance within the stated
-    error, and the stated error bounds the reference on meshes split 4 times finer."""
-    s = Strip(thickness=th)
-    f = np.array([1e-7, 1e-1, 1e2])
-    r = bias_reference(f, V, s, "linear")
-    Cd = float(ia.charge(th, V, "linear", "exact").C_diff)
-    assert abs(r.charge_transfer[0] / Cd - 1.0) <= r.error[0]
-    assert r.error.max() <= B.BIAS_REFERENCE_CEILING
-    mesh = B._graded_mesh
-    monkeypatch.setattr(B, "MAX_NODES", 10**7)
-    monkeypatch.setattr(B, "_graded_mesh", lambda ell, extra, refine=1, lo=-1.0: mesh(ell, extra, 4 * refine, lo))
-    fine = bias_reference(f, V, s, "linear")
-    assert np.all(np.abs(r.Z_area / fine.Z_area - 1.0) <= r.error)
 
 
 def test_sign_of_the_bias_is_a_mirror_image():
