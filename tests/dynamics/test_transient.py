@@ -497,3 +497,31 @@ def test_pnp_layer_voltage_stays_within_the_applied_hull():
     r = step_response(2.0, model="affine", points=21, fidelity="pnp")
     assert np.all(r.layer_voltage <= 2.0) and np.all(r.layer_voltage >= 0.0)
     assert r.layer_voltage[-1] == pytest.approx(2.0, rel=1e-5)
+
+
+def test_a_run_past_its_evaluation_cap_is_returned_unsuccessful():
+    """The time-error rerun of the ladder is capped (its step control can chase rounding on a settled
+    state); a capped run stops and says so instead of running on, and the same run uncapped succeeds."""
+    from ipmc_asym.dynamics.transient import _solve_once
+
+    kw = dict(cells_per_debye=4.0, ratio=1.08, h_core=0.02, refine=1.0, rtol=1e-8, atol=1e-12, method="BDF",
+              energy=False, profiles=False, moment=False)
+    t = np.array([0.0, TAU, 30 * TAU])
+    r = _solve_once(t, waveform("step", -0.1), S0, "constant", NAFION_LI, max_nfev=50, **kw)
+    assert not r.success and "more than 50" in r.message and np.all(np.isnan(r.sigma))
+    ok = _solve_once(t, waveform("step", -0.1), S0, "constant", NAFION_LI, **kw)
+    assert ok.success and ok.extra["nfev"] > 50
+
+
+@pytest.mark.slow  # ~5 s: two full ladders
+def test_negative_step_errors_mirror_the_positive_one():
+    """-0.1 V is the mirror image of +0.1 V: the charge, its stated error and the current's mirror
+    within the stated errors (the negative run's time-error rerun is capped, not left to stall)."""
+    t = np.array([0.0, TAU, 30 * TAU])
+    p = solve_transient(t, waveform("step", 0.1), S0, "constant", NAFION_LI)
+    n = solve_transient(t, waveform("step", -0.1), S0, "constant", NAFION_LI)
+    assert p.success and n.success
+    assert np.all(np.abs(p.sigma + n.sigma) <= p.sigma_error + n.sigma_error)
+    assert np.allclose(n.sigma_error, p.sigma_error, rtol=0.1)
+    j = slice(1, None)  # t = 0: the step's jump (withheld current)
+    assert np.all(np.abs(p.current_density[j] + n.current_density[j]) <= (p.current_error + n.current_error)[j])
