@@ -92,38 +92,38 @@ class BiasReference:
     C_diff: float = math.nan
 
 
-#: the linear model's closed-form static state is used where ``lambda`` is at most this
-#: (``e^{-1/lambda} <= 1e-11``, the overlap of the two layers' tails at the centre: the neutral core it
-#: assumes holds to that; 2e >= 24 um with the paper's set); the check of its static limit against the
-#: exact capacitance (:func:`_check_static_limit`) tests it at every bias
-CLOSED_FORM_LAYERS = 1.0 / (11.0 * math.log(10.0))
-#: ... and where its anode concentration ``u_f ~ 2 e^{-v}`` is below this (from ~0.6 V): above, the
-#: BVP's static state resolves the anode (to 0.7 V, measured) and serves every model alike
+#: the linear model's static state is taken in closed form where its anode concentration
+#: ``u_f = 2/(1 + e^v)`` is below this (from ~0.6 V): above, the BVP's static state resolves the anode
+#: (to 0.7 V, measured) and serves every model alike
 CLOSED_FORM_BELOW = 1e-10
 
 
 def _linear_profile(lam: float, v: float):
-    """The linear model's static state (``eps = alpha C``, ``r0 = 0``) about a neutral core, in closed
-    form, as ``profile(xi) -> (u, D_bar)`` at the distance ``xi = x + 1`` from the anode face.
+    """The linear model's static state (``eps = alpha C``, ``r0 = 0``) in closed form, as
+    ``profile(xi) -> (u, D_bar)`` at the distance ``xi = x + 1`` from the anode face; ``(u_f, profile)``.
 
-    With ``eps_hat = u`` the zero flux gives ``u' = D_bar/lambda^2`` and Gauss ``D_bar' = u - 1``, so
-    ``D_bar^2 - lambda^2 (u - 1)^2`` is constant, 0 in the neutral core: ``D_bar = lambda |1 - u|`` and
-    ``u = 1 -+ (1 - u_f) e^{-s/lambda}`` at the distance ``s`` from the anode (-) or the cathode (+)
-    face.  The potential drop of a layer is ``-ln u_f`` (anode) and ``ln u_c`` (cathode), with
-    ``u_c = 2 - u_f`` (the faces' charges opposite), so ``ln((2 - u_f)/u_f) = v`` (the bias in thermal
-    volts): ``u_f = 2/(1 + e^v)``.  ``u`` near the anode is formed from ``u_f`` and ``expm1``: its
-    relative accuracy holds where ``u ~ u_f ~ 2 e^{-v}`` (the BVP's spline of ``A0 C`` is accurate in
-    absolute terms only, 97 % off there at 1 V)."""
+    With ``eps_hat = u`` the zero flux gives ``u' = D_bar/lambda^2`` and Gauss ``D_bar' = u - 1``: the
+    problem is linear, ``u'' = (u - 1)/lambda^2``.  The zero flux makes ``u`` a Boltzmann factor of the
+    potential, so ``u(2)/u(0) = e^v`` (``v`` the bias in thermal volts), and the mirror symmetry of
+    the strip makes ``u - 1`` odd about the centre, ``u(2) = 2 - u_f``: ``u_f = 2/(1 + e^v)`` and::
+
+        u = u_f + (1 - u_f) (1 - e^{-xi/lambda} + e^{(xi - 2)/lambda} - e^{-2/lambda})/(1 - e^{-2/lambda})
+        D_bar = lambda (1 - u_f) (e^{-xi/lambda} + e^{(xi - 2)/lambda})/(1 - e^{-2/lambda})
+
+    at any thickness (a thick strip's neutral core is the limit ``e^{-2/lambda} -> 0``).  ``u`` near the
+    anode is formed from ``u_f`` and ``expm1``: relative accuracy where ``u ~ u_f ~ 2 e^{-v}`` (the
+    BVP's spline of ``A0 C`` is accurate in absolute terms only, 97 % off there at 1 V, 20 um)."""
     uf = 2.0 / (1.0 + math.exp(v)) if v < 700.0 else 2.0 * math.exp(-v)
     a = 1.0 - uf
+    q = math.exp(-2.0 / lam)
+    den = -math.expm1(-2.0 / lam)  # 1 - e^{-2/lambda}
 
     def profile(xi):
         xi = np.asarray(xi, dtype=float)
-        an = xi <= 1.0
-        sa = np.where(an, xi, 1.0) / lam
-        sc = np.where(an, 1.0, 2.0 - xi) / lam
-        u = np.where(an, uf - a * np.expm1(-sa), 1.0 + a * np.exp(-sc))
-        D = np.where(an, lam * a * np.exp(-sa), lam * a * np.exp(-sc))
+        near = -np.expm1(-xi / lam)  # 1 - e^{-xi/lambda}
+        far = np.exp((xi - 2.0) / lam)  # the cathode layer's e^{(xi - 2)/lambda}
+        u = uf + a * (near + (far - q)) / den
+        D = lam * a * (np.exp(-xi / lam) + far) / den
         return u, D
 
     return uf, profile
@@ -140,7 +140,7 @@ def _static(strip: Strip, perm: Permittivity, material: Material, V: float):
         return lam * lam, r0, -1.0, np.array([-1.0, 1.0]), lambda x: (np.ones_like(x), np.zeros_like(x))
     lam2 = lam * lam
     v = abs(V) * groups.inverse_thermal_voltage(material)
-    if r0 == 0.0 and lam <= CLOSED_FORM_LAYERS and 2.0 * math.exp(-v) < CLOSED_FORM_BELOW:
+    if r0 == 0.0 and 2.0 / (1.0 + math.exp(min(v, 700.0))) < CLOSED_FORM_BELOW:
         uf, profile = _linear_profile(lam, v)
         if uf < 1e-57:  # the anode layer below the mesh's floor (_face_mesh): refused before any solve
             raise RuntimeError(f"bias reference at {V:g} V ({perm.name} model): the depleted anode's concentration "
@@ -148,6 +148,7 @@ def _static(strip: Strip, perm: Permittivity, material: Material, V: float):
         # each layer graded from its face (the anode's scale u_f lambda: u = u_f + xi/lambda there), then
         # lambda/40 through the layer's 40 lambda (e^{-40}: the static layer's tail below 1e-17)
         body = lam + np.arange(1, 1601) * (lam / 40.0)
+        body = body[body < 2.0]  # a thin strip: to the other face
         xs = np.concatenate([_face_mesh(1e-3 * uf * lam, lam), body, 2.0 - _face_mesh(1e-3 * lam, lam), 2.0 - body])
         return lam2, r0, 0.0, xs, profile
     st = Strip(thickness=strip.thickness, width=strip.width, length=strip.length, voltage=abs(V))

@@ -50,10 +50,10 @@ def test_low_frequency_is_the_static_differential_capacitance(th, model, V):
     assert r.error[0] < 2e-5
 
 
-# 1 and -2 V on the thick strips only: their static state is the closed form (the 20 um strip refuses
-# there, test_reference_refuses_where_the_static_state_is_not_resolved)
+# past ~0.6 V the static state is the closed form (the 1 um strip refuses at 1 V,
+# test_reference_refuses_where_the_static_state_is_not_resolved)
 @pytest.mark.parametrize("th,V", [(th, V) for th in (20e-6, 1e-3) for V in (0.3, -0.5, 0.7)]
-                         + [(th, V) for th in (200e-6, 1e-3) for V in (1.0, -2.0)])
+                         + [(th, V) for th in (5e-6, 20e-6, 1e-3) for V in (1.0, -2.0)])
 def test_linear_model_depleted_anode(th, V, monkeypatch):
     """The linear model past 0.2 V (its anode depleted to ~2 e^{-v} of C_moy, dsigma/dphi0 down to 7e-9
     F/m^2 at 0.7 V, 6e-14 at 1 V, 1e-30 at 2 V): the low-frequency limit is the exact static
@@ -78,36 +78,41 @@ def test_linear_model_depleted_anode(th, V, monkeypatch):
 
 
 def test_reference_refuses_where_the_static_state_is_not_resolved():
-    """The linear model at 1 V on a 20 um strip (its layers too close for the closed-form static
-    state; the BVP's spline of ``A0 C`` is 97 % off at the anode): the static limit misses
-    dsigma/dphi0 and the reference refuses in one line rather than state a bound; on a thick strip
-    past 3.4 V (the anode at ~1e-59 of C_moy) it refuses before any solve."""
+    """Where the linearised solve cannot resolve the depleted anode (the linear model at 1 V on a
+    1 um strip, its layers filling the strip) the static limit misses dsigma/dphi0 and the reference
+    refuses in one line rather than state a bound; past 3.4 V (the anode at ~1e-59 of C_moy) it
+    refuses before any solve."""
     with pytest.raises(RuntimeError, match="differential capacitance|not resolved"):
-        bias_reference([1.0], 1.0, Strip(thickness=20e-6), "linear")
+        bias_reference([1.0], 1.0, Strip(thickness=1e-6), "linear")
     with pytest.raises(RuntimeError, match="below what the mesh resolves"):
         bias_reference([1.0], 3.5, Strip(thickness=200e-6), "linear")
 
 
-def test_linear_closed_form_static_state_is_the_bvp():
-    """The linear model's static state in closed form (``u = 1 -+ (1 - u_f) e^{-s/lambda}``,
-    ``u_f = 2/(1 + e^v)``) against the BVP's profiles at 0.3 V, where the BVP's anode is still
-    resolved (u_f = 1.8e-5): u and D_bar agree across the thickness to the BVP's accuracy."""
+@pytest.mark.parametrize("th", [1e-6, 5e-6, 20e-6, 200e-6])
+def test_linear_closed_form_static_state_is_the_bvp(th):
+    """The linear model's static state in closed form (``u'' = (u - 1)/lambda^2``, ``u_f = 2/(1 + e^v)``)
+    against the BVP's profiles at 0.3 V, where the BVP's anode is still resolved (u_f = 1.8e-5): u and
+    D_bar agree across the thickness to the BVP's accuracy, from layers filling the strip (1 um) to a
+    neutral core (200 um); its face induction is the exact rung's charge at 0.3 and 2 V."""
     from ipmc_asym.bvp.solver import solve
     from ipmc_asym.model import groups
-    from ipmc_asym.model.params import NAFION_LI
+    from ipmc_asym.model.params import NAFION_LI as m
     from ipmc_asym.model.permittivity import get_model
 
-    s = Strip(thickness=200e-6, voltage=0.3)
+    s = Strip(thickness=th, voltage=0.3)
     perm = get_model("linear")
-    lam = float(groups.debye_length(s.thickness, perm.eps_moy, NAFION_LI))
-    uf, prof = B._linear_profile(lam, 0.3 * groups.inverse_thermal_voltage(NAFION_LI))
-    r = solve(s, perm, NAFION_LI)
+    lam = float(groups.debye_length(s.thickness, perm.eps_moy, m))
+    _, prof = B._linear_profile(lam, 0.3 * groups.inverse_thermal_voltage(m))
+    r = solve(s, perm, m)
     x = np.concatenate([[-1.0], -1.0 + np.geomspace(1e-6, 1.0, 200), 1.0 - np.geomspace(1e-6, 1.0, 200)])
     sb, Db = r.sol(x)[:2]
     u, D = prof(x + 1.0)
-    assert np.max(np.abs(u - sb / float(r.groups.A0))) < 1e-8
-    assert np.max(np.abs(D - Db)) < 1e-8 * lam
-    assert abs(u[0] / uf - 1.0) < 1e-2  # the face value (the BVP's relative accuracy at 1e-5)
+    assert np.max(np.abs(u - sb / float(r.groups.A0))) < 1e-9
+    assert np.max(np.abs(D - Db)) < 1e-9 * lam
+    for V in (0.3, 2.0):
+        _, prof = B._linear_profile(lam, V * groups.inverse_thermal_voltage(m))
+        sigma = m.phi4 * m.F * m.C_moy * 0.5 * th * float(prof(np.array([0.0]))[1][0])
+        assert sigma == pytest.approx(float(ia.charge(th, V, "linear", "exact").sigma), rel=1e-13)
 
 
 def test_linear_closed_form_reference_is_the_bvp_reference(monkeypatch):
