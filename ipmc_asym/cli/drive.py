@@ -132,14 +132,14 @@ def run(args):
     info = resp.info
     columns = COLUMNS + (LINE_COLUMNS if args.sheet_resistance > 0.0 else ()) + (CLAMPED_COLUMNS if clamped else ()) + (
         ERROR_COLUMNS if stated else ())
-    what = "electrode line" if args.sheet_resistance > 0.0 else "circuit against the PNP, or the PNP's own"
+    source = "electrode line" if args.sheet_resistance > 0.0 else "circuit against the PNP, or the PNP's own"
     head = dict(info, waveform=args.waveform.spec, duration=args.duration, points=args.points,
                 thickness_total=strip.thickness, half_thickness_e=strip.e, diffusion_coefficient=material.D,
                 units={"t": "s", "phi0": "V", "sigma": "C/m^2 (face z = -e)", "current_density": "A/m^2",
                        "layer_voltage": "V", "M_A": "N m", "theta": "rad (free tip)", "w": "m (free tip)",
-                       "F_block": "N (blocked tip)", "sigma_error": f"C/m^2 ({what}, stated)",
-                       "w_error": f"m ({what}, stated)",
-                       **({"current_error": f"A/m^2 ({what}, stated)"} if stated else {}),
+                       "F_block": "N (blocked tip)", "sigma_error": f"C/m^2 ({source}, stated)",
+                       "w_error": f"m ({source}, stated)",
+                       **({"current_error": f"A/m^2 ({source}, stated)"} if stated else {}),
                        **(CLAMPED_UNITS if clamped else {})})
     gen = resp.iter_chunks()
     shown_cols = DRIVE_COLUMNS + (CLAMPED_COLUMNS if clamped else ()) + (ERROR_COLUMNS if stated else ())

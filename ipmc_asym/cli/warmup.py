@@ -43,12 +43,10 @@ def _steps():
     th = np.geomspace(20e-6, 2e-3, 64)  # enough points to run the compiled drivers, not their interpreted twins
     models = ("constant", "linear", "affine")
 
-    def closed(fids):
-        def run():
-            for m in models:
-                for fid in fids:
-                    ia.moment_integral(th, 1.0, model=m, fidelity=fid, on_invalid="nan")
-        return run
+    def closed():
+        for m in models:
+            for fid in ("leading", "corrected", "quadrature", "exact"):
+                ia.moment_integral(th, 1.0, model=m, fidelity=fid, on_invalid="nan")
 
     def per_point():
         from ipmc_asym.forward.model import forward  # deferred: heavy module, start-up (and options no public function has)
@@ -89,8 +87,7 @@ def _steps():
     # the longest first, so that --jobs balances them by taking the next group as a process frees
     # (measured cold, one process: the moment integral ~50 s, per point ~23 s, charge ~15 s, CSV ~12 s,
     # the rest ~2 s: they load what the first groups compiled)
-    return [("moment integral: leading, corrected, quadrature, exact x 3 models",
-             closed(("leading", "corrected", "quadrature", "exact"))),
+    return [("moment integral: leading, corrected, quadrature, exact x 3 models", closed),
             ("moment with C_moy per point and the pressure term", per_point),
             ("electrode charge", charge),
             ("sweep written to CSV (compiled formatter)", sweep_csv),

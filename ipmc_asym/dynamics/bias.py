@@ -140,8 +140,8 @@ def _static(strip: Strip, perm: Permittivity, material: Material, V: float):
         return lam * lam, r0, -1.0, np.array([-1.0, 1.0]), lambda x: (np.ones_like(x), np.zeros_like(x))
     lam2 = lam * lam
     v = abs(V) * groups.inverse_thermal_voltage(material)
-    if r0 == 0.0 and 2.0 / (1.0 + math.exp(min(v, 700.0))) < CLOSED_FORM_BELOW:
-        uf, profile = _linear_profile(lam, v)
+    uf, profile = _linear_profile(lam, v) if r0 == 0.0 else (1.0, None)
+    if uf < CLOSED_FORM_BELOW:
         if uf < 1e-57:  # the anode layer below the mesh's floor (_face_mesh): refused before any solve
             raise RuntimeError(f"bias reference at {V:g} V ({perm.name} model): the depleted anode's concentration "
                                f"({uf:.2g} of C_moy) is below what the mesh resolves; no reference at this bias")

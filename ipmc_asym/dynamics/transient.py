@@ -1012,23 +1012,19 @@ def _solve_once(t, phi0_fun, strip, model, material, *, cells_per_debye, ratio, 
             try:
                 sol = solve_ivp(rhs, (0.0, tt[-1] / tscale), y0, method=meth, t_eval=tt / tscale, rtol=rtol,
                                 atol=at, dense_output=False)
+                failed = None
+                if sol.success and sol.y.shape[1] == tt.size and not np.all(np.isfinite(sol.y[: P.N - 1])):
+                    failed = "the integration returned a non-finite state"
+                elif not sol.success or sol.y.shape[1] != tt.size:
+                    failed = str(sol.message)
             except _TooManyEvaluations:
-                sol = None
+                failed = f"more than {max_nfev} right-hand-side evaluations (the cap of this run)"
     secs = time.perf_counter() - t0
-    if sol is None:
-        nan = np.full(tt.size, np.nan)
-        return TransientResult(t=tt, sigma=nan, current_density=nan.copy(), layer_voltage=nan.copy(),
-                               M_A_profiles=nan.copy(), total_charge=nan.copy(), c=np.empty((0, P.N)), x=P.xc,
-                               faces=P.X, success=False,
-                               message=f"more than {max_nfev} right-hand-side evaluations (the cap of this run)",
-                               extra={"cells": P.N, "seconds": secs})
-    if sol.success and sol.y.shape[1] == tt.size and not np.all(np.isfinite(sol.y[: P.N - 1])):
-        sol.success, sol.message = False, "the integration returned a non-finite state"
-    if not sol.success or sol.y.shape[1] != tt.size:
+    if failed is not None:
         return TransientResult(t=tt, sigma=np.full(tt.size, np.nan), current_density=np.full(tt.size, np.nan),
                                layer_voltage=np.full(tt.size, np.nan),
                                M_A_profiles=np.full(tt.size, np.nan), total_charge=np.full(tt.size, np.nan),
-                               c=np.empty((0, P.N)), x=P.xc, faces=P.X, success=False, message=str(sol.message),
+                               c=np.empty((0, P.N)), x=P.xc, faces=P.X, success=False, message=failed,
                                extra={"cells": P.N, "seconds": secs})
     sig_scale = e * m.phi4 * m.F * m.C_moy
     nt = tt.size
