@@ -237,7 +237,21 @@ def small_u(order: int):
     q_ser = sum((-2 * u) ** k / sp.factorial(k) for k in range(n))  # Q = e^{-2u}
 
     def trunc(ex):
-        p = sp.Poly(sp.expand(ex.subs(Qs, q_ser)), u)
+        # ex(Q = q_ser) by Horner's rule in Q on polynomials cut at u^n after every product: the
+        # same coefficients as expanding the substitution, without the terms of degree >= n in u
+        # that the full expansion builds and drops (25x faster at order 2)
+        gens = (u,) + tuple(sorted(ex.free_symbols - {u, Qs}, key=str))
+        q = sp.Poly(q_ser, *gens)
+
+        def cut(p):
+            if p.degree(u) < n:
+                return p
+            return sp.Poly.from_dict({m: c for m, c in p.as_dict().items() if m[0] < n}, *gens, domain=p.domain)
+
+        r = sp.Poly(0, *gens)
+        for c in sp.Poly(ex, Qs).all_coeffs():  # highest power of Q first
+            r = cut(r * q + sp.Poly(c, *gens))
+        p = sp.Poly(r.as_expr(), u)
         return [p.coeff_monomial(u**k) for k in range(n)]
 
     a, b = trunc(num), trunc(den)

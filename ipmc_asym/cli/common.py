@@ -34,7 +34,8 @@ __all__ = ["UsageError", "Parser", "add_strip_options", "add_material_options", 
            "scene_with_material",
            "material_from_args", "strip_from_args", "strip_and_material",
            "arg_type", "count_type", "join_negative_values", "fmt_num", "c_moy_label", "length_type", "pressure_type",
-           "voltage_type", "tol_type", "first_run_notice", "diffusion_type", "sidecar_path", "add_size_option", "check_size_caps",
+           "voltage_type", "tol_type", "time_tol_type",
+           "first_run_notice", "diffusion_type", "sidecar_path", "add_size_option", "check_size_caps",
            "add_output_option", "check_outputs",
            "seed_type", "model_help", "viscous_modulus_type", "duration_type", "waveform_type", "sheet_resistance_type",
            "frequency_type", "add_beam_options", "SOLVER_ALIASES", "add_solver_option", "add_line_options",
@@ -161,6 +162,25 @@ def _tol(text):
 
 
 tol_type = arg_type(_tol, "tol")
+
+
+def _time_tol(text):
+    """``tol_type``, or ``auto`` (kept as the string: the library resolves it) or ``none`` (None)."""
+    t = str(text).strip().lower()
+    if t == "none":
+        return None
+    if t == "auto":
+        return "auto"
+    try:
+        return _tol(text)
+    except ValueError:
+        raise ValueError(f"--tol must be auto, none or a relative tolerance in (0, 1), e.g. 0.01 or 1%; "
+                         f"got {text!r}") from None
+
+
+#: ``--tol`` of the time responses (step, drive): a tolerance, ``auto`` (the errors stated where they can
+#: be, :func:`ipmc_asym.dynamics.entry.stated_tol`) or ``none`` (the bare circuit)
+time_tol_type = arg_type(_time_tol, "tol")
 
 
 def count_type(name, minimum=1):

@@ -27,7 +27,7 @@ from ipmc_asym.cli.common import (  # noqa: F401  (CLAMPED_UNITS, viscous_modulu
     sidecar_path,
     strip_and_material,
     support_from_args,
-    tol_type,
+    time_tol_type,
     viscous_modulus_type,
     waveform_type,
 )
@@ -40,7 +40,7 @@ from ipmc_asym.dynamics.drive import (
     MAX_DRIVE_POINTS,
     MAX_STATED_POINTS,
 )
-from ipmc_asym.dynamics.entry import ERROR_COLUMNS, time_path, time_response
+from ipmc_asym.dynamics.entry import ERROR_COLUMNS, stated_tol, time_path, time_response
 from ipmc_asym.io.fileio import atomic_path, atomic_write, check_output_path
 from ipmc_asym.io.textfmt import format_table
 
@@ -63,11 +63,13 @@ def register(sub):
     add_solver_option(p, "drive", dest="fidelity", default="circuit", choices=STEP_FIDELITIES,
                       help="circuit (reduced nonlinear capacitor, stepped chunk by chunk) or pnp (transient "
                            "Nernst-Planck/Gauss, in memory, at most %d points; its errors stated)" % MAX_STATED_POINTS)
-    p.add_argument("--tol", type=tol_type, default=None,
+    p.add_argument("--tol", type=time_tol_type, default=None,
                    help="relative accuracy required of sigma at every output time, e.g. 1e-2 or 1%% (in [1e-8, 0.5)): "
                         "the circuit's error is bounded against a PNP run over the same waveform and the PNP is used "
                         "where it fails, as in step; adds the columns " + ", ".join(ERROR_COLUMNS) + " (in memory, at "
-                        f"most {MAX_STATED_POINTS} points; default: no error stated for the circuit)")
+                        f"most {MAX_STATED_POINTS} points); auto: 1e-2 where the error can be stated (as step's default); "
+                        "default none: no error stated for the circuit (a long waveform's reference PNP run takes "
+                        "10-30 s CPU per 2 s of a 1-10 Hz drive)")
     add_beam_options(p)
     add_line_options(p)
     add_support_options(p)
@@ -103,6 +105,10 @@ def run(args):
         raise ValueError(f"--points must be at most {MAX_DRIVE_POINTS:g}; got {args.points}")
     if args.json and args.points > MAX_JSON_POINTS:
         raise ValueError(f"--json holds every row in memory: --points at most {MAX_JSON_POINTS:g} (use --out F.csv)")
+    support, electrode = support_from_args(args)
+    # --tol auto: the library's rule (dynamics.entry.stated_tol), its reason said where it states none
+    args.tol, why = stated_tol(args.tol, fidelity=args.fidelity, points=args.points,
+                               sheet_resistance=args.sheet_resistance, support=support, electrode=electrode)
     stated = args.tol is not None or args.fidelity == "pnp"
     if stated and args.points > MAX_STATED_POINTS:
         raise ValueError(f"--points with --tol or --solver pnp (solved in memory, the PNP's profiles at every output "
@@ -110,7 +116,6 @@ def run(args):
     if args.out:
         check_output_path(args.out, "file", formats=(".csv",))
         check_output_path(sidecar_path(args.out), "file")
-    support, electrode = support_from_args(args)
     # the choice's refusals first (a tolerance with the electrode line or a support), before any work
     time_path(fidelity=args.fidelity, tol=args.tol, beam=args.beam, sheet_resistance=args.sheet_resistance,
               support=support, electrode=electrode, stream=True, beam_grid="output")
@@ -130,6 +135,8 @@ def run(args):
                          line_segments=args.line_segments, support=support, electrode=electrode, stream=True,
                          beam_grid="output")
     info = resp.info
+    if why is not None:
+        info["notes"].append(why)
     columns = COLUMNS + (LINE_COLUMNS if args.sheet_resistance > 0.0 else ()) + (CLAMPED_COLUMNS if clamped else ()) + (
         ERROR_COLUMNS if stated else ())
     source = "electrode line" if args.sheet_resistance > 0.0 else "circuit against the PNP, or the PNP's own"

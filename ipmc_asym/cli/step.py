@@ -27,7 +27,7 @@ from ipmc_asym.cli.common import (
     model_help,
     sidecar_path,
     strip_and_material,
-    tol_type,
+    time_tol_type,
     waveform_type,
 )
 from ipmc_asym.dynamics.circuit import STEP_FIDELITIES
@@ -35,7 +35,7 @@ from ipmc_asym.dynamics.drive import (
     CHECK_COLUMNS,  # per time point: the forward model's checks, as drive
     LINE_COLUMNS,
 )
-from ipmc_asym.dynamics.entry import time_path, time_response
+from ipmc_asym.dynamics.entry import AUTO_TOL, stated_tol, time_path, time_response
 from ipmc_asym.forward.model import CHECKS
 from ipmc_asym.io.fileio import atomic_write
 
@@ -157,10 +157,12 @@ def register(sub):
                    help=model_help("constant") + "; all: each in turn")
     p.add_argument("--diffusion", type=diffusion_type(), default=None,
                    help="cation diffusion coefficient D (1e-10m2/s, 1e-6cm2/s; a bare number is m^2/s)")
-    p.add_argument("--tol", type=tol_type, default=None,
+    p.add_argument("--tol", type=time_tol_type, default="auto",
                    help="relative accuracy required of sigma at every output time, e.g. 1e-3 or 0.1%% (in [1e-8, 0.5)): "
-                        "the circuit's error is bounded against the PNP solver and the PNP is used where it fails; "
-                        "default: no estimate for the circuit, 1e-6 for pnp")
+                        "the circuit's error is bounded against a reference PNP run and the PNP is used where it fails; "
+                        f"default auto: {AUTO_TOL:g} where the error can be stated (at most 10001 output times, no "
+                        "--sheet-resistance: the electrode line states its own), 1e-6 for pnp; none: the bare circuit, "
+                        "no error stated (~100 times faster)")
     add_size_option(p, "--points", default=1000, maximum=MAX_POINTS, minimum=2,
                     help=f"output times (with --fidelity pnp at most {MAX_POINTS_PNP:.0e} unless --max-points is given)")
     p.add_argument("--waveform", type=waveform_type, default=None,
@@ -182,10 +184,18 @@ def run(args):
     strip, material, _ = strip_and_material(args)
     models = list(model_names()) if args.model == "all" else [args.model]
     stream = bool(args.out) and not args.json
+    # what --tol auto means here (the library's rule, dynamics.entry.stated_tol; time_response applies
+    # the same and says in the notes why where it states no error)
+    tol, _ = stated_tol(args.tol, fidelity=args.fidelity, points=args.points, sheet_resistance=args.sheet_resistance)
     # the choice's refusals first (a refused command compiles nothing), then the first-run notice
-    time_path(fidelity=args.fidelity, tol=args.tol, beam=args.beam, sheet_resistance=args.sheet_resistance,
+    time_path(fidelity=args.fidelity, tol=tol, beam=args.beam, sheet_resistance=args.sheet_resistance,
               stream=stream)
-    first_run_notice("step-pnp" if args.fidelity == "pnp" or args.tol is not None else "step")
+    first_run_notice("step-pnp" if args.fidelity == "pnp" or tol is not None else "step")
+    if tol is not None and args.fidelity == "circuit":  # the reference PNP run is the long part: say so first
+        sys.stderr.write(f"step: the circuit and a reference PNP run (tol {tol:g}) that bounds its error, "
+                         f"{len(models)} model{'s' if len(models) > 1 else ''} (1 V, nominal strip: ~2-10 s CPU "
+                         f"each; --tol none skips it)\n")
+        sys.stderr.flush()
     # the library chooses the solver (dynamics.entry.time_path): rows streamed to --out where a stepped
     # path serves, the in-memory solve otherwise
     resps = {m: time_response(strip, args.waveform, duration=args.duration, points=args.points, model=m,
@@ -199,9 +209,12 @@ def run(args):
     if path != "memory":
         return _stream_csv(args, strip, resps)
     results = {m: resp.result for m, resp in resps.items()}
+    # the tolerance the runs met (auto states none where the reference PNP run refuses the strip)
+    if any(resp.info.get("tol") is None for resp in resps.values()) and args.fidelity == "circuit":
+        tol = None
 
     # the errors wherever they are stated: with --tol, and always for the pnp (its default tolerance)
-    stated = args.tol is not None or args.fidelity == "pnp"
+    stated = tol is not None or args.fidelity == "pnp"
     # (the deflection's error: through the quasi-static beam, or through the beam's modes with --beam dynamic)
     columns = COLUMNS + (("sigma_error", "current_error") if stated else ()) + (
         ("w_error",) if stated else ())
@@ -237,7 +250,7 @@ def run(args):
                 "diffusion_coefficient": material.D, "seconds": r.seconds, "notes": r.notes, "message": r.message,
                 "waveform": drive, "beam": args.beam, "warnings": r.warnings,
                 # the tolerance the run met: --tol, or the pnp's default
-                "tol": args.tol if args.tol is not None else r.extra.get("tol"),
+                "tol": tol if tol is not None else r.extra.get("tol"),
                 "valid_from": r.extra.get("valid_from")}
 
     for mname in models:  # the forward model's flags, one line each (also in --json's "warnings")

@@ -104,10 +104,10 @@ DYNAMIC_NOTES = (
 BEAM_CHOICES = ("quasi-static", "dynamic")
 #: said by a circuit step run without a tolerance: its error bound is a reference PNP run, 100-1000
 #: times the circuit's cost (1 V step, nominal strip, to 5 tau: circuit 0.01-0.02 s CPU; with tol
-#: 1e-2 1.9 s constant, 18 s affine, 1.4 s linear), so it is run only when asked for
-CIRCUIT_NO_TOL_NOTE = ("circuit: sigma, current and w errors are stated with a tolerance (step --tol T): the bound is "
-                       "a reference PNP run, 100-1000 times the circuit's cost (nominal 1 V step: 1.4-18 s CPU "
-                       "against 0.02 s), so it is not run by default")
+#: 1e-2 1.9 s constant, 18 s affine, 1.4 s linear); ``ipmc-asym step`` runs it by default (tol "auto")
+CIRCUIT_NO_TOL_NOTE = ("circuit: no error stated for sigma, current and w (no tolerance): the bound is a reference PNP "
+                       "run, 100-1000 times the circuit's cost (nominal 1 V step: 1.4-18 s CPU against 0.02 s); "
+                       "step states it by default (--tol auto, 1e-2) or with --tol T")
 DYNAMIC_W_ERROR_NOTE = ("w_error with beam dynamics: the quasi-static errors of M_A and w through the beam's modes "
                         "(each mode's impulse response bounded by its envelope): without damping (viscous modulus 0) "
                         "the bound grows like omega_1 t, as an undamped mode keeps every error it was given")

@@ -45,13 +45,13 @@ def test_step_tol_refusals_are_one_line(argv, capsys):
 
 
 def test_step_csv_is_streamed_and_equals_the_in_memory_run(tmp_path):
-    """step --out (circuit, quasi-static beam) is written chunk by chunk through drive_chunks: the
-    same rows as the in-memory step_response (same circuit, same forward model and checks)."""
+    """step --out --tol none (circuit, quasi-static beam) is written chunk by chunk through drive_chunks:
+    the same rows as the in-memory step_response (same circuit, same forward model and checks)."""
     from ipmc_asym.dynamics.circuit import step_response
     from ipmc_asym.model.params import Strip
 
     f = tmp_path / "s.csv"
-    assert main(["step", "--voltage", "2V", "--points", "301", "--model", "affine", "--out", str(f)]) == 0
+    assert main(["step", "--voltage", "2V", "--points", "301", "--model", "affine", "--tol", "none", "--out", str(f)]) == 0
     rows = list(csv.reader(f.read_text().splitlines()))
     head, body = rows[0], rows[1:]
     r = step_response(2.0, strip=Strip(voltage=2.0), model="affine", points=301)

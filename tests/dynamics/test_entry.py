@@ -113,13 +113,13 @@ def test_spectrum_picks_the_line_with_a_sheet_resistance():
 
 def test_the_commands_make_the_entry_s_choice(tmp_path, capsys):
     """step/drive/freq print what the entry (and the functions it calls) return for the same options."""
-    assert main(["step", "--points", "9", "--voltage", "0.7V", "--json"]) == 0
+    assert main(["step", "--points", "9", "--voltage", "0.7V", "--tol", "none", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
     ref = step_response(0.7, None, strip=Strip(voltage=0.7), points=9)
     assert out["beam"] == DEFAULT_BEAM and np.allclose(out["sigma"], ref.sigma, rtol=1e-15, atol=0)
-    # step --out streams (the circuit on the output grid): the rows of drive_chunks
+    # step --out streams (the circuit on the output grid, no error stated): the rows of drive_chunks
     f = tmp_path / "s.csv"
-    assert main(["step", "--points", "9", "--voltage", "0.7V", "--duration", "0.2s", "--out", str(f)]) == 0
+    assert main(["step", "--points", "9", "--voltage", "0.7V", "--duration", "0.2s", "--tol", "none", "--out", str(f)]) == 0
     assert "streamed" in capsys.readouterr().err
     rows = [ln.split(",") for ln in f.read_text().splitlines()]
     sig = np.array([float(x[rows[0].index("sigma")]) for x in rows[1:]])
@@ -153,3 +153,31 @@ def test_time_response_is_a_result_object_of_its_rows():
     streamed = time_response(s, points=40, stream=True, sheet_resistance=2.5)
     with pytest.raises(ValueError, match="streamed"):
         streamed.to_xarray()
+
+
+def test_tol_auto_states_the_circuit_error_where_a_reference_can_run():
+    """tol="auto" (step's default): the in-memory circuit bounded at AUTO_TOL; where no reference PNP
+    run applies it states none instead of refusing, and says why (an explicit tol is refused there)."""
+    from ipmc_asym.dynamics.drive import MAX_STATED_POINTS
+    from ipmc_asym.dynamics.entry import AUTO_TOL, stated_tol
+
+    s = Strip(voltage=0.3)
+    # the electrode line: no refusal (its own discretisation error is stated), while tol=1e-2 is refused
+    r = time_response(s, points=20, tol="auto", sheet_resistance=2.5)
+    assert r.path == "line" and np.all(np.isfinite(r.columns["sigma_error"]))
+    with pytest.raises(ValueError, match="drop tol"):
+        time_response(s, points=20, tol=1e-2, sheet_resistance=2.5)
+    # a clamped-clamped support: stepped by the circuit only, said in the notes
+    r = time_response(s, points=20, tol="auto", support="clamped-clamped", stream=True)
+    assert r.path == "stream" and any("clamped-clamped" in n and "no error stated" in n for n in r.info["notes"])
+    # the reference PNP run refuses the strip (layers that fill 1 um at 20 V): auto keeps the circuit
+    # and says so; an explicit tolerance is refused
+    thin = Strip(thickness=1e-6, voltage=20.0)
+    r = time_response(thin, points=5, model="linear", tol="auto")
+    assert r.result.fidelity == "circuit" and np.all(np.isnan(r.result.sigma_error)) and r.info["tol"] is None
+    assert any("reference PNP run refuses" in n for n in r.info["notes"])
+    with pytest.raises(ValueError, match="neutral core"):
+        time_response(thin, points=5, model="linear", tol=1e-2)
+    assert stated_tol("auto", points=MAX_STATED_POINTS) == (AUTO_TOL, None)
+    assert stated_tol("auto", fidelity="pnp") == (None, None)  # the PNP states its own at 1e-6
+    assert stated_tol(3e-3, points=10**6) == (3e-3, None)  # an explicit tolerance is the caller's

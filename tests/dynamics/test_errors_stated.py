@@ -17,6 +17,8 @@ from ipmc_asym.dynamics.circuit import (
     step_response,
     time_constant,
 )
+from ipmc_asym.dynamics.drive import MAX_STATED_POINTS
+from ipmc_asym.dynamics.entry import AUTO_TOL
 from ipmc_asym.dynamics.transient import _log_window_max
 
 #: the reference: the PNP at a tolerance ten to a thousand times tighter, time integration at 1e-11
@@ -165,7 +167,7 @@ def test_log_window_max():
     assert _log_window_max(t, a).tolist() == [7.0, 7.0, 7.0, 7.0, 7.0, 2.0]
 
 
-def test_cli_step_states_w_error_by_default_for_pnp_and_with_tol(capsys):
+def test_cli_step_states_its_errors_by_default(capsys):
     from ipmc_asym.cli import main
 
     assert main(["step", "--fidelity", "pnp", "--json", "--points", "5"]) == 0
@@ -176,13 +178,25 @@ def test_cli_step_states_w_error_by_default_for_pnp_and_with_tol(capsys):
     # the current and its error at t > 0 (at the step's jump, t = 0, both may be withheld: null)
     assert all(np.isfinite(d["current_error"][1:])) and all(np.isfinite(d["current_density"][1:]))
     assert (d["current_error"][0] is None) == (d["current_density"][0] is None)
+    # the circuit by default: its errors against a reference PNP run at tol auto (1e-2), the same rows
+    # as --tol 1e-2
+    assert main(["step", "--json", "--points", "5"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["tol"] == AUTO_TOL == 1e-2 and d["fidelity"] == "circuit"
+    for k in ("sigma_error", "current_error", "w_error"):
+        assert all(x is not None and np.isfinite(x) for x in d[k][1:]), k
     assert main(["step", "--json", "--points", "5", "--tol", "1e-2"]) == 0
+    d2 = json.loads(capsys.readouterr().out)
+    assert {k: v for k, v in d2.items() if k != "seconds"} == {k: v for k, v in d.items() if k != "seconds"}
+    # --tol none: the bare circuit, no error column, and the note says how to get one
+    assert main(["step", "--json", "--points", "5", "--tol", "none"]) == 0
     d = json.loads(capsys.readouterr().out)
-    assert all(x is not None and np.isfinite(x) for x in d["w_error"]) and d["tol"] == 1e-2
-    assert main(["step", "--json", "--points", "5"]) == 0  # no error without --tol: no column (unchanged)
+    assert "w_error" not in d and d["tol"] is None and any("--tol auto" in n for n in d["notes"])
+    # auto states none where the reference cannot run, and says why (here: too many output times)
+    assert main(["step", "--json", "--points", str(MAX_STATED_POINTS + 1)]) == 0
     d = json.loads(capsys.readouterr().out)
-    assert "w_error" not in d and d["tol"] is None
-    assert main(["step", "--points", "5", "--tol", "1e-2"]) == 0
+    assert "w_error" not in d and d["tol"] is None and any(f"{MAX_STATED_POINTS + 1} output times" in n for n in d["notes"])
+    assert main(["step", "--points", "5"]) == 0
     out = capsys.readouterr().out
     assert "w [mm]        +-" in out
 

@@ -390,6 +390,29 @@ def test_small_signal_step_within_its_stated_error_of_the_exact_linearised_respo
     assert np.max(r.sigma_error) <= 1e-6 * np.max(np.abs(r.sigma))
 
 
+@pytest.mark.parametrize("V", [3e-8, 1e-20, -1e-300])
+def test_tiny_steps_within_their_stated_error_of_the_exact_linearised_response(V):
+    """Below SMALL_SIGNAL_V the PNP solves the small-signal limit (scaled from 10 and 20 uV runs):
+    sigma and J within their stated errors of the exact linearised response at every output time,
+    both signs, down to 1e-300 V.  The direct solve stalls from ~0.1 uV and from ~1e-20 V returns the
+    geometric charge with no charging at all (a perturbation of 1 below its rounding)."""
+    from ipmc_asym.dynamics.transient import SMALL_SIGNAL_V
+
+    assert abs(V) < SMALL_SIGNAL_V
+    tau = float(time_constant(S0.thickness, "constant"))
+    t = np.linspace(0.0, 5 * tau, 11)
+    r = solve_transient(t, waveform("step", V), S0, "constant", NAFION_LI, moment=False, tol=1e-6)
+    assert r.success, r.message
+    idx = [1, 2, 3, 5, 10]
+    for name, cur in (("sigma", False), ("current", True)):
+        ref = _exact_linear_step_sigma(V, t[idx], S0, "constant", current=cur)
+        got = (r.current_density if cur else r.sigma)[idx]
+        bound = (r.current_error if cur else r.sigma_error)[idx]
+        assert np.all(np.abs(got - ref) <= bound), (name, (np.abs(got - ref) / bound).tolist())
+    assert np.max(r.sigma_error) <= 1e-6 * np.max(np.abs(r.sigma))
+    assert np.sign(r.sigma[-1]) == np.sign(V)
+
+
 @pytest.mark.parametrize("thickness", [200e-6, 1e-3])
 def test_small_signal_step_at_a_loose_tol_within_its_stated_error_at_early_times(thickness):
     """0.1 mV at tol 1e-4 on step's default window (log-spaced from 1e-4 tau): at the early times the
