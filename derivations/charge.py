@@ -47,6 +47,7 @@ import functools
 
 import sympy as sp
 from sympy import QQ
+from sympy.codegen.cfunctions import expm1
 from sympy.polys.rings import ring
 
 from . import model as M
@@ -317,6 +318,52 @@ def small_signal_kernels():
          "Zhat(W) = psi0/J of the linearised PNP about 0 V (constant core permittivity); Z = (e/kappa) Zhat."),
         ("moment_transfer_hat", (W, lam), mom.subs(k, kk),
          "int d (1 - x^2)/2 dx / (lambda^2 psi0): the moment integral per unit psi0 is (1 + A3) times this."),
+    ]
+
+
+def linear_static_state():
+    """The linear model's static state at any thickness, in the distance ``xi = z + 1`` from the anode
+    face, in a form accurate where the anode is depleted (the bias reference linearises about it).
+
+    ``model.linear_exact_solution`` gives ``C = 1 + (B1 - 1) sinh(z/lambda)/sinh(1/lambda)`` with
+    ``B1 = 2/(1 + e^{-A2})``; at the anode ``C(-1) = u_f = 2 e^{-A2}/(1 + e^{-A2})`` (~2e-17 at 1 V),
+    which ``1 + (B1 - 1)(...)`` cannot hold (it cancels to rounding).  Written from ``u_f`` with
+    ``expm1``:  ``u = u_f + (1 - u_f)(1 - e^{-xi/lambda} + e^{(xi - 2)/lambda} - e^{-2/lambda})/(1 - e^{-2/lambda})``
+    keeps relative accuracy at the face, and the induction is ``D = lambda^2 u'`` (the zero flux with
+    ``eps_hat = u``).  Checked here against the exact solution, the ODE ``lambda^2 u'' = u - 1``, the
+    face values and ``int (u - 1) = 0``.  Returns ``(xi, uf, u, D, uf_of_A2)``.
+    """
+    xi, uf = sp.symbols("xi uf", real=True)
+    q = sp.exp(-2 / lam)
+    den = -expm1(-2 / lam)  # 1 - e^{-2/lambda}
+    near = -expm1(-xi / lam)  # 1 - e^{-xi/lambda}
+    far = sp.exp((xi - 2) / lam)  # the cathode layer
+    u = uf + (1 - uf) * (near + far - q) / den
+    D = lam * (1 - uf) * (sp.exp(-xi / lam) + far) / den
+    uf_of_A2 = 2 * sp.exp(-A2) / (1 + sp.exp(-A2))  # C(-1) = B1 e^{-A2}, no overflow for A2 >= 0
+    plain = {expm1: lambda a: sp.exp(a) - 1}
+    u_e, D_e = u.replace(expm1, plain[expm1]), D.replace(expm1, plain[expm1])
+    Cz, b1, _ = M.linear_exact_solution()
+    exact = Cz.subs(M.z, xi - 1).subs(sp.Symbol("z0", positive=True), lam).subs(B1, b1)
+    assert sp.simplify((u_e.subs(uf, uf_of_A2) - exact).rewrite(sp.exp)) == 0
+    assert sp.simplify(lam**2 * sp.diff(u_e, xi, 2) - (u_e - 1)) == 0
+    assert sp.simplify(D_e - lam**2 * sp.diff(u_e, xi)) == 0
+    assert sp.simplify(u_e.subs(xi, 0) - uf) == 0 and sp.simplify(u_e.subs(xi, 2) - (2 - uf)) == 0
+    assert sp.simplify(sp.integrate(u_e - 1, (xi, 0, 2))) == 0
+    assert sp.simplify(uf_of_A2 - b1 * sp.exp(-A2)) == 0
+    return xi, uf, u, D, uf_of_A2
+
+
+def linear_static_kernels():
+    """(name, args, expression, doc) of :func:`linear_static_state` (NumPy, vectorised)."""
+    xi, uf, u, D, uf_of_A2 = linear_static_state()
+    return [
+        ("linear_static_concentration", (xi, lam, uf), u,
+         "C/C_moy of the linear model's static state at the distance xi = z + 1 from the anode face (C(0) = uf)."),
+        ("linear_static_induction", (xi, lam, uf), D,
+         "D_bar = lambda^2 dC/dxi of the linear model's static state (the zero flux with eps_hat = C/C_moy)."),
+        ("linear_anode_concentration", (A2,), uf_of_A2,
+         "uf = C(-1)/C_moy = 2 e^{-A2}/(1 + e^{-A2}) of the linear model at A2 = |phi0| F/(R T) >= 0."),
     ]
 
 

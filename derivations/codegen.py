@@ -288,8 +288,8 @@ def _closed_forms() -> Module:
 
 
 def _charge() -> Module:
-    return Module(charge.kernels(), numpy_functions=tuple(charge.small_signal_kernels()),
-                  numpy_source="derivations.charge:small_signal")
+    return Module(charge.kernels(), numpy_functions=tuple(charge.small_signal_kernels() + charge.linear_static_kernels()),
+                  numpy_source="derivations.charge")
 
 
 def _debye_hueckel() -> Module:

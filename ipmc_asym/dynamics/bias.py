@@ -46,6 +46,11 @@ from ipmc_asym.base.settings import BVP_STATED_ERROR
 from ipmc_asym.bvp.problems import y_of_s
 from ipmc_asym.bvp.solver import solve as solve_static
 from ipmc_asym.integral.charge import charge
+from ipmc_asym.kernels._generated_charge import (
+    linear_anode_concentration,
+    linear_static_concentration,
+    linear_static_induction,
+)
 from ipmc_asym.model import groups
 from ipmc_asym.model.params import NAFION_LI, Material, Strip, check_finite
 from ipmc_asym.model.permittivity import Permittivity, get_model
@@ -103,28 +108,16 @@ def _linear_profile(lam: float, v: float):
     ``profile(xi) -> (u, D_bar)`` at the distance ``xi = x + 1`` from the anode face; ``(u_f, profile)``.
 
     With ``eps_hat = u`` the zero flux gives ``u' = D_bar/lambda^2`` and Gauss ``D_bar' = u - 1``: the
-    problem is linear, ``u'' = (u - 1)/lambda^2``.  The zero flux makes ``u`` a Boltzmann factor of the
-    potential, so ``u(2)/u(0) = e^v`` (``v`` the bias in thermal volts), and the mirror symmetry of
-    the strip makes ``u - 1`` odd about the centre, ``u(2) = 2 - u_f``: ``u_f = 2/(1 + e^v)`` and::
-
-        u = u_f + (1 - u_f) (1 - e^{-xi/lambda} + e^{(xi - 2)/lambda} - e^{-2/lambda})/(1 - e^{-2/lambda})
-        D_bar = lambda (1 - u_f) (e^{-xi/lambda} + e^{(xi - 2)/lambda})/(1 - e^{-2/lambda})
-
-    at any thickness (a thick strip's neutral core is the limit ``e^{-2/lambda} -> 0``).  ``u`` near the
-    anode is formed from ``u_f`` and ``expm1``: relative accuracy where ``u ~ u_f ~ 2 e^{-v}`` (the
-    BVP's spline of ``A0 C`` is accurate in absolute terms only, 97 % off there at 1 V, 20 um)."""
-    uf = 2.0 / (1.0 + math.exp(v)) if v < 700.0 else 2.0 * math.exp(-v)
-    a = 1.0 - uf
-    q = math.exp(-2.0 / lam)
-    den = -math.expm1(-2.0 / lam)  # 1 - e^{-2/lambda}
+    problem is linear, ``u'' = (u - 1)/lambda^2``, solved at any thickness by the paper's exact
+    solution, written from the anode's ``u_f = 2/(1 + e^v)`` (``v`` the bias in thermal volts) with
+    ``expm1``: relative accuracy where ``u ~ u_f ~ 2 e^{-v}`` (the BVP's spline of ``A0 C`` is accurate
+    in absolute terms only, 97 % off there at 1 V, 20 um).  Generated from
+    ``derivations.charge:linear_static_state``."""
+    uf = float(linear_anode_concentration(v))
 
     def profile(xi):
         xi = np.asarray(xi, dtype=float)
-        near = -np.expm1(-xi / lam)  # 1 - e^{-xi/lambda}
-        far = np.exp((xi - 2.0) / lam)  # the cathode layer's e^{(xi - 2)/lambda}
-        u = uf + a * (near + (far - q)) / den
-        D = lam * a * (np.exp(-xi / lam) + far) / den
-        return u, D
+        return linear_static_concentration(xi, lam, uf), linear_static_induction(xi, lam, uf)
 
     return uf, profile
 

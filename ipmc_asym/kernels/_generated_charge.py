@@ -76,7 +76,7 @@ def yc_small(A2, rho):
 def impedance_hat(W, lam):
     """Zhat(W) = psi0/J of the linearised PNP about 0 V (constant core permittivity); Z = (e/kappa) Zhat.
 
-    Derived in ``derivations.charge:small_signal``.  Vectorised NumPy (complex); not jitted.
+    Derived in ``derivations.charge``.  Vectorised NumPy (complex); not jitted.
     """
     t0 = lam**(-2.0)
     t1 = 1j*W + t0
@@ -88,7 +88,7 @@ def impedance_hat(W, lam):
 def moment_transfer_hat(W, lam):
     """int d (1 - x^2)/2 dx / (lambda^2 psi0): the moment integral per unit psi0 is (1 + A3) times this.
 
-    Derived in ``derivations.charge:small_signal``.  Vectorised NumPy (complex); not jitted.
+    Derived in ``derivations.charge``.  Vectorised NumPy (complex); not jitted.
     """
     t0 = 1j*W + lam**(-2.0)
     t1 = t0**(-1.0)
@@ -96,3 +96,31 @@ def moment_transfer_hat(W, lam):
     t3 = np.tanh(t2)
     t4 = t1 + 1j/W
     return -(-1/3*t1 + t4*(t1 - t3/t0**(3/2)))/(t1 - t3*t4/t2)
+
+
+def linear_static_concentration(xi, lam, uf):
+    """C/C_moy of the linear model's static state at the distance xi = z + 1 from the anode face (C(0) = uf).
+
+    Derived in ``derivations.charge``.  Vectorised NumPy (complex); not jitted.
+    """
+    t0 = lam**(-1.0)
+    t1 = -2*t0
+    return uf - (uf - 1)*(np.exp(t1) - np.exp(t0*(xi - 2)) + np.expm1(-t0*xi))/np.expm1(t1)
+
+
+def linear_static_induction(xi, lam, uf):
+    """D_bar = lambda^2 dC/dxi of the linear model's static state (the zero flux with eps_hat = C/C_moy).
+
+    Derived in ``derivations.charge``.  Vectorised NumPy (complex); not jitted.
+    """
+    t0 = lam**(-1.0)
+    return lam*(uf - 1)*(np.exp(t0*(xi - 2)) + np.exp(-t0*xi))/np.expm1(-2*t0)
+
+
+def linear_anode_concentration(A2):
+    """uf = C(-1)/C_moy = 2 e^{-A2}/(1 + e^{-A2}) of the linear model at A2 = |phi0| F/(R T) >= 0.
+
+    Derived in ``derivations.charge``.  Vectorised NumPy (complex); not jitted.
+    """
+    t0 = np.exp(-A2)
+    return 2*t0/(t0 + 1)
