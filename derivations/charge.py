@@ -363,7 +363,7 @@ def linear_static_kernels():
         ("linear_static_induction", (xi, lam, uf), D,
          "D_bar = lambda^2 dC/dxi of the linear model's static state (the zero flux with eps_hat = C/C_moy)."),
         ("linear_anode_concentration", (A2,), uf_of_A2,
-         "uf = C(-1)/C_moy = 2 e^{-A2}/(1 + e^{-A2}) of the linear model at A2 = |phi0| F/(R T) >= 0."),
+         "``uf = C(-1)/C_moy = 2 e^{-A2}/(1 + e^{-A2})`` of the linear model at ``A2 = F |phi0|/(R T) >= 0``."),
     ]
 
 

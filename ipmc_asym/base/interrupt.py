@@ -8,16 +8,18 @@ are restored on exit, so using the library imports no handler).  Each of the thr
   BaseException`` cleanup, e.g. ``io.fileio.atomic_write`` removing its ``.part`` file, runs as
   for Ctrl-C).
 
-An exception raised from a signal handler may be swallowed when the signal arrives inside a
-callback from compiled code (a Numba/llvmlite cache callback drops it); the flag is not:
+An exception raised from a signal handler would be swallowed when the signal arrives inside a
+callback from compiled code (a Numba/llvmlite cache callback drops it, and the JIT is left
+half-updated), so there the handler only sets the flag; the flag is never lost:
 streaming writers call :func:`check` between chunks (``io.fileio.atomic_write`` does on every
-write and before renaming), so an interruption is never lost and no output file is committed
-after it.  The exit status is ``128 + signal number`` (130, 143, 129), the shell's convention.
+write and before renaming) and the command line when a command returns, so an interruption is never
+lost and no output file is committed after it.  The exit status is ``128 + signal number`` (130, 143, 129), the shell's convention.
 """
 
 from __future__ import annotations
 
 import contextlib
+import os
 import signal
 import threading
 
@@ -56,9 +58,25 @@ def exit_status(exc: BaseException) -> int:
     return 128 + (exc.signum if isinstance(exc, Interrupted) else int(signal.SIGINT))
 
 
+def _in_compiled_callback(frame) -> bool:
+    """Whether ``frame`` runs inside a callback from llvmlite's compiled code (Numba's object cache
+    loading or storing a kernel): an exception raised there is dropped by ``ctypes`` and leaves the
+    JIT's state half-updated (a later call crashed with SIGSEGV when Ctrl-C arrived while ``drive``
+    loaded its kernels)."""
+    marker = os.sep + "llvmlite" + os.sep
+    while frame is not None:
+        if marker in frame.f_code.co_filename:
+            return True
+        frame = frame.f_back
+    return False
+
+
 def _handler(signum, frame):
     _pending.append(int(signum))
-    raise Interrupted(signum)
+    # inside the JIT's callbacks only the flag is set: the next check() (between chunks, before a file
+    # is committed, and by the command line when the command returns) raises it
+    if not _in_compiled_callback(frame):
+        raise Interrupted(signum)
 
 
 def pending() -> int | None:

@@ -19,6 +19,7 @@ from importlib.metadata import entry_points
 
 from ipmc_asym import __version__
 from ipmc_asym.base.inputs import MAX_INPUT_BYTES, input_size_cap, max_input_bytes, parse_size
+from ipmc_asym.base.interrupt import check as check_interrupted
 from ipmc_asym.base.interrupt import exit_status, handling_signals
 
 __all__ = ["main", "build_parser", "COMMANDS", "UsageError", "PLUGIN_GROUP", "plugin_commands", "load_plugin"]
@@ -162,7 +163,9 @@ def main(argv=None) -> int:
             plugins = plugin_commands()
             known = only in COMMANDS or only in plugins
             command = only if known else "?"
-            return _run(argv, only if known else None, plugins, UsageError)
+            rc = _run(argv, only if known else None, plugins, UsageError)
+            check_interrupted()  # a signal that arrived inside the JIT's callbacks (only flagged there)
+            return rc
         except KeyboardInterrupt as exc:
             # every file is written through fileio.atomic_write/atomic_path: nothing partial is left
             how = "Ctrl-C" if exit_status(exc) == 130 else getattr(exc, "name", "signal")

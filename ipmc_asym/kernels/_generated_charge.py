@@ -118,7 +118,7 @@ def linear_static_induction(xi, lam, uf):
 
 
 def linear_anode_concentration(A2):
-    """uf = C(-1)/C_moy = 2 e^{-A2}/(1 + e^{-A2}) of the linear model at A2 = |phi0| F/(R T) >= 0.
+    """``uf = C(-1)/C_moy = 2 e^{-A2}/(1 + e^{-A2})`` of the linear model at ``A2 = F |phi0|/(R T) >= 0``.
 
     Derived in ``derivations.charge``.  Vectorised NumPy (complex); not jitted.
     """
