@@ -328,17 +328,18 @@ def linear_static_state():
     ``model.linear_exact_solution`` gives ``C = 1 + (B1 - 1) sinh(z/lambda)/sinh(1/lambda)`` with
     ``B1 = 2/(1 + e^{-A2})``; at the anode ``C(-1) = u_f = 2 e^{-A2}/(1 + e^{-A2})`` (~2e-17 at 1 V),
     which ``1 + (B1 - 1)(...)`` cannot hold (it cancels to rounding).  Written from ``u_f`` with
-    ``expm1``:  ``u = u_f + (1 - u_f)(1 - e^{-xi/lambda} + e^{(xi - 2)/lambda} - e^{-2/lambda})/(1 - e^{-2/lambda})``
+    ``expm1``:  ``u = u_f + (1 - u_f)(1 - e^{-xi/lambda})(1 + e^{(xi - 2)/lambda})/(1 - e^{-2/lambda})``
     keeps relative accuracy at the face, and the induction is ``D = lambda^2 u'`` (the zero flux with
     ``eps_hat = u``).  Checked here against the exact solution, the ODE ``lambda^2 u'' = u - 1``, the
     face values and ``int (u - 1) = 0``.  Returns ``(xi, uf, u, D, uf_of_A2)``.
     """
     xi, uf = sp.symbols("xi uf", real=True)
-    q = sp.exp(-2 / lam)
     den = -expm1(-2 / lam)  # 1 - e^{-2/lambda}
     near = -expm1(-xi / lam)  # 1 - e^{-xi/lambda}
     far = sp.exp((xi - 2) / lam)  # the cathode layer
-    u = uf + (1 - uf) * (near + far - q) / den
+    # e^{(xi - 2)/lambda} - e^{-2/lambda} = far * near: no cancellation where xi is below the spacing of
+    # the doubles at 2 (the anode's sublayer, ~u_f lambda: 3e-17 at 1 V), where (xi - 2) rounds to -2
+    u = uf + (1 - uf) * near * (1 + far) / den
     D = lam * (1 - uf) * (sp.exp(-xi / lam) + far) / den
     uf_of_A2 = 2 * sp.exp(-A2) / (1 + sp.exp(-A2))  # C(-1) = B1 e^{-A2}, no overflow for A2 >= 0
     plain = {expm1: lambda a: sp.exp(a) - 1}

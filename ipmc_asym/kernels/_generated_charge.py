@@ -104,8 +104,7 @@ def linear_static_concentration(xi, lam, uf):
     Derived in ``derivations.charge``.  Vectorised NumPy (complex); not jitted.
     """
     t0 = lam**(-1.0)
-    t1 = -2*t0
-    return uf - (uf - 1)*(np.exp(t1) - np.exp(t0*(xi - 2)) + np.expm1(-t0*xi))/np.expm1(t1)
+    return uf - (uf - 1)*(np.exp(t0*(xi - 2)) + 1)*np.expm1(-t0*xi)/np.expm1(-2*t0)
 
 
 def linear_static_induction(xi, lam, uf):
