@@ -30,7 +30,7 @@ def section(quick: bool = False) -> dict:
             r["step_pnp_nominal_s"] = cpu_best(lambda: ia.step_response(1.0, fidelity="pnp", points=200), 1)
     units = {"charge_ns_per_point": "ns/point", "step_circuit_1000_s": "s", "step_pnp_nominal_s": "s"}
     what = {"charge_ns_per_point": "closed-form charge() (sigma, C_d, eps_app), 1 thread",
-            "step_circuit_1000_s": "step --fidelity circuit, 1000 time points (incl. moment and beam)",
+            "step_circuit_1000_s": "step --fidelity circuit --tol none, 1000 time points (incl. moment and beam)",
             "step_pnp_nominal_s": "step --fidelity pnp, nominal strip, 1 V, 5 tau, 200 output times"}
     note = f"CPU time, load {load():.2f}"
     figs = [{"what": what[k], "value": r[k], "unit": units[k], "target": TARGETS[k],

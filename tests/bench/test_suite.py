@@ -75,7 +75,7 @@ def test_printed_targets_are_the_goals(res):
     assert len(over) == 6 and set(over.values()) == {1.2}
     assert figs["scalar moment_integral(2e-4, 1.0, fidelity='exact')"]["target"] == 12e-6
     assert next(f for w, f in figs.items() if w.startswith("exact time per point"))["target"] == 10e-6
-    assert figs["step --fidelity circuit, 1000 time points (incl. moment and beam)"]["target"] == 10e-3
+    assert figs["step --fidelity circuit --tol none, 1000 time points (incl. moment and beam)"]["target"] == 10e-3
     assert figs["uq end to end at leading (sampling + 5 outputs + Sobol')"]["target"] == 1e6
 
 
