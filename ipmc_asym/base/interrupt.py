@@ -61,8 +61,8 @@ def exit_status(exc: BaseException) -> int:
 def _in_compiled_callback(frame) -> bool:
     """Whether ``frame`` runs inside a callback from llvmlite's compiled code (Numba's object cache
     loading or storing a kernel): an exception raised there is dropped by ``ctypes`` and leaves the
-    JIT's state half-updated (a later call crashed with SIGSEGV when Ctrl-C arrived while ``drive``
-    loaded its kernels)."""
+    JIT's state half-updated (a later call can crash with SIGSEGV: Ctrl-C while ``drive`` loads its
+    kernels)."""
     marker = os.sep + "llvmlite" + os.sep
     while frame is not None:
         if marker in frame.f_code.co_filename:

@@ -833,12 +833,9 @@ def _small_signal(t, phi0_fun, vmax, strip, model, material, kw):
     return r
 
 
-def _solve_direct(t, phi0_fun, strip: Strip, model="constant", material: Material = NAFION_LI, *,
-                    cells_per_debye: float = 4.0, ratio: float = 1.08, h_core: float = 0.02, refine: float | None = None,
-                    rtol: float | None = None, atol: float = 1e-12, method: str = "BDF", energy: bool = False,
-                    profiles: bool = False, moment: bool = True, tol: float | None = 1e-6,
-                    max_cells: int = 20000) -> TransientResult:
-    """:func:`solve_transient` without its small-signal branch."""
+def _solve_direct(t, phi0_fun, strip, model, material, *, cells_per_debye, ratio, h_core, refine, rtol, atol, method,
+                  energy, profiles, moment, tol, max_cells) -> TransientResult:
+    """:func:`solve_transient` without its small-signal branch (its arguments, defaults there)."""
     if tol is None:
         r = _solve_once(t, phi0_fun, strip, model, material, cells_per_debye=cells_per_debye, ratio=ratio,
                         h_core=h_core, refine=1.0 if refine is None else refine,

@@ -243,3 +243,13 @@ def test_drive_tolerance_refusals_before_the_work(args, word, capsys):
     assert code == 2
     err = capsys.readouterr().err.strip()
     assert word in err and len(err.splitlines()) == 1
+
+
+def test_drive_tol_auto_keeps_the_circuit_where_the_reference_refuses(capsys):
+    """--tol auto as step's default: where the reference PNP run refuses the strip (layers filling 1 um
+    at 20 V) the circuit's rows are printed without error columns and a note says why."""
+    assert main(["drive", "--waveform", "sine:20V@10Hz", "--thickness", "1um", "--model", "linear",
+                 "--duration", "2ms", "--points", "21", "--tol", "auto", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert "sigma_error" not in out and len(out["sigma"]) == 21
+    assert any("reference PNP run refuses" in n for n in out["notes"])

@@ -80,8 +80,8 @@ def test_linear_static_state_keeps_its_slope_inside_the_anode_sublayer():
     """The generated closed form at distances from the anode below the spacing of the doubles at 2
     (the depleted sublayer, ~u_f lambda: 3e-17 at 1 V): u against the exact solution at 50 digits,
     on a strip whose layers fill it (lambda ~ 1, where the cathode term's share of the slope
-    is e^{-2/lambda} ~ 12 %: a form with e^{(xi - 2)/lambda} - e^{-2/lambda} lost it and the 1 um
-    reference missed dsigma/dphi0 by 5-10 %)."""
+    is e^{-2/lambda} ~ 12 %: a form with e^{(xi - 2)/lambda} - e^{-2/lambda} loses it, and the 1 um
+    reference then misses dsigma/dphi0 by 5-10 %)."""
     import mpmath as mp
 
     from ipmc_asym.kernels._generated_charge import linear_static_concentration
