@@ -38,12 +38,6 @@ over ``u^2 (1 - Q)^j`` (no overflow at any ``u``); below ``U_SERIES`` (thin stri
 from __future__ import annotations
 
 import functools
-import hashlib
-import os
-import pickle
-import sys
-import tempfile
-from pathlib import Path
 
 import mpmath as mp
 import sympy as sp
@@ -157,6 +151,14 @@ def _evalpoly(expr, env):
     return out
 
 
+def _det3(m):
+    """The determinant of a 3x3 matrix by cofactors, unexpanded: SymPy's ``det`` expands every
+    product of the order-3 entries (~40 s); the remainder bound only evaluates it numerically."""
+    return (m[0, 0] * (m[1, 1] * m[2, 2] - m[1, 2] * m[2, 1])
+            - m[0, 1] * (m[1, 0] * m[2, 2] - m[1, 2] * m[2, 0])
+            + m[0, 2] * (m[1, 0] * m[2, 1] - m[1, 1] * m[2, 0]))
+
+
 @functools.lru_cache(maxsize=None)
 def perturbation(n: int = 3) -> dict:
     """``{k: I_k(u, E, rho, A3)}`` for even ``k < n`` (``E = e^u``), from ``x_1 .. x_n``.
@@ -176,7 +178,8 @@ def perturbation(n: int = 3) -> dict:
     for order in range(n):
         fk = _evalpoly(flux.coeff(a, order) - dxs[order], env)
         rk = _evalpoly(rhs.coeff(a, order) - xs[order], env)
-        xg = _add(_particular(_add(rk, _scale(_diff(fk), -1))), _scale(_SINH, Aa), _scale(_COSH, Bb))
+        part = _particular(_add(rk, _scale(_diff(fk), -1)))
+        xg = _add(part, _scale(_SINH, Aa), _scale(_COSH, Bb))
         eqs = [_at(xg, 1) - bk, _at(xg, -1) - (bk - 1 if order == 0 else bk), _integ(_add(xg, rk))]
         if order <= 2:
             sol = sp.solve(eqs, [Aa, Bb, bk], dict=True)[0]
@@ -184,13 +187,15 @@ def perturbation(n: int = 3) -> dict:
             xk = {k: v for k, v in xk.items() if v != 0}
         else:  # Cramer's rule, unsimplified (evaluated numerically only)
             Mx, rv = sp.linear_eq_to_matrix(eqs, [Aa, Bb, bk])
-            det = Mx.det(method="berkowitz")
-            sol = {}
-            for i, var in enumerate((Aa, Bb, bk)):
+            det = _det3(Mx)
+            coef = []
+            for i in (0, 1):  # Aa, Bb (bk, the A2^k term of ln B1, does not enter x_k)
                 Mi = Mx.copy()
                 Mi[:, i] = rv
-                sol[var] = Mi.det(method="berkowitz") / det
-            xk = {k: v.subs(sol) for k, v in xg.items()}
+                coef.append(_det3(Mi) / det)
+            # x_k built from its parts rather than by substituting into xg: ``subs`` walks the
+            # unexpanded determinants once per term
+            xk = _add(part, _scale(_SINH, coef[0]), _scale(_COSH, coef[1]))
         env[xs[order]] = xk
         env[dxs[order]] = _diff(xk)
     # p z: C/A2 - A3 phi with phi = (ln B1 - X)/A2; constants drop (int s ds = 0)
@@ -279,47 +284,17 @@ def b1_series(order: int = 4):
     return sp.expand(B.subs(sol))
 
 
-def _cache_path() -> Path:
-    """Where :func:`order_four` keeps its result: keyed by the sources it is derived from (this
-    module and ``model.py``) and the SymPy, mpmath and Python versions, so any change of them
-    derives it again."""
-    h = hashlib.sha256()
-    for p in (Path(__file__), Path(M.__file__)):
-        h.update(p.read_bytes())
-    h.update(f"{sp.__version__} {mp.__version__} {sys.version_info[:2]}".encode())
-    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
-    return Path(base) / "ipmc_asym" / "derivations" / f"dh_order4-{h.hexdigest()[:16]}.pickle"
-
-
 @functools.lru_cache(maxsize=None)
 def order_four():
-    """``I4(u, E, rho, A3)``, unsimplified: ``perturbation(5)[4]`` (~40 s of SymPy), cached on
-    disk by :func:`_cache_path` (a missing or unreadable cache file is derived again)."""
-    path = _cache_path()
-    try:
-        with open(path, "rb") as fh:
-            return pickle.load(fh)
-    except (OSError, pickle.UnpicklingError, EOFError, AttributeError, ImportError):
-        pass
-    I4 = perturbation(5)[4]
-    tmp = None
-    try:  # atomic: a concurrent or interrupted run never leaves a partial file
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp")
-        with os.fdopen(fd, "wb") as fh:
-            pickle.dump(I4, fh)
-        os.replace(tmp, path)
-    except OSError:  # a read-only cache: derived again next time
-        if tmp is not None and os.path.exists(tmp):
-            os.unlink(tmp)
-    return I4
+    """``I4(u, E, rho, A3)``, unsimplified: ``perturbation(5)[4]`` (~5 s of SymPy)."""
+    return perturbation(5)[4]
 
 
 @functools.lru_cache(maxsize=None)
 def remainder_constants():
     """``(K4A, K4B)``: ``|I4| <= (K4A + K4B |A3|) n(u)`` over u in [0.02, 1e4], rho in [0, 1]."""
-    # common subexpressions evaluated once: the unsimplified I4 (~5e4 operations) evaluates ~30x
-    # faster at the same 60 digits; both maxima agree with the plain evaluation to 40 digits
+    # common subexpressions evaluated once: the unexpanded Cramer quotients of the order-3 and
+    # order-4 solutions share most of their terms
     f = sp.lambdify((u, E, rho, A3), order_four(), "mpmath", cse=True)
     worst_a = worst_b = mp.mpf(0)
     with mp.workdps(60):

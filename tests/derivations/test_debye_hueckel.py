@@ -58,9 +58,8 @@ def test_b1_series_against_exact_root(rho):
 @pytest.mark.slow
 def test_remainder_constants_bound_the_next_term():
     """Spot values of the order-4 term within the bound the kernels use (``MARGIN`` included)."""
-    # the order-4 term as ``derive`` gets it (``order_four``: derived once, kept on disk keyed by
-    # the sources it comes from), evaluated with its common subexpressions shared (the same
-    # value, ~30x faster at 60 digits); the spot points are not the grid the constants come from
+    # the order-4 term as ``derive`` gets it (``order_four``), evaluated with its common
+    # subexpressions shared; the spot points are not the grid the constants come from
     I4 = sp.lambdify((DH.u, DH.E, DH.rho, DH.A3), DH.order_four(), "mpmath", cse=True)
     with mp.workdps(60):
         for uu in (0.05, 0.7, 3.0, 40.0, 3000.0):
