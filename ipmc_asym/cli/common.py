@@ -543,7 +543,8 @@ def first_run_notice(command: str | None = None):
     Quiet once ``ipmc-asym warmup`` has compiled everything, or once ``command`` (a command and the
     variant whose kernels differ, e.g. ``"step-pnp"``) has run with this cache.
     """
-    from ipmc_asym.kernels.jit import CACHE_DIR  # deferred: loads Numba; only the first-compile notice needs it
+    from ipmc_asym.kernels.jit import CACHE_DIR, compile_notice_given  # deferred: loads Numba
+
 
     ran = os.path.join(CACHE_DIR, f".ipmc_asym-ran-{command}") if command else None
     if os.path.exists(os.path.join(CACHE_DIR, WARM_MARKER)) or (ran is not None and os.path.exists(ran)):
@@ -555,6 +556,7 @@ def first_run_notice(command: str | None = None):
                      "the PNP solver on a busy machine); later runs load them from the cache ('ipmc-asym warmup' "
                      "compiles all of them at once)\n")
     sys.stderr.flush()
+    compile_notice_given()
     if ran is not None:
         _touch(ran)
 

@@ -99,6 +99,9 @@ def _steps():
 
 def _group(i):
     """Run step ``i`` of :func:`_steps` (in a worker process of ``--jobs``); its seconds."""
+    from ipmc_asym.kernels.jit import compile_notice_given  # deferred: loads Numba
+
+    compile_notice_given()  # the parent has said what compiles
     t0 = time.perf_counter()
     _steps()[i][1]()
     return time.perf_counter() - t0
@@ -107,8 +110,9 @@ def _group(i):
 def run(args):
     if args.jobs > MAX_JOBS:
         raise ValueError(f"--jobs must be an integer in [1, {MAX_JOBS}]; got {args.jobs}")
-    from ipmc_asym.kernels.jit import CACHE_DIR  # deferred: loads Numba
+    from ipmc_asym.kernels.jit import CACHE_DIR, compile_notice_given  # deferred: loads Numba
 
+    compile_notice_given()  # the line below says it
     steps = _steps()
     sys.stderr.write(f"ipmc-asym warmup: compiling the kernels of {len(steps)} groups into {CACHE_DIR} "
                      "(a few minutes on a busy machine; once per install)\n")

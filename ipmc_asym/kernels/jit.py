@@ -12,13 +12,14 @@ from __future__ import annotations
 import ast
 import hashlib
 import os
+import sys
 import types
 from pathlib import Path
 
 import numba as nb
 from numba.core import caching
 
-__all__ = ["jit", "jit_parallel", "prange", "CACHE_DIR", "interpreted"]
+__all__ = ["jit", "jit_parallel", "prange", "CACHE_DIR", "interpreted", "compile_notice_given"]
 
 
 #: names whose import from this module marks a module that defines jitted code
@@ -164,8 +165,33 @@ class _PackageCacheImpl(caching.CompileResultCacheImpl):
     _locator_classes = [_PackageCacheLocator]
 
 
+#: whether this process has said on stderr that it compiles (once: by the command line's own notice,
+#: ``ipmc-asym warmup``'s, or :meth:`_PackageFunctionCache.load_overload`)
+_NOTICE = {"given": False}
+
+
+def compile_notice_given() -> None:
+    """Record that a line about compiling has been written (the command line's notices): the
+    library then does not write its own."""
+    _NOTICE["given"] = True
+
+
 class _PackageFunctionCache(caching.FunctionCache):
     _impl_class = _PackageCacheImpl
+
+    def load_overload(self, sig, target_context):
+        """The cached code for ``sig``, or None: Numba then compiles, which takes from seconds (a
+        kernel) to minutes (a fused driver and what it calls: ~35 s for the moment's); a library
+        call that waits that long says so on stderr, once per process, before the compiler runs."""
+        data = super().load_overload(sig, target_context)
+        if data is None and not _NOTICE["given"]:
+            _NOTICE["given"] = True
+            name = getattr(self._py_func, "__qualname__", "a kernel")
+            sys.stderr.write(f"ipmc_asym: compiling the Numba kernels this call needs (first: {name}), once per "
+                             f"install: ~20 s to a few minutes; later runs load them from {CACHE_DIR} "
+                             "('ipmc-asym warmup' compiles all of them at once)\n")
+            sys.stderr.flush()
+        return data
 
 
 def _cached(dispatcher):

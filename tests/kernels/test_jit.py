@@ -113,6 +113,38 @@ def test_a_copy_of_the_package_elsewhere_shares_the_compiled_code(tmp_path):
     assert path_in_copy(edit=True) != here
 
 
+def test_a_library_call_that_compiles_says_so_once(tmp_path):
+    """A call that compiles (a fresh cache) writes one line on stderr before the compiler runs,
+    once per process however many kernels compile; a call whose kernels load from the cache is
+    silent."""
+    import os
+    import subprocess
+    import sys
+
+    code = ("import numpy as np; from ipmc_asym.kernels.bernoulli import bernoulli_point, bernoulli_array; "
+            "bernoulli_point(0.5); bernoulli_array(np.ones(3))")
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"))
+
+    def stderr():
+        p = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=300)
+        assert p.returncode == 0, p.stderr
+        return p.stderr
+
+    first = stderr()
+    assert first.count("compiling the Numba kernels") == 1 and "bernoulli_point" in first, first
+    assert stderr() == ""
+
+
+def test_the_command_line_notice_silences_the_library_s(monkeypatch, tmp_path, capsys):
+    from ipmc_asym.cli.common import first_run_notice
+
+    monkeypatch.setattr(_jit, "CACHE_DIR", str(tmp_path))  # an empty cache: the notice speaks
+    monkeypatch.setitem(_jit._NOTICE, "given", False)
+    first_run_notice()
+    assert "compiling the Numba kernels" in capsys.readouterr().err
+    assert _jit._NOTICE["given"]
+
+
 # --------------------------------------------------------------------------------------
 # Interpreted twins (start-up of one-shot commands): same source, same numbers
 # --------------------------------------------------------------------------------------
