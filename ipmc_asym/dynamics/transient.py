@@ -56,7 +56,7 @@ import numpy as np
 
 from ipmc_asym.dynamics.electrode import charge_scale, layer_voltage
 from ipmc_asym.kernels._generated import b1_exact
-from ipmc_asym.kernels.bernoulli import bernoulli_array, bernoulli_pair
+from ipmc_asym.kernels.bernoulli import bernoulli_array
 from ipmc_asym.kernels.pnp import linear_rhs, newton_delta, sg_rhs
 from ipmc_asym.model import groups
 from ipmc_asym.model.params import NAFION_LI, Material, Strip, check_positive
@@ -248,11 +248,6 @@ class _Problem:
         psi = self.psi0(t) + np.cumsum(dpsi[:-1])  # cell centres
         return c, d, r, dpsi, psi
 
-    def flux(self, c, dpsi):
-        """SG flux at the interior faces 1..N-1."""
-        bp, bm = bernoulli_pair(np.ascontiguousarray(dpsi[1:-1]))
-        return (c[:-1] * bp - c[1:] * bm) / self.delta
-
     def jacobian(self, S, t):
         """Analytic Jacobian of ``dS/dt = -N`` as ``-(T + u v^T)``: ``(lower, diag, upper, u, v)``.
 
@@ -294,7 +289,7 @@ class _Problem:
     def outputs(self, S, t, dpsi0):
         """``(d_0, dd_0/dt, profile moment, free energy, c)`` at one time (``dpsi0 = dpsi0/dt``)."""
         c, d, r, dpsi, psi = self.fields(S, t)
-        Nf = self.flux(c, dpsi)
+        Nf = -sg_rhs(np.ascontiguousarray(S), float(self.psi0(t)), self.h, self.delta, self.lam2, self.rho)
         # dd0/dt from the constraint: sum r_f (d0 + S_f) = lam^2 psi0(t)
         Sdot = np.zeros(self.N + 1)
         Sdot[1:-1] = -Nf
@@ -322,10 +317,11 @@ class _Problem:
 
     def rhs(self, t, y, with_diss):
         S = y[: self.N - 1]
+        minus_N = sg_rhs(S, float(self.psi0(t)), self.h, self.delta, self.lam2, self.rho)
         if not with_diss:
-            return sg_rhs(S, float(self.psi0(t)), self.h, self.delta, self.lam2, self.rho)
+            return minus_N
+        Nf = -minus_N
         c, d, r, dpsi, psi = self.fields(S, t)
-        Nf = self.flux(c, dpsi)
         mu = np.log(np.maximum(c, 1e-300)) + psi
         diss = float(np.dot(Nf, mu[:-1] - mu[1:]))
         return np.concatenate((-Nf, [diss]))

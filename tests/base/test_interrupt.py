@@ -50,5 +50,12 @@ def test_the_command_line_ends_with_the_signal_s_status_when_it_was_only_flagged
         return rc
 
     monkeypatch.setattr(cli, "_run", run_and_signal)
-    assert cli.main(["laws", "--model", "constant"]) == 130
+    # Python's own SIGINT handler, whatever this process inherited: a shell starts a background job
+    # with SIGINT ignored, and an ignored signal stays ignored under handling_signals (nohup)
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        rc = cli.main(["laws", "--model", "constant"])
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    assert rc == 130
     assert "interrupted (Ctrl-C)" in capsys.readouterr().err
