@@ -67,6 +67,7 @@ def _steps():
     def transient():
         ia.step_response(1.0, points=50)
         ia.step_response(0.1, duration=0.05, points=20, fidelity="pnp")
+        ia.step_response(0.1, duration=0.05, points=20, fidelity="pnp", model="linear")  # its own right-hand side
 
     def spectrum():
         f = np.geomspace(1.0, 1e3, 20)

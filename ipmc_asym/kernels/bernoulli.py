@@ -1,9 +1,9 @@
 """The Bernoulli function of the Scharfetter-Gummel flux, ``B(x) = x/(e^x - 1)``, over an array.
 
-The transient Nernst-Planck solver (:mod:`ipmc_asym.dynamics.transient`) evaluates ``B`` at both
-signs of every interior face's potential jump, several times per time step; a compiled loop does
-it in one pass over the faces where the masked NumPy form took a quarter of the solver's time
-(measured: 5.2 of 20 s, affine model, 200 um, 2 V, tol 1e-4).
+The transient Nernst-Planck solver evaluates ``B`` at both signs of every interior face's potential
+jump (:mod:`ipmc_asym.kernels.pnp`, point by point) and, for its Jacobian, over arrays
+(:func:`bernoulli_array`): compiled, where the masked NumPy form took a quarter of the solver's
+time (measured: 5.2 of 20 s, affine model, 200 um, 2 V, tol 1e-4).
 """
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ import numpy as np
 
 from ipmc_asym.kernels.jit import jit
 
-__all__ = ["bernoulli_point", "bernoulli_array", "bernoulli_pair"]
+__all__ = ["bernoulli_point", "bernoulli_array"]
 
 
 @jit
@@ -38,14 +38,3 @@ def bernoulli_array(x):
     for i in range(x.size):
         out[i] = bernoulli_point(x[i])
     return out
-
-
-@jit
-def bernoulli_pair(x):
-    """``(B(x), B(-x))`` at each element of the 1-D array ``x`` (the two directions of a face's flux)."""
-    bp = np.empty(x.size)
-    bm = np.empty(x.size)
-    for i in range(x.size):
-        bp[i] = bernoulli_point(x[i])
-        bm[i] = bernoulli_point(-x[i])
-    return bp, bm
