@@ -272,7 +272,7 @@ def _closed_block(lam, A2, A3, rho, model_id, order, I, err, B1, core):
 @jit_parallel
 def _sweep(lam, A2, A3, rho, model_id, order, sign, I, err, B1, core):
     """The bare sweep driver on precomputed groups (prange; the bench's kernel cost):
-    ``order`` 1 leading, 2 corrected (blocks, as in :func:`_sweep_fused`), 0 quadrature, 3 exact."""
+    ``order`` 1 leading, 2 corrected (blocks, as in :func:`_fused_blocks`), 0 quadrature, 3 exact."""
     n = lam.size
     if order == 1 or order == 2:
         for b in prange((n + BLOCK - 1) // BLOCK):
@@ -300,24 +300,26 @@ def _groups_point(t, vv, lamc, a2c):
     return lamc / t, a2c * abs(vv)
 
 
-@jit
-def _sweep_fused(th, v, lamc, a2c, A3, rho, model_id, order, any_thickness, limit,
-                 I, err, B1, core, lam_o, A2_o, valid, nan_invalid=False):
-    """The fused sweep driver: groups, sign and validity computed inside the parallel loop.
+def _fused_driver(order: int):
+    """The fused sweep driver of the rung ``order`` (``kernel_code`` of the registry): groups,
+    sign and validity computed inside the parallel loop.  :func:`_fused_blocks` for the closed
+    forms (1 leading, 2 corrected), :func:`_fused_points` for 0 quadrature and 3 exact.
 
-    ``th``, ``v``: flat arrays of the output size or of size 1 (broadcast); the outputs are
-    flat views of the result arrays, so nothing else is allocated.  ``I`` and ``valid`` are
-    always written; the other outputs only if they have the size of ``I`` (pass empty arrays
-    for those not wanted: :func:`moment_integral` needs ``I`` and ``valid`` only), and
-    ``nan_invalid`` puts NaN in ``I`` where the point is invalid (no second pass over the
-    arrays).  Returns the counts of bad thicknesses (not finite or <= 0), of bad voltages
-    (not finite) -- those points are left as NaN and the caller raises -- and of invalid points.
+    Chosen here, in Python, rather than by a compiled branch on ``order``: a compiled dispatcher
+    compiles every rung it can reach, so the first ``leading`` call compiled the quadrature and
+    exact rungs too (~35 s in a fresh cache instead of the closed forms' share).
+
+    Both take ``(th, v, lamc, a2c, A3, rho, model_id, order, any_thickness, limit, I, err, B1,
+    core, lam_o, A2_o, valid, nan_invalid)``: ``th``, ``v`` flat arrays of the output size or of
+    size 1 (broadcast); the outputs are flat views of the result arrays, so nothing else is
+    allocated.  ``I`` and ``valid`` are always written; the other outputs only if they have the
+    size of ``I`` (pass empty arrays for those not wanted: :func:`moment_integral` needs ``I`` and
+    ``valid`` only), and ``nan_invalid`` puts NaN in ``I`` where the point is invalid (no second
+    pass over the arrays).  They return the counts of bad thicknesses (not finite or <= 0), of bad
+    voltages (not finite) -- those points are left as NaN and the caller raises -- and of invalid
+    points.
     """
-    if order == 1 or order == 2:  # closed forms: blocks of points, stage by stage
-        return _fused_blocks(th, v, lamc, a2c, A3, rho, model_id, order, any_thickness, limit,
-                             I, err, B1, core, lam_o, A2_o, valid, nan_invalid)
-    return _fused_points(th, v, lamc, a2c, A3, rho, model_id, order, any_thickness, limit,
-                         I, err, B1, core, lam_o, A2_o, valid, nan_invalid)
+    return _fused_blocks if order in (1, 2) else _fused_points
 
 
 @jit(inline="always")
@@ -363,7 +365,7 @@ def _put(i, t, vv, lam, A2, Ii, e_i, b1, c, limit, any_thickness, nan_invalid, f
 @jit_parallel
 def _fused_blocks(th, v, lamc, a2c, A3, rho, model_id, order, any_thickness, limit,
                   I, err, B1, core, lam_o, A2_o, valid, nan_invalid):
-    """:func:`_sweep_fused` for the closed forms: blocks of ``BLOCK`` points, stage by stage
+    """The fused driver (:func:`_fused_driver`) of the closed forms: blocks of ``BLOCK`` points, stage by stage
     (:func:`_closed_block`); bit for bit the per-point results."""
     n = I.size
     sth = th.size > 1
@@ -419,7 +421,7 @@ def _fused_blocks(th, v, lamc, a2c, A3, rho, model_id, order, any_thickness, lim
 @jit_parallel
 def _fused_points(th, v, lamc, a2c, A3, rho, model_id, order, any_thickness, limit,
                   I, err, B1, core, lam_o, A2_o, valid, nan_invalid):
-    """:func:`_sweep_fused` point by point (``quadrature``, ``exact``)."""
+    """The fused driver (:func:`_fused_driver`) point by point (``quadrature``, ``exact``)."""
     n = I.size
     sth = th.size > 1
     sv = v.size > 1
@@ -825,7 +827,7 @@ def _fused(thickness, voltage, perm: Permittivity, mat: Material, fidelity: str,
     if floor:  # False: the caller's Strip or edge check holds it
         check_min_thickness(th)
     outs = [a.reshape(-1) for a in extra] if full else [np.empty(0)] * 5
-    counts = _run_driver(_sweep_fused, I.size, fidelity, (
+    counts = _run_driver(_fused_driver(_FIDELITY_SPECS[fidelity].kernel_code), I.size, fidelity, (
         _flat_input(th, shape), _flat_input(v, shape), *_driver_constants(perm, mat, fidelity),
         I.reshape(-1), *outs, valid.reshape(-1), not full), parallel=True)
     return I, valid, extra, counts

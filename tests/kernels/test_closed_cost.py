@@ -1,7 +1,7 @@
 """What a closed-form point costs in transcendental calls: the reason the closed forms are
 measured against a loop of seven of them (``ipmc-asym bench``) and where their time goes.
 
-The interpreted twin of the fused driver runs the compiled driver's own source (bit for bit,
+The interpreted twin of the closed forms' fused driver runs the compiled driver's own source (bit for bit,
 ``test_jit.py``); its ``math`` is swapped for a counter, so the count is that of the compiled
 code's path through each point (the sweep of the bench's closed-form figures)."""
 
@@ -45,14 +45,14 @@ def test_closed_forms_spend_about_two_transcendental_calls_a_point(model, fideli
     v = np.exp(np.linspace(np.log(1e-3), np.log(10.0), n))[::-1].copy()
     consts = integral._driver_constants(get_model(model), NAFION_LI, fidelity)
     out = [np.empty(n) for _ in range(6)] + [np.empty(n, bool)]
-    twin = _jit.interpreted(integral._sweep_fused)
-    twin(th[:2], v[:2], *consts, *[a[:2] for a in out])  # every twin module's globals exist now
+    twin = _jit.interpreted(integral._fused_blocks)
+    twin(th[:2], v[:2], *consts, *[a[:2] for a in out], False)  # every twin module's globals exist now
     counts = collections.Counter()
     saved = {k: g["math"] for k, g in _jit._TWIN_GLOBALS.items() if "math" in g}
     try:
         for k in saved:
             _jit._TWIN_GLOBALS[k]["math"] = _CountingMath(counts)
-        twin(th, v, *consts, *out)
+        twin(th, v, *consts, *out, False)
     finally:
         for k, m in saved.items():
             _jit._TWIN_GLOBALS[k]["math"] = m
@@ -61,5 +61,5 @@ def test_closed_forms_spend_about_two_transcendental_calls_a_point(model, fideli
     assert counts["sqrt"] / n <= 2.5, dict(counts)
     # the compiled driver gives the same numbers: the count is that of the compiled path
     ref = [np.empty(n) for _ in range(6)] + [np.empty(n, bool)]
-    integral._sweep_fused(th, v, *consts, *ref)
+    integral._fused_blocks(th, v, *consts, *ref, False)
     assert np.array_equal(out[0], ref[0], equal_nan=True)

@@ -177,10 +177,11 @@ def test_interpreted_driver_is_the_compiled_one_bit_for_bit(fidelity, model):
     consts = integral._driver_constants(get_model(model), NAFION_LI, fidelity)
     a = [np.empty(n) for _ in range(6)] + [np.empty(n, bool)]
     b = [np.empty(n) for _ in range(6)] + [np.empty(n, bool)]
-    integral._sweep_fused(th, v, *consts, *a)
+    driver = integral._fused_driver(consts[5])
+    driver(th, v, *consts, *a, False)
     try:
         with np.errstate(all="raise", under="ignore"):
-            _jit.interpreted(integral._sweep_fused)(th, v, *consts, *b)
+            _jit.interpreted(driver)(th, v, *consts, *b, False)
     except (ArithmeticError, ValueError):
         pytest.skip("the interpreter met an inf/NaN the compiled code returns: the caller falls back")
     for x, y in zip(a, b):
@@ -188,7 +189,7 @@ def test_interpreted_driver_is_the_compiled_one_bit_for_bit(fidelity, model):
 
 
 def test_interpreted_twins_call_twins_not_dispatchers():
-    twin = _jit.interpreted(integral._sweep_fused)
+    twin = _jit.interpreted(integral._fused_points)
     assert not _jit._is_jitted(twin)
     assert not _jit._is_jitted(twin.__globals__["_point"])
     assert _jit.interpreted(len) is len  # not jitted: itself
@@ -199,7 +200,8 @@ def test_estimate_interprets_a_few_points_and_loads_nothing_compiled():
     (that load is what made start-up 2.6x ``import numba``); ``--compiled`` loads it; same output."""
     code = ("import sys; from ipmc_asym.cli import main; import ipmc_asym.integral.api as integral; "
             "rc = main(['estimate', '--fidelity', 'leading', '--json'] + sys.argv[1:]); "
-            "sys.stderr.write('LOADED %d' % len(integral._sweep_fused.signatures))")
+            "sys.stderr.write('LOADED %d' % (len(integral._fused_blocks.signatures) "
+            "+ len(integral._fused_points.signatures)))")
     out = {}
     for extra in ([], ["--compiled"]):
         p = subprocess.run([sys.executable, "-c", code, *extra], capture_output=True, text=True, timeout=600)
