@@ -180,13 +180,16 @@ def _core_error(core, lam):
 
 @jit
 def _point(lam, A2, A3, rho, model_id, order, fz=None):
-    """(I for ``|phi0|``, error, B1, core) of one point; ``order`` 0 = quadrature, 3 = exact.
+    """(I for ``|phi0|``, error, B1, core) of one point; ``order`` 0 = quadrature, 3 = exact, 1 and 2
+    the closed forms (:func:`_closed_point`, which a closed-form driver calls directly).
 
     ``fz``: for ``exact``, the frozen cores of the caller's sweep (:func:`exact_frozen`), or None.
 
     ``error`` bounds the relative error of the returned ``I`` (not of one term of it).
     Zero volts: no field, I = 0 exactly (the odd extension; no 0/0).
     """
+    if order == 1 or order == 2:
+        return _closed_point(lam, A2, A3, rho, model_id, order)
     if A2 == 0.0:
         return 0.0, 0.0, 1.0, 2.0
     if A2 < DH_A2:  # small voltage: the Debye-Hueckel series, no eps/A2 rounding
@@ -196,9 +199,18 @@ def _point(lam, A2, A3, rho, model_id, order, fz=None):
         if niter < 0:  # thickness constraint not met: no number, and invalid
             return math.nan, math.inf, b1, c
         return Ii, EXACT_STATED_ERROR, b1, c
-    if order == 0:
-        Ii, J1, J2, b1, c = moment_quadrature(lam, A2, A3, rho)
-        return Ii, ROUNDING_ERROR + _core_error(c, lam), b1, c
+    Ii, J1, J2, b1, c = moment_quadrature(lam, A2, A3, rho)  # order 0
+    return Ii, ROUNDING_ERROR + _core_error(c, lam), b1, c
+
+
+@jit
+def _closed_point(lam, A2, A3, rho, model_id, order):
+    """:func:`_point` of the closed forms (``order`` 1 leading, 2 corrected): no quadrature or exact
+    code is reachable from here, so a driver of the closed forms compiles only them."""
+    if A2 == 0.0:
+        return 0.0, 0.0, 1.0, 2.0
+    if A2 < DH_A2:  # small voltage: the Debye-Hueckel series, no eps/A2 rounding
+        return _dh_point(lam, A2, A3, rho, order)
     return _closed_post(lam, *moment_closed(lam, A2, A3, rho, model_id, order))
 
 
@@ -448,10 +460,24 @@ def _fused_points(th, v, lamc, a2c, A3, rho, model_id, order, any_thickness, lim
 @jit
 def _scalar_point(t, vv, lamc, a2c, A3, rho, model_id, order, any_thickness, limit, fz=None):
     """``(I, valid)`` of one point (the scalar fast path of :func:`moment_integral`); ``fz`` as
-    :func:`_point` (kept between calls by the caller)."""
+    :func:`_point` (kept between calls by the caller).  Quadrature and exact; the closed forms have
+    :func:`_scalar_closed` (see :func:`_scalar_driver`)."""
     lam, A2 = _groups_point(t, vv, lamc, a2c)
     Ii, e_i, b1, c = _point(lam, A2, A3, rho, model_id, order, fz)
     return (Ii if vv >= 0.0 else -Ii), (e_i < limit) and (c > 0.0 or any_thickness)
+
+
+@jit
+def _scalar_closed(t, vv, lamc, a2c, A3, rho, model_id, order, any_thickness, limit):
+    """:func:`_scalar_point` of the closed forms (:func:`_closed_point`: it compiles only them)."""
+    lam, A2 = _groups_point(t, vv, lamc, a2c)
+    Ii, e_i, b1, c = _closed_point(lam, A2, A3, rho, model_id, order)
+    return (Ii if vv >= 0.0 else -Ii), (e_i < limit) and (c > 0.0 or any_thickness)
+
+
+def _scalar_driver(order: int):
+    """The scalar fast path's driver of the rung ``order``, chosen in Python as :func:`_fused_driver`."""
+    return _scalar_closed if order in (1, 2) else _scalar_point
 
 
 def _driver_constants(perm: Permittivity, mat: Material, fidelity: str) -> tuple:
@@ -763,7 +789,7 @@ def moment_integral(thickness, voltage, model="constant", fidelity="quadrature",
             _SCALAR_CACHE[(model, fidelity)] = consts
         t, vv = float(thickness), float(voltage)
         if consts is not None and t >= MIN_THICKNESS and math.isfinite(t) and math.isfinite(vv):
-            Ii, ok = _run_driver(_scalar_point, 1, fidelity, (t, vv, *consts))
+            Ii, ok = _run_driver(_scalar_driver(consts[5]), 1, fidelity, (t, vv, *consts))
             if ok:
                 return Ii
     lean = _lean_integral(thickness, voltage, model, fidelity, material, material_kw)
