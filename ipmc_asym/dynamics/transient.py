@@ -320,11 +320,10 @@ class _Problem:
         minus_N = sg_rhs(S, float(self.psi0(t)), self.h, self.delta, self.lam2, self.rho)
         if not with_diss:
             return minus_N
-        Nf = -minus_N
         c, d, r, dpsi, psi = self.fields(S, t)
         mu = np.log(np.maximum(c, 1e-300)) + psi
-        diss = float(np.dot(Nf, mu[:-1] - mu[1:]))
-        return np.concatenate((-Nf, [diss]))
+        diss = float(np.dot(-minus_N, mu[:-1] - mu[1:]))
+        return np.concatenate((minus_N, [diss]))
 
 
 def _int_x_over_linear(H, ln_c0, c1):
@@ -584,18 +583,14 @@ class _LinearProblem(_Problem):
 
     def rhs(self, t, y, with_diss):
         S = y[: self.N - 1]
+        minus_N, self._delta = linear_rhs(S, float(self.psi0(t)), self.h, self.delta, self.lam2, self.wL, self.wR,
+                                          self.GL, self.GR, self._delta)
         if not with_diss:
-            out, x = linear_rhs(S, float(self.psi0(t)), self.h, self.delta, self.lam2, self.wL, self.wR, self.GL,
-                                self.GR, self._delta)
-            self._delta = x
-            return out
-        Sf, c = self.unpack(S)
-        d0 = self.solve_d0(S, t)[0]
-        Nf = self.flux(c, d0 + Sf)
-        _, _, _, _, psi = self.fields(S, t)
+            return minus_N
+        c, _, _, _, psi = self.fields(S, t)
         mu = np.log(np.maximum(c, 1e-300)) + psi
-        diss = float(np.dot(Nf, mu[:-1] - mu[1:]))
-        return np.concatenate((-Nf, [diss]))
+        diss = float(np.dot(-minus_N, mu[:-1] - mu[1:]))
+        return np.concatenate((minus_N, [diss]))
 
 
 class _BorderedJacobian:
