@@ -3,8 +3,8 @@
 The finite-volume scheme is :mod:`ipmc_asym.dynamics.transient`'s (its class notes hold the
 derivation); these loops evaluate its right-hand side ``dS/dt = -N`` in one pass over the faces.
 The integrator calls it ~1e5 times per run on a few hundred cells, where NumPy's per-call
-overhead on small arrays was most of the solver's time (measured: ~12 of 27 s, affine model,
-200 um, 1 V, tol 1e-2, under cProfile).
+overhead on small arrays would be most of the solver's time (measured with the NumPy form: ~12 of
+27 s, affine model, 200 um, 1 V, tol 1e-2, under cProfile).
 """
 
 from __future__ import annotations
