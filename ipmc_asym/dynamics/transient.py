@@ -211,12 +211,18 @@ class TransientResult:
     current_error: np.ndarray | None = None
 
 
-#: rows per block of the linear model's vectorised outputs (see _solve_once)
+#: rows per block of the vectorised outputs (see _solve_once)
 _OUTPUT_BLOCK = 32
 
 
 class _Problem:
-    def __init__(self, X, lam, rho, psi0_fun, A3):
+    """The affine model's finite-volume problem (see the module notes).
+
+    ``psi0_fun(t)``: the applied potential at one scaled time (float); ``psi0_many(t)``: the same at an
+    array of times (the outputs are computed for blocks of times at once; default: one call per time).
+    """
+
+    def __init__(self, X, lam, rho, psi0_fun, A3, psi0_many=None):
         self.X = X
         self.h = np.diff(X)
         self.N = self.h.size
@@ -225,6 +231,8 @@ class _Problem:
         self.lam2 = lam * lam
         self.rho = rho
         self.psi0 = psi0_fun
+        self.psi0_many = psi0_many if psi0_many is not None else (
+            lambda ts: np.array([psi0_fun(x) for x in np.atleast_1d(ts)], dtype=float))
         self.A3 = A3
 
     def unpack(self, S):
@@ -286,34 +294,50 @@ class _Problem:
         v = -(r[1:-1] + g[:-1] - g[1:]) / Rs
         return -lower, -diag, -upper, -u, v
 
-    def outputs(self, S, t, dpsi0):
-        """``(d_0, dd_0/dt, profile moment, free energy, c)`` at one time (``dpsi0 = dpsi0/dt``)."""
-        c, d, r, dpsi, psi = self.fields(S, t)
-        Nf = -sg_rhs(np.ascontiguousarray(S), float(self.psi0(t)), self.h, self.delta, self.lam2, self.rho)
-        # dd0/dt from the constraint: sum r_f (d0 + S_f) = lam^2 psi0(t)
-        Sdot = np.zeros(self.N + 1)
-        Sdot[1:-1] = -Nf
-        Nfull = np.zeros(self.N + 1)
-        Nfull[1:-1] = Nf
-        cdot = -np.diff(Nfull) / self.h
-        eh = self.rho + (1.0 - self.rho) * c
-        hdot = -0.5 * self.h * (1.0 - self.rho) * cdot / (eh * eh)
-        rdot = np.empty(self.N + 1)
-        rdot[0], rdot[-1] = hdot[0], hdot[-1]
-        rdot[1:-1] = hdot[:-1] + hdot[1:]
-        J = (self.lam2 * dpsi0 - np.dot(r, Sdot) - np.dot(rdot, d)) / np.sum(r)
+    def outputs_all(self, S2, t, dpsi0):
+        """``(d_0, dd_0/dt, profile moment, free energy, c)`` at the states ``S2`` (m, n), times ``t`` (m,)
+        (``dpsi0 = dpsi0/dt``), rows at once (a drive's reference has ~10^4 output times: one NumPy
+        pass per time cost ~200 us of call overhead each, most of a sine drive's PNP run)."""
+        S2 = np.ascontiguousarray(S2, dtype=float)
+        m, N, h, rho, lam2 = S2.shape[0], self.N, self.h, self.rho, self.lam2
+        p0 = self.psi0_many(t)
+        Sf = np.zeros((m, N + 1))
+        Sf[:, 1:-1] = S2
+        c = 1.0 + np.diff(Sf, axis=-1) / h
+        eh = rho + (1.0 - rho) * c
+        half = 0.5 * h / eh
+        r = np.zeros((m, N + 1))
+        r[:, :-1] += half
+        r[:, 1:] += half
+        Rs = np.sum(r, axis=-1)
+        d0 = (lam2 * p0 - np.einsum("ij,ij->i", r, Sf)) / Rs
+        d = d0[:, None] + Sf
+        # the flux from the integrator's own kernel (one home for it), a row at a time
+        Nfull = np.zeros((m, N + 1))
+        for k in range(m):
+            Nfull[k, 1:-1] = -sg_rhs(S2[k], float(p0[k]), h, self.delta, lam2, rho)
+        # dd0/dt from the constraint: sum r_f (d0 + S_f) = lam^2 psi0(t), with dS_f/dt = -N_f
+        cdot = -np.diff(Nfull, axis=-1) / h
+        hdot = -0.5 * h * (1.0 - rho) * cdot / (eh * eh)
+        rdot = np.zeros((m, N + 1))
+        rdot[:, :-1] += hdot
+        rdot[:, 1:] += hdot
+        J = (lam2 * np.asarray(dpsi0, dtype=float) + np.einsum("ij,ij->i", r, Nfull)
+             - np.einsum("ij,ij->i", rdot, d)) / Rs
         M = self._moment(c, d, eh)
         cpos = np.maximum(c, 1e-300)
-        Fe = float(np.dot(r, d * d) / (2 * self.lam2) + np.dot(self.h, cpos * np.log(cpos) - cpos + 1.0))
-        return d[0], J, M, Fe, c
+        Fe = np.einsum("ij,ij->i", r, d * d) / (2 * lam2) + (cpos * np.log(cpos) - cpos + 1.0) @ h
+        return d0, J, M, Fe, c
 
     def _moment(self, c, d, eh):
-        """Moment from the profiles: ``(c + A3) (-dpsi)`` over the half cells, weight ``(1 - z^2)/2``."""
+        """Moment from the profiles: ``(c + A3) (-dpsi)`` over the half cells, weight ``(1 - z^2)/2``
+        (one state, or rows)."""
         zl = self.xc - 0.25 * self.h
         zr = self.xc + 0.25 * self.h
         drop = 0.5 * self.h / eh / self.lam2  # -dpsi per unit d over a half cell
-        return float(np.sum((c + self.A3) * drop * (d[:-1] * 0.75 + d[1:] * 0.25) * (1 - zl * zl) / 2
-                            + (c + self.A3) * drop * (d[:-1] * 0.25 + d[1:] * 0.75) * (1 - zr * zr) / 2))
+        M = np.sum((c + self.A3) * drop * (d[..., :-1] * 0.75 + d[..., 1:] * 0.25) * (1 - zl * zl) / 2
+                   + (c + self.A3) * drop * (d[..., :-1] * 0.25 + d[..., 1:] * 0.75) * (1 - zr * zr) / 2, axis=-1)
+        return float(M) if np.ndim(M) == 0 else M
 
     def rhs(self, t, y, with_diss):
         S = y[: self.N - 1]
@@ -360,8 +384,8 @@ class _LinearProblem(_Problem):
     midpoint rule per cell.  The methods take one state ``S`` (n,) or a stack (m, n).
     """
 
-    def __init__(self, X, lam, rho, psi0_fun, A3):
-        super().__init__(X, lam, 0.0, psi0_fun, A3)
+    def __init__(self, X, lam, rho, psi0_fun, A3, psi0_many=None):
+        super().__init__(X, lam, 0.0, psi0_fun, A3, psi0_many)
         h = self.h
 
         def face_coefs(hs):
@@ -428,7 +452,7 @@ class _LinearProblem(_Problem):
         one = S.ndim == 1
         S2 = np.atleast_2d(S)
         Sf, c, Nhat, w, a_L, a_R = self._parts(S2) if parts is None else parts
-        p0 = np.broadcast_to(np.asarray([self.psi0(x) for x in np.atleast_1d(t)], dtype=float), a_L.shape)
+        p0 = np.broadcast_to(self.psi0_many(t), a_L.shape)
         ok = np.all(c > 0.0, axis=-1) & (a_L * self.GR + a_R * self.GL > 0.0)
         W = np.sum(np.where(ok[:, None], w, 1.0), axis=-1) / self.lam2
         I0 = np.sum(np.where(ok[:, None], Nhat * w, 0.0), axis=-1)
@@ -535,7 +559,7 @@ class _LinearProblem(_Problem):
         # face extrapolation with the slope d_0/lambda^2 would put an O(h) layer there)
         at0 = (np.asarray(t) == 0.0) & ~np.any(S2, axis=-1)
         if np.any(at0):
-            d0 = np.where(at0, 0.5 * self.lam2 * np.array([self.psi0(x) for x in t]), d0)
+            d0 = np.where(at0, 0.5 * self.lam2 * self.psi0_many(t), d0)
             d = d0[:, None] + Sf
             lnL = np.where(at0, 0.0, lnL)
             lnR = np.where(at0, 0.0, lnR)
@@ -1010,7 +1034,10 @@ def _solve_once(t, phi0_fun, strip, model, material, *, cells_per_debye, ratio, 
     def psi0(th):
         return float(phi0_fun(np.array([th * tscale]))[0]) / VT
 
-    P = (_LinearProblem if rho == 0.0 else _Problem)(X, lam, rho, psi0, A3)
+    def psi0_many(th):
+        return np.asarray(phi0_fun(np.asarray(th, dtype=float).reshape(-1) * tscale), dtype=float) / VT
+
+    P = (_LinearProblem if rho == 0.0 else _Problem)(X, lam, rho, psi0, A3, psi0_many)
     n = P.N - 1 + (1 if energy else 0)
     y0 = np.zeros(n)
     # atol is absolute on S (units of e) while the charge scales with the signal: the small-signal
@@ -1071,28 +1098,22 @@ def _solve_once(t, phi0_fun, strip, model, material, *, cells_per_debye, ratio, 
     Mprof = np.empty(nt)
     Fe = np.empty(nt)
     cs = np.empty((nt, P.N)) if profiles else np.empty((0, P.N))
-    dpsi0 = np.zeros(nt)
-    for k in range(nt):
-        th = sol.t[k]
-        dt = 1e-7 * max(th, 1e-3)
-        dpsi0[k] = (psi0(th + dt) - psi0(max(th - dt, 0.0))) / (th + dt - max(th - dt, 0.0)) if th > 0 else 0.0
-    if isinstance(P, _LinearProblem):
-        # in blocks of rows: the vectorised outputs build ~15 temporaries of the block's size, which
-        # at 1000 times on the finest mesh (~8000 cells) stream through memory 2x slower than blocks
-        # that stay in the cache
-        Y = sol.y[: P.N - 1].T
-        for a in range(0, nt, _OUTPUT_BLOCK):
-            b = min(a + _OUTPUT_BLOCK, nt)
-            d0[a:b], J[a:b], Mprof[a:b], Fe[a:b], cb = P.outputs_all(Y[a:b], sol.t[a:b], dpsi0[a:b])
-            qtot[a:b] = (cb - 1.0) @ P.h
-            if profiles:
-                cs[a:b] = cb
-    else:
-        for k in range(nt):
-            d0[k], J[k], Mprof[k], Fe[k], c = P.outputs(sol.y[: P.N - 1, k], sol.t[k], dpsi0[k])
-            qtot[k] = float(np.dot(c - 1.0, P.h))
-            if profiles:
-                cs[k] = c
+    # dpsi0/dt by a central difference (one-sided at 0; 0 at t = 0)
+    th = np.asarray(sol.t, dtype=float)
+    dt = 1e-7 * np.maximum(th, 1e-3)
+    lo = np.maximum(th - dt, 0.0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        dpsi0 = np.where(th > 0, (psi0_many(th + dt) - psi0_many(lo)) / (th + dt - lo), 0.0)
+    # in blocks of rows: the vectorised outputs build ~15 temporaries of the block's size, which
+    # at 1000 times on the finest mesh (~8000 cells) stream through memory 2x slower than blocks
+    # that stay in the cache
+    Y = sol.y[: P.N - 1].T
+    for a in range(0, nt, _OUTPUT_BLOCK):
+        b = min(a + _OUTPUT_BLOCK, nt)
+        d0[a:b], J[a:b], Mprof[a:b], Fe[a:b], cb = P.outputs_all(Y[a:b], sol.t[a:b], dpsi0[a:b])
+        qtot[a:b] = (cb - 1.0) @ P.h
+        if profiles:
+            cs[a:b] = cb
     sigma = sig_scale * d0
     Jsi = sig_scale * J / tscale
 
