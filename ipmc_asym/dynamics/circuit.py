@@ -297,10 +297,11 @@ def waveform(kind, voltage, *, ramp_time=None, frequency=None):
             t = np.asarray(t, dtype=float)
             try:
                 v = np.asarray(kind(t), dtype=float)
-                v = np.broadcast_to(v, t.shape).astype(float)
+                if v.shape != t.shape:  # a constant, say (the transient solver calls this per step)
+                    v = np.broadcast_to(v, t.shape).astype(float)
             except Exception:  # not vectorised
                 v = np.array([float(kind(x)) for x in t.ravel()]).reshape(t.shape)
-            if not np.all(np.isfinite(v)):
+            if not np.isfinite(v).all():
                 raise ValueError("the voltage function phi0(t) must return finite volts")
             return v
         return user
