@@ -68,8 +68,9 @@ def register(sub):
                         "the circuit's error is bounded against a PNP run over the same waveform and the PNP is used "
                         "where it fails, as in step; adds the columns " + ", ".join(ERROR_COLUMNS) + " (in memory, at "
                         f"most {MAX_STATED_POINTS} points); auto: 1e-2 where the error can be stated (as step's default); "
-                        "default none: no error stated for the circuit (a long waveform's reference PNP run takes "
-                        "10-30 s CPU per 2 s of a 1-10 Hz drive)")
+                        "default none: no error stated for the circuit (the reference PNP run over 2 s of a 1 Hz sine takes "
+                        "~4 s CPU (constant model) to ~11 s (affine), ~14 s at 10 Hz, ~28 s for an affine 1 Hz square "
+                        "wave; it grows with the periods and jumps in the duration)")
     add_beam_options(p)
     add_line_options(p)
     add_support_options(p)
@@ -128,7 +129,7 @@ def run(args):
     if stated:  # the in-memory PNP run is the long part (seconds to minutes): say so before it starts
         what = "the PNP" if args.fidelity == "pnp" else f"the circuit and a reference PNP run (tol {tol:g})"
         sys.stderr.write(f"drive: {what} over {args.points} output times, in memory (the nominal strip, a "
-                         f"sine over 0.2 s: ~3 s CPU at 1001 times, ~14 s at 10001)\n")
+                         f"sine over 2 s: ~4 s CPU at 1 Hz, ~14 s at 10 Hz)\n")
         sys.stderr.flush()
     resp = time_response(strip, args.waveform, duration=args.duration, points=args.points, model=args.model,
                          material=material, fidelity=args.fidelity, tol=args.tol, beam=args.beam,

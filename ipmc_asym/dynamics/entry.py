@@ -54,8 +54,8 @@ ERROR_COLUMNS = ("sigma_error", "current_error", "w_error")
 #: the tolerance on sigma of ``tol="auto"`` (``ipmc-asym step``'s default): the circuit's sigma, current and w
 #: errors stated against a reference PNP run (the PNP where the circuit misses it).  1 % of sigma's peak: the
 #: circuit meets it on the nominal strip at 1 V (constant model), the reference runs at a tenth of it, and the
-#: run costs ~1-10 s CPU instead of the bare circuit's ~0.02 s (measured: constant 2.3 s, linear 3.1 s,
-#: affine 10.5 s at 1 V, where the affine and linear circuits miss 1 % and the PNP is used)
+#: run costs ~1-10 s CPU instead of the bare circuit's ~0.02 s (measured: constant 1.8 s, linear 2.1 s,
+#: affine 6.6 s at 1 V, where the affine and linear circuits miss 1 % and the PNP is used)
 AUTO_TOL = 1e-2
 
 #: how the dynamic beam meets the output grid: ``refined`` (the transient is solved on a grid of >= 40
