@@ -41,7 +41,7 @@ from ipmc_asym.base.registry import fidelity_names
 from ipmc_asym.base.results import Panel, ResultMixin, ResultSpec
 from ipmc_asym.base.settings import BVP_STATED_ERROR, VALIDATED_VOLTAGE, VALIDITY_LIMIT
 from ipmc_asym.integral.api import check_fidelity, check_min_thickness, paper_model_id, run_parallel
-from ipmc_asym.kernels.charge import GL_W, GL_X, charge_sweep
+from ipmc_asym.kernels.charge import GL_W, GL_X, closed_sweep, exact_sweep, near_sweep
 from ipmc_asym.model import groups
 from ipmc_asym.model.params import NAFION_LI, Material, Strip, check_positive
 from ipmc_asym.model.permittivity import Permittivity, get_model
@@ -144,7 +144,7 @@ def charge_inputs(thickness, voltage, model="constant", width=5.0e-3, length=0.0
     return th, v, perm, w, L, mat
 
 
-#: compiled seconds per point of :func:`ipmc_asym.kernels.charge.charge_sweep`, one thread (order
+#: compiled seconds per point of the drivers of :mod:`ipmc_asym.kernels.charge`, one thread (order
 #: of magnitude, measured on 1-10^4 points of 1e-4 < lam < 0.1, 1e-3 < A2 < 100: the closed forms
 #: carry their error estimates and, near overlap, an exact point): with
 #: :data:`ipmc_asym.integral.api.PARALLEL_MIN_S`, the work below which one thread runs
@@ -162,9 +162,22 @@ def charge_at(th, v, perm: Permittivity, w: float, L: float, mat: Material, fide
         lam = np.asarray(groups.debye_length(th, perm.eps_moy, mat), dtype=float).reshape(-1)
         rho = perm.eps0 / perm.eps_moy
         outs = [np.empty(A2.size) for _ in range(5)]
-        run_parallel(charge_sweep, A2.size * CHARGE_COMPILED_S.get(fidelity, 0.0),
-                     (np.ascontiguousarray(A2), np.ascontiguousarray(lam), rho, paper_model_id(perm),
-                      _FIDELITY_SPECS[fidelity].kernel_code, GL_X, GL_W, *outs))
+        A2, lam, mid = np.ascontiguousarray(A2), np.ascontiguousarray(lam), paper_model_id(perm)
+        code = _FIDELITY_SPECS[fidelity].kernel_code
+        work = A2.size * CHARGE_COMPILED_S.get(fidelity, 0.0)
+        # the rung's driver chosen here, not by a compiled branch on the code: a compiled dispatcher
+        # compiles every rung it can reach, and the exact rung is most of the charge's compile
+        # (fresh cache: `ipmc-asym charge` 14 s with one driver for every rung, 5 s with the closed forms' own)
+        if code == 3:
+            run_parallel(exact_sweep, work, (A2, lam, rho, mid, *outs))
+        else:
+            near = np.zeros(A2.size, np.uint8)
+            run_parallel(closed_sweep, work, (A2, lam, rho, mid, code, GL_X, GL_W, *outs, near))
+            idx = np.flatnonzero(near)
+            if idx.size:  # overlapping layers: the error measured against the exact rung
+                g0, cd0, err0, errc0, _ = outs
+                run_parallel(near_sweep, idx.size * CHARGE_COMPILED_S["exact"],
+                             (idx, A2, lam, rho, mid, code, g0, cd0, err0, errc0))
         g, cdh, err, errc, core = (o.reshape(th.shape) for o in outs)
         # sigma = (S F/RT) (sigma_hat/A2) phi0: odd in phi0, -> C_d(0) phi0, no A2^2 formed
         sig = capacitance_scale(perm, mat) * g * v

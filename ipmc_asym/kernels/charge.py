@@ -1,6 +1,6 @@
 """Compiled kernels of the static electrode charge ``sigma`` and differential capacitance ``C_d``.
 
-The point kernels and the ``prange`` sweep driver behind :func:`ipmc_asym.integral.charge.charge`
+The point kernels and the ``prange`` sweep drivers behind :func:`ipmc_asym.integral.charge.charge`
 (derivation: ``derivations/charge.py``, generated into :mod:`ipmc_asym.kernels._generated_charge`;
 the exact rung: :mod:`ipmc_asym.kernels.charge_exact`).  Hats: ``sigma = S sigma_hat`` with
 ``S = sqrt(phi4 C_moy eps_core R T)``, ``C_d = (S F/(R T)) Cd_hat``; ``A2 = F|phi0|/(R T)``.
@@ -25,7 +25,8 @@ from ipmc_asym.kernels.jit import jit, jit_parallel, prange
 from ipmc_asym.kernels.quadrature import doubling_panels
 from ipmc_asym.kernels.special import gauss_legendre
 
-__all__ = ["CLOSED_TRUNCATION", "NEAR_LIMIT", "GL_X", "GL_W", "charge_hat_point", "charge_point", "charge_sweep"]
+__all__ = ["CLOSED_TRUNCATION", "NEAR_LIMIT", "GL_X", "GL_W", "charge_hat_point", "closed_point", "near_errors",
+           "exact_point", "closed_sweep", "near_sweep", "exact_sweep"]
 
 #: rounding of the closed forms (Yc, Dhat, chat are cancellation-free): relative; measured
 #: <= 4.4e-16 against the exact rung where the layers are apart (tests/dynamics/test_electrode.py)
@@ -109,27 +110,34 @@ def _core(Ya, lam, rho):
 
 
 @jit
-def charge_point(A2, lam, rho, model_id, order, X, Wt):
-    """``(g, Cdhat, error_sigma, error_C, core)`` at ``A2 >= 0``; ``g = sigma_hat/A2``.
+def _tiny_point(A2, lam, rho, order):
+    """:func:`closed_point` and :func:`exact_point` below ``TINY_A2``: the Debye-Hueckel limit (linearised Poisson-Boltzmann,
+    eps = eps_core): ``sigma_hat/A2`` and ``Cdhat`` are 1/2 (neutral core) or coth(1/lam)/2 (exact),
+    up to relative O(A2) < 1e-29; the closed forms' core error is its value in that limit
+    (independent of A2)."""
+    if order == 3:
+        c = 0.5 / math.tanh(1.0 / lam)
+        return c, c, EXACT_STATED_ERROR + 10.0 * A2, EXACT_STATED_ERROR + 10.0 * A2, 2.0
+    Yc, Ya = 0.5 * TINY_A2, -0.5 * TINY_A2
+    es, ec = closed_charge_errors(lam, Yc, Ya, rho, 1.0, 1.0)
+    return 0.5, 0.5, CLOSED_TRUNCATION + 10.0 * A2 + es, CLOSED_TRUNCATION + 10.0 * A2 + ec, _core(Ya, lam, rho)
 
-    ``order`` 1/2: closed forms, 0: quadrature, 3: exact (``kernels/charge_exact.py``).
+
+@jit
+def closed_point(A2, lam, rho, model_id, order, X, Wt):
+    """``(g, Cdhat, error_sigma, error_C, core, near)`` of the neutral-core rungs (``order`` 1/2 closed
+    forms, 0 quadrature) at ``A2 >= 0``, ``g = sigma_hat/A2``, up to the overlap measurement.
+
+    ``near``: the neutral-core error estimate is above ``NEAR_LIMIT`` (overlapping layers), where
+    :func:`near_errors` replaces the errors by the difference from the exact rung.  No exact code is
+    reachable from here, so a driver of these rungs compiles without it (the exact rung is most of
+    the charge's compile: ~6 of 14 s in a fresh cache).
     """
     if A2 < TINY_A2:
-        # Debye-Hueckel limit (linearised Poisson-Boltzmann, eps = eps_core): sigma_hat/A2 and
-        # Cdhat are 1/2 (neutral core) or coth(1/lam)/2 (exact), up to relative O(A2) < 1e-29;
-        # the closed forms' core error is its value in that limit (independent of A2)
-        if order == 3:
-            c = 0.5 / math.tanh(1.0 / lam)
-            return c, c, EXACT_STATED_ERROR + 10.0 * A2, EXACT_STATED_ERROR + 10.0 * A2, 2.0
-        Yc, Ya = 0.5 * TINY_A2, -0.5 * TINY_A2
-        es, ec = closed_charge_errors(lam, Yc, Ya, rho, 1.0, 1.0)
-        return 0.5, 0.5, CLOSED_TRUNCATION + 10.0 * A2 + es, CLOSED_TRUNCATION + 10.0 * A2 + ec, _core(Ya, lam, rho)
+        g, cd, es, ec, core = _tiny_point(A2, lam, rho, order)
+        return g, cd, es, ec, core, False
     mid = -1 if order == 0 else model_id
     Yc, Ya, sb = layer_potentials(A2, rho, mid)
-    if order == 3:
-        g, cd, t, niter = charge_exact_point(lam, A2, rho, Yc, Ya)
-        e = EXACT_STATED_ERROR + sb if niter > 0 else math.inf
-        return g, cd, e, e, _core(Ya, lam, rho)
     if order == 0:
         sh = _layer_integral(Yc, rho, X, Wt)
     else:
@@ -139,18 +147,57 @@ def charge_point(A2, lam, rho, model_id, order, X, Wt):
     g = sh / A2
     cd = GC.series_capacitance(cc, ca)
     es, ec = closed_charge_errors(lam, Yc, Ya, rho, cc, ca)
-    if max(es, ec) > NEAR_LIMIT:
-        # overlapping layers: the neutral-core asymptotics of kappa loosen (up to ~300x at 1 um,
-        # 20 V, constant model); the difference from the exact rung is the error there
-        gx, cdx, _, niter = charge_exact_point(lam, A2, rho, Yc, Ya)
-        if niter > 0:
-            es = 2.0 * abs(g / gx - 1.0) + 2.0 * EXACT_STATED_ERROR
-            ec = 2.0 * (abs(cd / cdx - 1.0) if cdx > 0.0 else (0.0 if cd == 0.0 else math.inf)) + 2.0 * EXACT_STATED_ERROR
-    return g, cd, CLOSED_TRUNCATION + sb + es, CLOSED_TRUNCATION + sb + ec, _core(Ya, lam, rho)
+    return (g, cd, CLOSED_TRUNCATION + sb + es, CLOSED_TRUNCATION + sb + ec, _core(Ya, lam, rho),
+            max(es, ec) > NEAR_LIMIT)
+
+
+@jit
+def near_errors(A2, lam, rho, model_id, order, g, cd, err, errc):
+    """The errors of a ``near`` point of :func:`closed_point` (``g``, ``cd``, ``err``, ``errc`` its
+    values): overlapping layers, where the neutral-core asymptotics of kappa loosen (up to ~300x at
+    1 um, 20 V, constant model), so the difference from the exact rung is the error there; ``err``,
+    ``errc`` kept where the exact iteration fails."""
+    mid = -1 if order == 0 else model_id
+    Yc, Ya, sb = layer_potentials(A2, rho, mid)
+    gx, cdx, _, niter = charge_exact_point(lam, A2, rho, Yc, Ya)
+    if niter <= 0:
+        return err, errc
+    es = 2.0 * abs(g / gx - 1.0) + 2.0 * EXACT_STATED_ERROR
+    ec = 2.0 * (abs(cd / cdx - 1.0) if cdx > 0.0 else (0.0 if cd == 0.0 else math.inf)) + 2.0 * EXACT_STATED_ERROR
+    return CLOSED_TRUNCATION + sb + es, CLOSED_TRUNCATION + sb + ec
+
+
+@jit
+def exact_point(A2, lam, rho, model_id):
+    """``(g, Cdhat, error_sigma, error_C, core)`` of the exact rung (``kernels/charge_exact.py``) at
+    ``A2 >= 0``; ``g = sigma_hat/A2``."""
+    if A2 < TINY_A2:
+        return _tiny_point(A2, lam, rho, 3)
+    Yc, Ya, sb = layer_potentials(A2, rho, model_id)
+    g, cd, t, niter = charge_exact_point(lam, A2, rho, Yc, Ya)
+    e = EXACT_STATED_ERROR + sb if niter > 0 else math.inf
+    return g, cd, e, e, _core(Ya, lam, rho)
 
 
 @jit_parallel
-def charge_sweep(A2, lam, rho, model_id, order, X, Wt, g, cd, err, errc, core):
-    """:func:`charge_point` at every ``A2[i]``, ``lam[i]`` (flat arrays) into the output arrays."""
+def closed_sweep(A2, lam, rho, model_id, order, X, Wt, g, cd, err, errc, core, near):
+    """:func:`closed_point` at every ``A2[i]``, ``lam[i]`` (flat arrays) into the output arrays
+    (``near``: uint8)."""
     for i in prange(A2.size):
-        g[i], cd[i], err[i], errc[i], core[i] = charge_point(A2[i], lam[i], rho, model_id, order, X, Wt)
+        g[i], cd[i], err[i], errc[i], core[i], nr = closed_point(A2[i], lam[i], rho, model_id, order, X, Wt)
+        near[i] = nr
+
+
+@jit_parallel
+def near_sweep(idx, A2, lam, rho, model_id, order, g, cd, err, errc):
+    """:func:`near_errors` at the points ``idx`` of a :func:`closed_sweep` (its outputs, in place)."""
+    for k in prange(idx.size):
+        i = idx[k]
+        err[i], errc[i] = near_errors(A2[i], lam[i], rho, model_id, order, g[i], cd[i], err[i], errc[i])
+
+
+@jit_parallel
+def exact_sweep(A2, lam, rho, model_id, g, cd, err, errc, core):
+    """:func:`exact_point` at every ``A2[i]``, ``lam[i]`` (flat arrays) into the output arrays."""
+    for i in prange(A2.size):
+        g[i], cd[i], err[i], errc[i], core[i] = exact_point(A2[i], lam[i], rho, model_id)
