@@ -2,12 +2,15 @@
 
 * linear model: exact solution ``C = 1 + (B1 - 1) sinh(z/z0)/sinh(1/z0)`` (paper eqs (29)-(30));
 * constant / affine: first integral + layer quadratures (core neutral, exponentially small
-  error), with scipy.integrate.quad at tight tolerances.
+  error), with scipy.integrate.quad at tight tolerances;
+* :func:`jitted_reach`: what a compiled function names, read from its code (the tests that a
+  rung's driver compiles no other rung's kernels).
 """
 
 from __future__ import annotations
 
 import math
+import types
 from pathlib import Path
 
 from scipy.integrate import quad
@@ -116,3 +119,33 @@ def partial_electrode_statics(L, EI, x1, x2):
     w_mid = (A * h * h / 2.0 + B * h**3 / 6.0 - ((h - c) ** 2 - (h - d) ** 2) / 2.0) / EI
     return {"w": -lever / EI, "theta": -(x2 - x1) / EI, "F": 3.0 * lever / L**3,
             "M_root": A, "M_tip": A + B * L, "F_root": B, "F_tip": -B, "w_mid": w_mid}
+
+
+def _is_jitted(obj):
+    import numba
+
+    return isinstance(obj, numba.core.dispatcher.Dispatcher)
+
+
+def jitted_reach(f):
+    """The jitted functions a jitted ``f`` names, transitively (what Numba compiles with it: a name in
+    a branch not taken is compiled all the same)."""
+    seen, todo = set(), [f]
+    while todo:
+        g = todo.pop()
+        if g in seen:
+            continue
+        seen.add(g)
+        code, glb = g.py_func.__code__, g.py_func.__globals__
+        names = set(code.co_names)
+        for c in code.co_consts:  # nested code (comprehensions)
+            if hasattr(c, "co_names"):
+                names |= set(c.co_names)
+        for n in names:
+            v = glb.get(n)
+            if _is_jitted(v):
+                todo.append(v)
+            elif isinstance(v, types.ModuleType) and v.__name__.startswith("ipmc_asym."):
+                # a module's kernel called as module.name: co_names holds the attribute name too
+                todo.extend(getattr(v, a) for a in names if _is_jitted(getattr(v, a, None)))
+    return seen

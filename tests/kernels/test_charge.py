@@ -1,34 +1,11 @@
 """The charge's compiled drivers: one per rung, so a first closed-form call compiles no exact code."""
 
 import numpy as np
+from references import jitted_reach as _reach
 
 import ipmc_asym as ia
 from ipmc_asym.kernels import charge as K
-from ipmc_asym.kernels import jit as _jit
 from ipmc_asym.kernels.charge_exact import charge_exact_point
-
-
-def _reach(f):
-    """The jitted functions a jitted ``f`` names, transitively (what Numba compiles with it: a name in
-    a branch not taken is compiled all the same)."""
-    seen, todo = set(), [f]
-    while todo:
-        g = todo.pop()
-        if g in seen:
-            continue
-        seen.add(g)
-        code, glb = g.py_func.__code__, g.py_func.__globals__
-        names = set(code.co_names)
-        for c in code.co_consts:  # nested code (comprehensions)
-            if hasattr(c, "co_names"):
-                names |= set(c.co_names)
-        for n in names:
-            v = glb.get(n)
-            if _jit._is_jitted(v):
-                todo.append(v)
-            elif hasattr(v, "__dict__") and getattr(v, "__name__", "").startswith("ipmc_asym."):
-                todo.extend(x for x in vars(v).values() if _jit._is_jitted(x))
-    return seen
 
 
 def test_closed_driver_reaches_no_exact_code():
