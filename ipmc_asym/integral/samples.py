@@ -11,7 +11,7 @@ cache (hashed sources, ``_jit``).
 from __future__ import annotations
 
 from ipmc_asym.integral.api import _closed_point, _point
-from ipmc_asym.kernels.jit import jit_parallel, prange
+from ipmc_asym.kernels.jit import jit, jit_parallel, prange
 
 __all__ = ["moment_samples"]
 
@@ -27,21 +27,24 @@ def moment_samples(lam, A2, A3, rho, model_id, order, sign, I, err, core):
     driver(lam, A2, A3, rho, model_id, order, sign, I, err, core)
 
 
+@jit(inline="always")
+def _put(i, sign, Ii, e_i, c, I, err, core):
+    I[i] = sign[i] * Ii
+    err[i] = e_i
+    core[i] = c
+
+
 @jit_parallel
 def _closed_samples(lam, A2, A3, rho, model_id, order, sign, I, err, core):
     """:func:`moment_samples` of the closed forms (``order`` 1, 2)."""
     for i in prange(lam.size):
-        Ii, e_i, b1, c = _closed_point(lam[i], A2[i], A3[i], rho, model_id, order)
-        I[i] = sign[i] * Ii
-        err[i] = e_i
-        core[i] = c
+        Ii, e_i, _, c = _closed_point(lam[i], A2[i], A3[i], rho, model_id, order)
+        _put(i, sign, Ii, e_i, c, I, err, core)
 
 
 @jit_parallel
 def _point_samples(lam, A2, A3, rho, model_id, order, sign, I, err, core):
     """:func:`moment_samples` of the other rungs (``order`` 0 quadrature)."""
     for i in prange(lam.size):
-        Ii, e_i, b1, c = _point(lam[i], A2[i], A3[i], rho, model_id, order)
-        I[i] = sign[i] * Ii
-        err[i] = e_i
-        core[i] = c
+        Ii, e_i, _, c = _point(lam[i], A2[i], A3[i], rho, model_id, order)
+        _put(i, sign, Ii, e_i, c, I, err, core)
