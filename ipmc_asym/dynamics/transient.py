@@ -216,7 +216,7 @@ _OUTPUT_BLOCK = 32
 
 
 class _Problem:
-    """The affine model's finite-volume problem (see the module notes).
+    """The finite-volume problem of the permittivity models with eps0 > 0 (constant, affine; see the module notes).
 
     ``psi0_fun(t)``: the applied potential at one scaled time (float); ``psi0_many(t)``: the same at an
     array of times (the outputs are computed for blocks of times at once; default: one call per time).
