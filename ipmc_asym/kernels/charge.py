@@ -111,10 +111,10 @@ def _core(Ya, lam, rho):
 
 @jit
 def _tiny_point(A2, lam, rho, order):
-    """:func:`closed_point` and :func:`exact_point` below ``TINY_A2``: the Debye-Hueckel limit (linearised Poisson-Boltzmann,
-    eps = eps_core): ``sigma_hat/A2`` and ``Cdhat`` are 1/2 (neutral core) or coth(1/lam)/2 (exact),
-    up to relative O(A2) < 1e-29; the closed forms' core error is its value in that limit
-    (independent of A2)."""
+    """:func:`closed_point` and :func:`exact_point` below ``TINY_A2``: the Debye-Hueckel limit
+    (linearised Poisson-Boltzmann, eps = eps_core): ``sigma_hat/A2`` and ``Cdhat`` are 1/2 (neutral
+    core) or coth(1/lam)/2 (exact), up to relative O(A2) < 1e-29; the closed forms' core error is
+    its value in that limit (independent of A2)."""
     if order == 3:
         c = 0.5 / math.tanh(1.0 / lam)
         return c, c, EXACT_STATED_ERROR + 10.0 * A2, EXACT_STATED_ERROR + 10.0 * A2, 2.0
