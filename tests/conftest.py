@@ -1,3 +1,5 @@
+import os
+
 import numpy as np
 
 np.seterr(all="raise", under="ignore")
@@ -11,6 +13,16 @@ def pytest_addoption(parser):
 def pytest_configure(config):
     # the generated kernels have their own compare-or-update: ipmc-asym derive [--check]
     config.update_golden = config.getoption("--update-golden")
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        # one BLAS thread per test worker (and its subprocesses): the workers share the cores, and
+        # OpenBLAS's threads spin between calls, so a second BLAS thread per worker only competes with
+        # the other worker (measured, -n 2 on 2 cores, -m "not slow": 154-163 s with the default
+        # threads, 131 s with one).  Numba's threads are left alone: the tests of the package's own
+        # thread rule set them.
+        from threadpoolctl import threadpool_limits
+
+        config.blas_limit = threadpool_limits(limits=1, user_api="blas")
+        os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 
 def _declared_commands_entry_points():
