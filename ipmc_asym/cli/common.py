@@ -545,7 +545,6 @@ def first_run_notice(command: str | None = None):
     """
     from ipmc_asym.kernels.jit import CACHE_DIR, compile_notice_given  # deferred: loads Numba
 
-
     ran = os.path.join(CACHE_DIR, f".ipmc_asym-ran-{command}") if command else None
     if os.path.exists(os.path.join(CACHE_DIR, WARM_MARKER)) or (ran is not None and os.path.exists(ran)):
         return

@@ -64,6 +64,16 @@ def sg_rhs(S, psi0, h, delta, lam2, rho):
     return out
 
 
+@jit(inline="always")
+def _d0_of(x, a_L, a_R, GL, GR):
+    """``(d_0, dd_0/ddelta)`` at ``delta = x`` (``c_L = c_R e^delta``), scaled by ``e^{-|x|}`` so that
+    neither face concentration overflows (the scalar form of ``_LinearProblem._d0_of``)."""
+    ex = math.exp(-abs(x))
+    den = GL * ex + GR if x > 0.0 else GL + GR * ex
+    d0 = (a_L * ex - a_R) / den if x > 0.0 else (a_L - a_R * ex) / den
+    return d0, -(a_R * GL + a_L * GR) * ex / (den * den)
+
+
 @jit
 def newton_delta(a_L, a_R, GL, GR, W, I0, p0, x):
     """Root ``delta`` of ``F = d_0(delta) - (delta + psi0 - I0)/W`` (decreasing), scalars: Newton
@@ -71,14 +81,7 @@ def newton_delta(a_L, a_R, GL, GR, W, I0, p0, x):
     ``dynamics.transient._LinearProblem.solve_d0``); ``x`` is the start."""
     lo, hi = -math.inf, math.inf
     for _ in range(200):
-        ex = math.exp(-abs(x))
-        if x > 0.0:
-            den = GL * ex + GR
-            d0 = (a_L * ex - a_R) / den
-        else:
-            den = GL + GR * ex
-            d0 = (a_L - a_R * ex) / den
-        dd = -(a_R * GL + a_L * GR) * ex / (den * den)
+        d0, dd = _d0_of(x, a_L, a_R, GL, GR)
         F = d0 - (x + p0 - I0) / W
         if F > 0.0:
             lo = x
@@ -132,11 +135,7 @@ def linear_rhs(S, psi0, h, delta, lam2, wL, wR, GL, GR, x0):
         W += w
         I0 += nhat * w
     x = newton_delta(a_L, a_R, GL, GR, W / lam2, I0, psi0, x0 if math.isfinite(x0) else 0.0)
-    ex = math.exp(-abs(x))
-    if x > 0.0:
-        d0 = (a_L * ex - a_R) / (GL * ex + GR)
-    else:
-        d0 = (a_L - a_R * ex) / (GL + GR * ex)
+    d0 = _d0_of(x, a_L, a_R, GL, GR)[0]
     for f in range(N - 1):
         out[f] = -(out[f] + d0 / lam2)
     return out, x
