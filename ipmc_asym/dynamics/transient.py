@@ -168,9 +168,9 @@ def _jump_withheld(t, js, current_error):
     (linear model, 0.5 V: J(0) moved 8.5, 17, 34, 68 A/m^2 at each halving).  Changes that shrink by
     ``q = d24/d12`` leave a tail ``d24 q/(1 - q)`` beyond the finest level, within the stated error
     (it holds ``d12``, counted twice) for ``q <= 0.618``; the line is drawn at :data:`JUMP_SHRINK` = 0.6,
-    not at first order itself (``q = 0.5``), where a current converging at exactly first order
-    (constant model, 0.8 V, 180 um: ``q = 0.50003``) was withheld or not by the rounding of the output
-    arithmetic.
+    not at first order itself (``q = 0.5``): a current converging at exactly first order (constant
+    model, 0.8 V, 180 um: ``q = 0.50003``) sits on that line, where the rounding of the output
+    arithmetic would decide whether it is withheld.
     """
     d12, d24 = np.abs(js[0] - js[1]), np.abs(js[1] - js[2])
     return ((np.asarray(t) == 0.0) & (d24 > JUMP_SHRINK * d12)
