@@ -40,7 +40,15 @@ from ipmc_asym.dynamics.drive import (
     MAX_DRIVE_POINTS,
     MAX_STATED_POINTS,
 )
-from ipmc_asym.dynamics.entry import ERROR_COLUMNS, stated_tol, time_path, time_response
+from ipmc_asym.dynamics.entry import (
+    AUTO_TOL,
+    AUTO_WORK,
+    ERROR_COLUMNS,
+    WORK_PER_SECOND,
+    stated_tol,
+    time_path,
+    time_response,
+)
 from ipmc_asym.io.fileio import atomic_path, atomic_write, check_output_path
 from ipmc_asym.io.textfmt import format_table
 
@@ -63,14 +71,16 @@ def register(sub):
     add_solver_option(p, "drive", dest="fidelity", default="circuit", choices=STEP_FIDELITIES,
                       help="circuit (reduced nonlinear capacitor, stepped chunk by chunk) or pnp (transient "
                            "Nernst-Planck/Gauss, in memory, at most %d points; its errors stated)" % MAX_STATED_POINTS)
-    p.add_argument("--tol", type=time_tol_type, default=None,
+    p.add_argument("--tol", type=time_tol_type, default="auto",
                    help="relative accuracy required of sigma at every output time, e.g. 1e-2 or 1%% (in [1e-8, 0.5)): "
                         "the circuit's error is bounded against a PNP run over the same waveform and the PNP is used "
                         "where it fails, as in step; adds the columns " + ", ".join(ERROR_COLUMNS) + " (in memory, at "
-                        f"most {MAX_STATED_POINTS} points); auto: 1e-2 where the error can be stated (as step's default); "
-                        "default none: no error stated for the circuit (the reference PNP run over 2 s of a 1 Hz sine takes "
-                        "~4 s CPU (constant model) to ~11 s (affine), ~14 s at 10 Hz, ~28 s for an affine 1 Hz square "
-                        "wave; it grows with the periods and jumps in the duration)")
+                        f"most {MAX_STATED_POINTS} points); default auto: {AUTO_TOL:g} where the error can be stated "
+                        f"and its reference run costs at most {AUTO_WORK:.3g} cell-evaluations (~{AUTO_WORK / WORK_PER_SECOND:.0f} s CPU; "
+                        "2 s of a 1 Hz sine: ~2.4 s (constant model) to ~9 s (affine), ~11 s at 10 Hz; the cost grows "
+                        "with the periods and jumps in the duration: beyond the cap no error is stated, said in a "
+                        "note, after a sixth of the cap or less), as in step; none: the bare circuit streamed, no "
+                        "error stated (~1 s)")
     add_beam_options(p)
     add_line_options(p)
     add_support_options(p)
@@ -128,8 +138,10 @@ def run(args):
     first_run_notice("step-pnp" if stated else None)
     if stated:  # the in-memory PNP run is the long part (seconds to minutes): say so before it starts
         what = "the PNP" if args.fidelity == "pnp" else f"the circuit and a reference PNP run (tol {tol:g})"
+        cap = (f"; under --tol auto at most ~{AUTO_WORK / WORK_PER_SECOND:.0f} s, beyond which no error is stated; "
+               f"--tol none skips it" if args.fidelity == "circuit" and args.tol == "auto" else "")
         sys.stderr.write(f"drive: {what} over {args.points} output times, in memory (the nominal strip, a "
-                         f"sine over 2 s: ~4 s CPU at 1 Hz, ~14 s at 10 Hz)\n")
+                         f"sine over 2 s: ~2-9 s CPU at 1 Hz, ~11 s at 10 Hz{cap})\n")
         sys.stderr.flush()
     resp = time_response(strip, args.waveform, duration=args.duration, points=args.points, model=args.model,
                          material=material, fidelity=args.fidelity, tol=args.tol, beam=args.beam,

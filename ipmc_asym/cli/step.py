@@ -193,7 +193,7 @@ def run(args):
     first_run_notice("step-pnp" if args.fidelity == "pnp" or tol is not None else "step")
     if tol is not None and args.fidelity == "circuit":  # the reference PNP run is the long part: say so first
         sys.stderr.write(f"step: the circuit and a reference PNP run (tol {tol:g}) that bounds its error, "
-                         f"{len(models)} model{'s' if len(models) > 1 else ''} (nominal strip, each: ~2-7 s CPU for "
+                         f"{len(models)} model{'s' if len(models) > 1 else ''} (nominal strip, each: ~1.5-2.5 s CPU for "
                          f"a 1 V step, ~6 s for 1 s of a 10 Hz sine; --tol none skips it)\n")
         sys.stderr.flush()
     # the library chooses the solver (dynamics.entry.time_path): rows streamed to --out where a stepped

@@ -107,7 +107,7 @@ BEAM_CHOICES = ("quasi-static", "dynamic")
 #: 1e-2 1.9 s constant, 18 s affine, 1.4 s linear); ``ipmc-asym step`` runs it by default (tol "auto")
 CIRCUIT_NO_TOL_NOTE = ("circuit: no error stated for sigma, current and w (no tolerance): the bound is a reference PNP "
                        "run, 100-1000 times the circuit's cost (nominal 1 V step: 1.4-18 s CPU against 0.02 s); "
-                       "step states it by default (--tol auto, 1e-2) or with --tol T")
+                       "step and drive state it by default (--tol auto, 1e-2) or with --tol T")
 DYNAMIC_W_ERROR_NOTE = ("w_error with beam dynamics: the quasi-static errors of M_A and w through the beam's modes "
                         "(each mode's impulse response bounded by its envelope): without damping (viscous modulus 0) "
                         "the bound grows like omega_1 t, as an undamped mode keeps every error it was given")
@@ -908,6 +908,15 @@ def circuit_band(f, error, tol):
     return out
 
 
+class ReferenceFailed(RuntimeError):
+    """The reference PNP run that bounds the circuit's error failed; ``over_budget``: it was stopped by
+    its cap on work (``pnp_options["max_work"]``), not by the problem."""
+
+    def __init__(self, message, over_budget=False):
+        super().__init__(message)
+        self.over_budget = over_budget
+
+
 def _circuit_error(sigma_c, t, fun, strip, perm, material, opts):
     """Bound on the circuit's sigma error at each time: ``|sigma_c - sigma_pnp| + error_pnp``.
 
@@ -921,7 +930,8 @@ def _circuit_error(sigma_c, t, fun, strip, perm, material, opts):
     o.setdefault("rtol", 1e-8)  # the 1 % allowance below was measured with this time integration
     r = solve_transient(t, fun, strip, perm, material, **o)
     if not r.success:
-        raise RuntimeError(f"transient PNP solver failed (the reference for the circuit's error): {r.message}")
+        raise ReferenceFailed(f"transient PNP solver failed (the reference for the circuit's error): {r.message}",
+                              over_budget=bool(r.extra.get("over_budget")))
     # the reference's Richardson estimate covers its mesh; its time integration, controlled to a
     # fraction of its tol, is covered by 1 % of that tol over the run (the excess measured against a
     # PNP run at 1e-6: 3e-5 of it, constant model, 2e = 1 mm, 0.05 V)

@@ -25,6 +25,7 @@ from ipmc_asym.dynamics.circuit import (
     FREQ_METHODS,
     STEP_FIDELITIES,
     TIME_MODES,
+    ReferenceFailed,
     StepResult,
     default_times,
     frequency_response,
@@ -38,8 +39,8 @@ from ipmc_asym.dynamics.waveforms import Waveform, check_drive_voltage, parse_wa
 from ipmc_asym.forward.model import CHECKS
 from ipmc_asym.model.params import NAFION_LI, Material, Strip, check_finite
 
-__all__ = ["DEFAULT_BEAM", "TIME_PATHS", "ERROR_COLUMNS", "AUTO_TOL", "Drive", "TimeResponse", "stated_tol", "time_path",
-           "time_response", "spectrum"]
+__all__ = ["DEFAULT_BEAM", "TIME_PATHS", "ERROR_COLUMNS", "AUTO_TOL", "AUTO_WORK", "WORK_PER_SECOND", "Drive",
+           "TimeResponse", "stated_tol", "time_path", "time_response", "spectrum"]
 
 #: solvers of a time response: ``memory`` (step_response: circuit or PNP, optional tolerance, the dynamic
 #: beam on a refined grid), ``stream`` (the circuit stepped on the output grid, chunk by chunk, memory
@@ -54,9 +55,22 @@ ERROR_COLUMNS = ("sigma_error", "current_error", "w_error")
 #: the tolerance on sigma of ``tol="auto"`` (``ipmc-asym step``'s default): the circuit's sigma, current and w
 #: errors stated against a reference PNP run (the PNP where the circuit misses it).  1 % of sigma's peak: the
 #: circuit meets it on the nominal strip at 1 V (constant model), the reference runs at a tenth of it, and the
-#: run costs ~1-10 s CPU instead of the bare circuit's ~0.02 s (measured: constant 1.8 s, linear 2.1 s,
-#: affine 6.6 s at 1 V, where the affine and linear circuits miss 1 % and the PNP is used)
+#: run costs ~1-10 s CPU instead of the bare circuit's ~0.02 s (measured: constant 1.5 s, linear 1.9 s,
+#: affine 2.4 s at 1 V, where the affine and linear circuits miss 1 % and the PNP is used)
 AUTO_TOL = 1e-2
+
+#: the cap on the reference PNP run's work under ``tol="auto"`` (cell-evaluations,
+#: :func:`~ipmc_asym.dynamics.transient.solve_transient`'s ``max_work``: a count, the same on every
+#: machine).  Where the reference would cost more, ``auto`` states no error and says so; a number
+#: for ``tol`` runs it whatever it costs.  5e7 is ~15 s CPU here at most (measured on this 2-core
+#: x86-64: 2 s of a 1 Hz sine 5.9e6 = 2.4 s, constant model, and 3.3e7 = 9.4 s, affine; 10 Hz
+#: 4.7e7 = 10.8 s); the reference's cost grows with the periods and jumps in the duration, and a
+#: case beyond the cap is given up after a sixth of it or less (the ladder's first level predicts it)
+AUTO_WORK = 5e7
+
+#: cell-evaluations of the transient solver per second of CPU, to say a cap in seconds (measured on
+#: this 2-core x86-64, 2.4e6-4.4e6 over the cases of :data:`AUTO_WORK`; a figure, not a check)
+WORK_PER_SECOND = 3.3e6
 
 #: how the dynamic beam meets the output grid: ``refined`` (the transient is solved on a grid of >= 40
 #: points per period of the first mode and sampled at the output times) or ``output`` (the modes are
@@ -323,15 +337,24 @@ def time_response(strip: Strip | None = None, drive=None, *, duration=None, poin
         args = (d.voltage if d.kind == "step" else s.voltage, duration)
         kw = dict(strip=s, model=model, fidelity=fidelity, material=m, points=points, waveform_kind=kind, beam=beam,
                   viscous_modulus=viscous_modulus, n_modes=n_modes, pnp_options=pnp_options)
+        if auto and tol is not None:  # the reference's cost capped (pnp_options may set its own cap)
+            kw["pnp_options"] = {"max_work": AUTO_WORK, **(pnp_options or {})}
         try:
             r = step_response(*args, tol=tol, **kw)
-        except ValueError as ex:
+        except (ValueError, ReferenceFailed) as ex:
             if not auto or tol is None:
                 raise
             # "auto" asked for an error where one can be stated: where the reference PNP run itself
-            # refuses the strip (e.g. layers that fill a 1 um strip at 20 V), the circuit as it is, said
-            r = step_response(*args, tol=None, **kw)
-            tol, why = None, f"circuit: no error stated against the PNP: the reference PNP run refuses this case ({ex})"
+            # refuses the strip (e.g. layers that fill a 1 um strip at 20 V), fails, or would cost more
+            # than its cap, the circuit as it is, said
+            cap = kw["pnp_options"].get("max_work")
+            r = step_response(*args, tol=None, **dict(kw, pnp_options=pnp_options))
+            tol, why = None, ("circuit: no error stated against the PNP: " + (
+                f"the reference PNP run over this drive would cost more than tol='auto' allows ({cap:.3g} "
+                f"cell-evaluations, ~{cap / WORK_PER_SECOND:.0f} s CPU; it grows with the periods and jumps in "
+                f"the duration); a tolerance (e.g. --tol 1e-2) runs it whatever it costs" if getattr(ex, "over_budget", False)
+                else f"the reference PNP run {'refuses' if isinstance(ex, ValueError) else 'fails in'} this "
+                     f"case ({ex})"))
         # the header of the stepped paths, with the run's own notes (what it states and what it leaves out)
         info = dict(drive_info(s, model, m, beam, viscous_modulus), notes=list(r.notes), fidelity=r.fidelity,
                     tol=tol if tol is not None else r.extra.get("tol"), valid_from=r.extra.get("valid_from"))

@@ -154,6 +154,18 @@ def _layer_voltage(sigma, err, perm, material):
 CURRENT_ERROR_MARGIN = 2.0
 
 
+#: the first mesh level is dropped where its time integration needs more than this many times the
+#: right-hand-side evaluations of the next, finer level (:func:`solve_transient`)
+COARSE_NFEV = 4
+
+#: what the transient ladder's cap on work (``max_work``) takes the rest of the ladder to cost: the
+#: first run (the second level) at most ``1/_LADDER_SHARE`` of the cap (the level below it at half,
+#: the one above at twice, that one's time check at ~1.3 times that: 0.5 + 1 + 2 + 2.6 ~ 6), a next
+#: level ``_NEXT_LEVEL_SHARE`` times the last (2 for it, 2.6 for its time check; measured ratios of
+#: the check's evaluations to its level's: 1.24-1.44 over constant/linear/affine steps and sines)
+_LADDER_SHARE = 6.0
+_NEXT_LEVEL_SHARE = 4.6
+
 #: a current at ``t = 0`` is withheld where its changes over three mesh levels shrink by less than this
 #: (see :func:`_jump_withheld`)
 JUMP_SHRINK = 0.6
@@ -727,7 +739,7 @@ def solve_transient(t, phi0_fun, strip: Strip, model="constant", material: Mater
                     cells_per_debye: float = 4.0, ratio: float = 1.08, h_core: float = 0.02, refine: float | None = None,
                     rtol: float | None = None, atol: float = 1e-12, method: str = "BDF", energy: bool = False,
                     profiles: bool = False, moment: bool = True, tol: float | None = 1e-6,
-                    max_cells: int = 20000) -> TransientResult:
+                    max_cells: int = 20000, max_work: float | None = None) -> TransientResult:
     """Integrate the transient Nernst-Planck/Gauss problem from the uncharged state at ``t = 0``.
 
     Parameters
@@ -752,6 +764,12 @@ def solve_transient(t, phi0_fun, strip: Strip, model="constant", material: Mater
     max_cells : int
         Cap on the cells of the finest mesh; the solver fails (``success = False``, one-line
         message) when the tolerance needs more.
+    max_work : float or None
+        Cap on the cost, counted in cell-evaluations (right-hand-side evaluations times the cells of
+        their mesh, summed over every run of the ladder: a count, the same on every machine; ~3e6 a
+        second of CPU here).  A level that would pass it is not started (the next level is taken
+        to cost twice the last), one that passes it stops there; the solver then fails with
+        ``extra["over_budget"] = True``.  Default None: no cap.
     rtol, atol : float
         solve_ivp tolerances; ``rtol`` default: ``tol/100`` with a tolerance, 1e-8 without one
         (``atol`` on ``S``, in units of ``e``; no looser than ``rtol`` times the small-signal
@@ -799,7 +817,8 @@ def solve_transient(t, phi0_fun, strip: Strip, model="constant", material: Mater
     tt = np.asarray(t, dtype=float).reshape(-1)
     vmax = float(np.max(np.abs(phi0_fun(np.linspace(tt[0], tt[-1], 2001))))) if tt.size else 0.0
     kw = dict(cells_per_debye=cells_per_debye, ratio=ratio, h_core=h_core, refine=refine, rtol=rtol, atol=atol,
-              method=method, energy=energy, profiles=profiles, moment=moment, tol=tol, max_cells=max_cells)
+              method=method, energy=energy, profiles=profiles, moment=moment, tol=tol, max_cells=max_cells,
+              max_work=None if max_work is None else check_positive("max_work", max_work))
     if not 0.0 < vmax < SMALL_SIGNAL_V or energy:  # (the energy balance is quadratic in phi0: solved as it is)
         return _solve_direct(t, phi0_fun, strip, model, material, **kw)
     return _small_signal(t, phi0_fun, vmax, strip, model, material, kw)
@@ -851,13 +870,13 @@ def _small_signal(t, phi0_fun, vmax, strip, model, material, kw):
 
 
 def _solve_direct(t, phi0_fun, strip, model, material, *, cells_per_debye, ratio, h_core, refine, rtol, atol, method,
-                  energy, profiles, moment, tol, max_cells) -> TransientResult:
+                  energy, profiles, moment, tol, max_cells, max_work) -> TransientResult:
     """:func:`solve_transient` without its small-signal branch (its arguments, defaults there)."""
     if tol is None:
         r = _solve_once(t, phi0_fun, strip, model, material, cells_per_debye=cells_per_debye, ratio=ratio,
                         h_core=h_core, refine=1.0 if refine is None else refine,
                         rtol=1e-8 if rtol is None else rtol, atol=atol, method=method, energy=energy,
-                        profiles=profiles, moment=moment)
+                        profiles=profiles, moment=moment, max_work=max_work)
         r.sigma_error = np.full(r.t.size, np.nan)
         r.current_error = np.full(r.t.size, np.nan)
         return r
@@ -884,16 +903,62 @@ def _solve_direct(t, phi0_fun, strip, model, material, *, cells_per_debye, ratio
     # default tol = 1e-6 the start is 1, as before
     rf = min(1.0, max(0.25, math.sqrt(1e-6 / tol))) if refine is None else refine
     t_start = time.perf_counter()
+    spent = [0]  # cell-evaluations of every run so far (max_work's measure of cost)
+    dropped = []
+
+    def level(q, max_nfev=None, rtol_=rt, atol_=min(atol, 1e-6 * tol), keep=profiles, share=1.0):
+        left = None if max_work is None else share * max_work - spent[0]
+        x = _solve_once(t, phi0_fun, strip, model, material, cells_per_debye=cells_per_debye, ratio=ratio,
+                        h_core=h_core, refine=q, rtol=rtol_, atol=atol_, method=method, energy=energy,
+                        profiles=keep, moment=False, max_nfev=max_nfev, max_work=left)
+        spent[0] += x.extra["cells"] * x.extra.get("nfev", 0)
+        return x
+
+    def over_budget(x, what):
+        # stopped by max_work, or the next run would pass it: the estimate is not made (the caller's
+        # budget, e.g. time_response's tol="auto", says what to do instead)
+        return _failed(x, f"{what} needs more than max_work = {max_work:.3g} cell-evaluations "
+                          f"({spent[0]:.3g} spent)", levels(), over_budget=True, work=spent[0])
+
+    def levels():
+        return dropped + [{"refine": q, "cells": x.extra["cells"], "seconds": x.extra["seconds"],
+                           "nfev": x.extra.get("nfev")} for q, x in runs]
+
     while True:
-        r = _solve_once(t, phi0_fun, strip, model, material, cells_per_debye=cells_per_debye, ratio=ratio,
-                        h_core=h_core, refine=rf, rtol=rt, atol=min(atol, 1e-6 * tol), method=method,
-                        energy=energy, profiles=profiles, moment=False)
-        if not r.success:
-            r.sigma_error = np.full(r.t.size, np.nan)
-            r.current_error = np.full(r.t.size, np.nan)
-            return r
+        if not runs:
+            # the first two levels, the finer one first: a coarsest level whose time integration
+            # needs more than COARSE_NFEV times the evaluations of the next (its stiffness, not the
+            # physics, sets the steps: affine model, 1 V step, 200 um, one cell per Debye length:
+            # 98 522 evaluations where the next level took 1 673, 4.9 of the run's 5.5 s) is dropped;
+            # the ladder goes on from the next (it extrapolates from its last three levels only)
+            # (the ladder needs at least the level below this one, the one above at about twice its
+            # cost and that one's time check: ~6 times this run, so this run gets a sixth of max_work)
+            r2 = level(2.0 * rf, share=1.0 / _LADDER_SHARE)
+            if not r2.success:
+                return over_budget(r2, "the run") if r2.extra.get("over_budget") else _failed(r2, r2.message, [])
+            r = level(rf, max_nfev=COARSE_NFEV * int(r2.extra["nfev"]))
+            if r.success:
+                runs.append((rf, r))
+            elif r.extra.get("over_budget"):
+                return over_budget(r, "the run")
+            elif r.extra["nfev"] >= COARSE_NFEV * int(r2.extra["nfev"]):
+                dropped.append({"refine": rf, "cells": r.extra["cells"], "seconds": r.extra["seconds"],
+                                "nfev": r.extra["nfev"],
+                                "dropped": f"more than {COARSE_NFEV} times the next level's evaluations"})
+            else:
+                return _failed(r, r.message, [])
+            rf, r = 2.0 * rf, r2
+        else:
+            # the next level costs about twice the last (cells double, evaluations alike), and its
+            # time check (the level again at a tenth of rtol) ~1.3 times that
+            w_last = runs[-1][1].extra["cells"] * runs[-1][1].extra["nfev"]
+            if max_work is not None and spent[0] + _NEXT_LEVEL_SHARE * w_last > max_work:
+                return over_budget(runs[-1][1], "the next mesh level")
+            r = level(rf)
+            if not r.success:
+                return over_budget(r, "the run") if r.extra.get("over_budget") else _failed(r, r.message, levels())
         runs.append((rf, r))
-        levels = [{"refine": q, "cells": x.extra["cells"], "seconds": x.extra["seconds"]} for q, x in runs]
+        lv = levels()
         if len(runs) >= 3:
             s1, s2, s4 = (x.sigma for _, x in runs[-3:])
             scale = float(np.max(np.abs(s4)))
@@ -910,7 +975,7 @@ def _solve_direct(t, phi0_fun, strip, model, material, *, cells_per_debye, ratio
                 j1, j2, j4 = (x.current_density for _, x in runs[-3:])
                 r.current_error = (np.full(r.t.size, float(np.max(np.abs(j1 - j2)) + np.max(np.abs(j2 - j4))))
                                    + allowance(r.current_density, peak=True))
-                r.extra = dict(r.extra, refinement=levels, observed_order=p, tol=tol,
+                r.extra = dict(r.extra, refinement=lv, observed_order=p, tol=tol, work=spent[0],
                                sigma_error_max_rel=float(np.max(err)) / scale if scale > 0 else 0.0,
                                seconds=time.perf_counter() - t_start)
                 return r
@@ -963,14 +1028,16 @@ def _solve_direct(t, phi0_fun, strip, model, material, *, cells_per_debye, ratio
                     # evaluations; unmeasured, the allowance serves and the output says so
                     cap = 5 * int(r0.extra.get("nfev", 1000))
                     for f_rt in (0.1, 0.3):
+                        if max_work is not None and spent[0] + r0.extra["cells"] * r0.extra["nfev"] > max_work:
+                            return over_budget(r0, "the time integration's check (the finest level again)")
                         try:
                             with np.errstate(all="ignore"):
-                                rtt = _solve_once(t, phi0_fun, strip, model, material, cells_per_debye=cells_per_debye,
-                                                  ratio=ratio, h_core=h_core, refine=q0, rtol=f_rt * rt,
-                                                  atol=min(atol, 1e-6 * f_rt * tol), method=method, energy=energy,
-                                                  profiles=False, moment=False, max_nfev=cap)
+                                rtt = level(q0, max_nfev=cap, rtol_=f_rt * rt, atol_=min(atol, 1e-6 * f_rt * tol),
+                                            keep=False)
                         except (FloatingPointError, ValueError, np.linalg.LinAlgError):
                             continue
+                        if rtt.extra.get("over_budget"):
+                            return over_budget(rtt, "the time integration's check (the finest level again)")
                         # the finest level's own values (out, the same object, holds the extrapolation)
                         d = np.abs(js[2] - rtt.current_density) / (1.0 - f_rt)
                         ds = np.abs(s4 - rtt.sigma) / (1.0 - f_rt)
@@ -999,7 +1066,7 @@ def _solve_direct(t, phi0_fun, strip, model, material, *, cells_per_debye, ratio
                     if moment:
                         perm = get_model(model)
                         out.layer_voltage = _layer_voltage(E24, err, perm, material)
-                    out.extra = dict(out.extra, refinement=levels, observed_order=p, tol=tol,
+                    out.extra = dict(out.extra, refinement=lv, observed_order=p, tol=tol, work=spent[0],
                                      sigma_error_max_rel=float(np.max(err)) / scale,
                                      seconds=time.perf_counter() - t_start)
                     return out
@@ -1009,12 +1076,17 @@ def _solve_direct(t, phi0_fun, strip, model, material, *, cells_per_debye, ratio
             est = "n/a" if len(runs) < 3 else f"{float(np.max(np.abs(runs[-1][1].sigma - runs[-2][1].sigma))):.2g} C/m^2"
             msg = (f"mesh refinement cannot meet tol = {tol:g} within max_cells = {mc} "
                    f"(finest {r.extra['cells']} cells; last change {est})")
-            return TransientResult(t=r.t, sigma=np.full(r.t.size, np.nan), current_density=np.full(r.t.size, np.nan),
-                                   layer_voltage=np.full(r.t.size, np.nan), M_A_profiles=np.full(r.t.size, np.nan),
-                                   total_charge=r.total_charge, c=r.c, x=r.x, faces=r.faces, success=False,
-                                   message=msg, extra=dict(r.extra, refinement=levels),
-                                   sigma_error=np.full(r.t.size, np.nan), current_error=np.full(r.t.size, np.nan))
+            return _failed(r, msg, lv)
         rf = nxt
+
+
+def _failed(r, message, levels, **extra) -> TransientResult:
+    """An unsuccessful result on ``r``'s times and mesh: every output NaN, ``message`` one line."""
+    nan = np.full(r.t.size, np.nan)
+    return TransientResult(t=r.t, sigma=nan, current_density=nan.copy(), layer_voltage=nan.copy(),
+                           M_A_profiles=nan.copy(), total_charge=r.total_charge, c=r.c, x=r.x, faces=r.faces,
+                           success=False, message=message, extra=dict(r.extra, refinement=levels, **extra),
+                           sigma_error=nan.copy(), current_error=nan.copy())
 
 
 class _TooManyEvaluations(Exception):
@@ -1022,9 +1094,11 @@ class _TooManyEvaluations(Exception):
 
 
 def _solve_once(t, phi0_fun, strip, model, material, *, cells_per_debye, ratio, h_core, refine, rtol, atol, method,
-                energy, profiles, moment, max_nfev=None) -> TransientResult:
+                energy, profiles, moment, max_nfev=None, max_work=None) -> TransientResult:
     """One run on one mesh (see :func:`solve_transient`); with ``max_nfev``, a run that needs more
-    right-hand-side evaluations stops there and is returned unsuccessful."""
+    right-hand-side evaluations stops there and is returned unsuccessful; ``max_work`` caps them at
+    ``max_work // cells`` alike (the run's cost in cell-evaluations; ``extra["over_budget"]`` says
+    that this cap stopped it).  ``extra["nfev"]`` holds the evaluations made, stopped or not."""
     from scipy.integrate import solve_ivp  # deferred: heavy import (start-up)
 
     perm: Permittivity = get_model(model)
@@ -1080,10 +1154,12 @@ def _solve_once(t, phi0_fun, strip, model, material, *, cells_per_debye, ratio, 
         # np.seterr(all="raise") the rejection itself raised, depending on rounding-level
         # differences between runs); the accepted states are checked finite below
         count = [0]
+        by_work = max_work is not None and (max_nfev is None or max_work // P.N < max_nfev)
+        cap = max(0, int(max_work) // P.N) if by_work else max_nfev
 
         def rhs(th, y):
             count[0] += 1
-            if max_nfev is not None and count[0] > max_nfev:
+            if cap is not None and count[0] > cap:
                 raise _TooManyEvaluations
             return P.rhs(th, y, energy)
 
@@ -1097,14 +1173,16 @@ def _solve_once(t, phi0_fun, strip, model, material, *, cells_per_debye, ratio, 
                 elif not sol.success or sol.y.shape[1] != tt.size:
                     failed = str(sol.message)
             except _TooManyEvaluations:
-                failed = f"more than {max_nfev} right-hand-side evaluations (the cap of this run)"
+                failed = (f"more than {cap} right-hand-side evaluations on {P.N} cells (the cap of this run"
+                          + (f": max_work = {max_work:.3g} cell-evaluations left)" if by_work else ")"))
     secs = time.perf_counter() - t0
     if failed is not None:
         return TransientResult(t=tt, sigma=np.full(tt.size, np.nan), current_density=np.full(tt.size, np.nan),
                                layer_voltage=np.full(tt.size, np.nan),
                                M_A_profiles=np.full(tt.size, np.nan), total_charge=np.full(tt.size, np.nan),
                                c=np.empty((0, P.N)), x=P.xc, faces=P.X, success=False, message=failed,
-                               extra={"cells": P.N, "seconds": secs})
+                               extra={"cells": P.N, "seconds": secs, "nfev": min(count[0], cap or count[0]),
+                                      "over_budget": by_work and count[0] > cap})
     sig_scale = e * m.phi4 * m.F * m.C_moy
     nt = tt.size
     d0 = np.empty(nt)

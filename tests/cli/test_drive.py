@@ -13,7 +13,7 @@ from ipmc_asym.forward.model import CHECKS
 def test_drive_csv_streamed(tmp_path, capsys):
     f = tmp_path / "d.csv"
     assert main(["drive", "--waveform", "dc:0.2V+sine:0.5V@10Hz", "--duration", "0.2s", "--points", "801",
-                 "--out", str(f)]) == 0
+                 "--tol", "none", "--out", str(f)]) == 0
     rows = list(csv.reader(f.read_text().splitlines()))
     meta = json.loads((tmp_path / "d.csv.json").read_text())  # the metadata beside the CSV
     assert meta["waveform"] == "dc:0.2V+sine:0.5V@10Hz" and any("Darcy" in n for n in meta["notes"])
@@ -64,7 +64,8 @@ def test_freq_bias_and_beam(capsys):
 
 @pytest.mark.parametrize("args,word", [
     (["drive", "--waveform", "sin:1V@1Hz", "--duration", "1s"], "--waveform"),
-    (["drive", "--waveform", "sine:1V@1Hz", "--duration", "10s", "--points", "100", "--beam", "dynamic"], "points"),
+    (["drive", "--waveform", "sine:1V@1Hz", "--duration", "10s", "--points", "100", "--beam", "dynamic", "--tol", "none"],
+     "points"),
     (["drive", "--waveform", "sine:1V@1Hz", "--duration", "1s", "--points", "2e6", "--json"], "--json"),
     (["drive", "--waveform", "sine:1V@1Hz", "--duration", "1s", "--viscous-modulus", "-1"], "viscous"),
     (["freq", "--from", "1Hz", "--to", "10Hz", "--voltage", "0.5V", "--method", "pnp-linear"], "circuit"),
@@ -81,7 +82,8 @@ def test_drive_and_step_with_a_sheet_resistance(tmp_path, capsys):
     from ipmc_asym.dynamics.drive import drive_response
 
     # 0 Ohm/sq is today's uniform strip, bit for bit
-    base = ["drive", "--waveform", "step:0.5V", "--duration", "20ms", "--points", "41", "--beam", "quasi-static", "--json"]
+    base = ["drive", "--waveform", "step:0.5V", "--duration", "20ms", "--points", "41", "--beam", "quasi-static",
+            "--tol", "none", "--json"]
     assert main(base) == 0
     a = json.loads(capsys.readouterr().out)
     assert main(base + ["--sheet-resistance", "0"]) == 0
@@ -194,16 +196,21 @@ def test_support_and_electrode_refusals_one_line(args, word, capsys):
 
 
 def test_drive_says_in_one_line_that_its_rows_state_no_error(capsys):
-    """drive's rows carry no circuit error (an arbitrary waveform is not bounded): one note line says
-    so and where an error is stated (freq's small signal, step --tol), in the text and in --json."""
+    """drive --tol none: the rows carry no circuit error (an arbitrary waveform is not bounded): one
+    note line says so and where an error is stated (freq's small signal, --tol), in the text and in
+    --json.  By default (--tol auto) the rows state it and no such note is printed."""
     from ipmc_asym.dynamics.drive import DRIVE_ERROR_NOTE
 
     base = ["drive", "--waveform", "sine:0.1V@5Hz", "--duration", "0.1s", "--points", "21", "--beam", "quasi-static"]
-    assert main(base) == 0
+    assert main(base + ["--tol", "none"]) == 0
     lines = [ln for ln in capsys.readouterr().out.splitlines() if "no error of the reduced circuit" in ln]
     assert lines == [f"note: {DRIVE_ERROR_NOTE}"] and "--tol" in lines[0] and "freq" in lines[0]
-    assert main(base + ["--json"]) == 0
+    assert main(base + ["--tol", "none", "--json"]) == 0
     assert DRIVE_ERROR_NOTE in json.loads(capsys.readouterr().out)["notes"]
+    assert main(base + ["--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["tol"] == 1e-2 and DRIVE_ERROR_NOTE not in d["notes"]
+    assert all(np.all(np.isfinite(np.asarray(d[c], float))) for c in ("sigma_error", "w_error"))
 
 
 def test_drive_with_a_tolerance_states_errors_that_hold_against_a_finer_pnp(capsys):
@@ -223,7 +230,7 @@ def test_drive_with_a_tolerance_states_errors_that_hold_against_a_finer_pnp(caps
         v, e, r, re = (np.asarray(x, float) for x in (c[k], c[f"{k}_error"], ref[k], ref[f"{k}_error"]))
         assert np.all(np.isfinite(e)) and np.all(np.abs(v - r) <= e + re), k
         assert np.max(e) <= 1e-2 * np.max(np.abs(v)) or k == "w"  # sigma's bound meets the tolerance
-    assert main(base) == 0
+    assert main(base + ["--tol", "none"]) == 0
     streamed = json.loads(capsys.readouterr().out)
     assert "sigma_error" not in streamed
     s, v, e = (np.asarray(x, float) for x in (streamed["sigma"], c["sigma"], c["sigma_error"]))

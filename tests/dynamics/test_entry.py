@@ -181,3 +181,27 @@ def test_tol_auto_states_the_circuit_error_where_a_reference_can_run():
     assert stated_tol("auto", points=MAX_STATED_POINTS) == (AUTO_TOL, None)
     assert stated_tol("auto", fidelity="pnp") == (None, None)  # the PNP states its own at 1e-6
     assert stated_tol(3e-3, points=10**6) == (3e-3, None)  # an explicit tolerance is the caller's
+
+
+def test_tol_auto_gives_up_a_reference_past_its_cost_cap_or_that_fails_and_says_so():
+    """tol="auto" caps the reference PNP run's work (AUTO_WORK; here a small cap through pnp_options):
+    past it, or where the reference fails (too few cells allowed), the circuit's rows come back
+    without an error, bit for bit the bare circuit's, with a note that says which; an explicit
+    tolerance raises the failure instead (no silent downgrade)."""
+    from ipmc_asym.dynamics.circuit import ReferenceFailed
+    from ipmc_asym.dynamics.entry import AUTO_WORK
+
+    s = Strip(voltage=0.5)
+    bare = time_response(s, "sine:0.5V@20Hz", duration=0.1, points=41, tol=None).result
+    assert np.all(np.isnan(bare.sigma_error))
+    for opts, words in (({"max_work": 1e5}, "would cost more than tol='auto' allows"),
+                        ({"max_cells": 60}, "reference PNP run fails in this case")):
+        r = time_response(s, "sine:0.5V@20Hz", duration=0.1, points=41, tol="auto", pnp_options=opts)
+        assert r.info["tol"] is None and r.result.fidelity == "circuit"
+        assert np.all(np.isnan(r.result.sigma_error)) and np.array_equal(r.result.sigma, bare.sigma)
+        assert sum(words in n for n in r.info["notes"]) == 1, r.info["notes"]
+        with pytest.raises(ReferenceFailed):
+            time_response(s, "sine:0.5V@20Hz", duration=0.1, points=41, tol=1e-2, pnp_options=opts)
+    # within the cap (the default one), the same drive states its error
+    r = time_response(s, "sine:0.5V@20Hz", duration=0.1, points=41, tol="auto")
+    assert r.info["tol"] == 1e-2 and np.all(np.isfinite(r.result.sigma_error)) and AUTO_WORK >= 1e7

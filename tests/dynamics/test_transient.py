@@ -101,6 +101,51 @@ def test_tolerance_refused_beyond_the_cell_cap():
         step_response(1.0, TAU, fidelity="pnp", points=3, pnp_options={"tol": 1e-9, "max_cells": 3000})
 
 
+def _work(r):
+    """Cell-evaluations of a ladder's runs, from its own record of each level (cells, evaluations)."""
+    return sum(lv["cells"] * lv["nfev"] for lv in r.extra["refinement"])
+
+
+def test_a_coarsest_level_whose_integration_crawls_is_dropped():
+    """Affine model, 1 V step, the reference's settings (tol 1e-3 from refine 1/4): the quarter mesh
+    needs far more evaluations than the next and is dropped; the result is, bit for bit, the ladder
+    started one level finer (an independent run of the same levels), and a ladder whose first level
+    behaves (constant model) keeps it."""
+    tau = float(time_constant(S0.thickness, "affine"))
+    t = tau * np.array([0.0, 0.01, 0.1, 1.0, 5.0])
+    a = solve_transient(t, waveform("step", 1.0), S0, "affine", NAFION_LI, tol=1e-3, refine=0.25, rtol=1e-8)
+    assert a.success, a.message
+    first = a.extra["refinement"][0]
+    assert first["refine"] == 0.25 and "dropped" in first and first["nfev"] >= 4 * a.extra["refinement"][1]["nfev"]
+    b = solve_transient(t, waveform("step", 1.0), S0, "affine", NAFION_LI, tol=1e-3, refine=0.5, rtol=1e-8)
+    assert b.success and "dropped" not in b.extra["refinement"][0]
+    for k in ("sigma", "sigma_error", "current_density"):
+        assert np.array_equal(getattr(a, k), getattr(b, k), equal_nan=True), k
+    c = _pnp(1.0, t, tol=1e-3, refine=0.25, rtol=1e-8)
+    assert c.success and not any("dropped" in lv for lv in c.extra["refinement"])
+
+
+def test_max_work_caps_the_ladder_and_changes_nothing_below_it():
+    """``max_work`` (cell-evaluations): well above the ladder's own cost (3x: the cap is checked
+    against a prediction of the next level) the result is the uncapped one, bit for bit; below it the
+    run fails in one line, says it was the cap, and never spends more than the cap; far below it (a
+    tenth), the first level shows it early."""
+    t = np.linspace(0.0, 3 * TAU, 11)
+    free = _pnp(1.0, t, tol=1e-3)
+    assert free.success
+    need = free.extra["work"]
+    assert need > _work(free)  # the levels' own records, and the time check's reruns beside them
+    same = _pnp(1.0, t, tol=1e-3, max_work=3 * need)
+    assert same.success and np.array_equal(same.sigma, free.sigma) and np.array_equal(same.sigma_error, free.sigma_error)
+    for frac, spent_at_most in ((0.5, 1.0), (0.1, 1.0 / 3.0)):
+        r = _pnp(1.0, t, tol=1e-3, max_work=frac * need)
+        assert not r.success and r.extra["over_budget"] and "max_work" in r.message and "\n" not in r.message
+        assert np.all(np.isnan(r.sigma)) and np.all(np.isnan(r.sigma_error))
+        assert 0 < r.extra["work"] <= spent_at_most * frac * need
+    with pytest.raises(ValueError, match="max_work"):
+        _pnp(1.0, t, tol=1e-3, max_work=-1.0)
+
+
 @pytest.mark.parametrize("model,V", [("constant", 1.0), ("affine", -0.5), ("linear", 1.0), ("linear", -0.3)])
 def test_analytic_jacobian_against_finite_differences(model, V):
     from ipmc_asym.dynamics.transient import _LinearProblem, _Problem, make_fv_mesh
