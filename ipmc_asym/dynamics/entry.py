@@ -20,6 +20,7 @@ from ipmc_asym.base.registry import check_choice
 from ipmc_asym.base.results import Panel, ResultMixin, ResultSpec
 from ipmc_asym.dynamics.circuit import (
     BEAM_CHOICES,
+    CIRCUIT_NO_TOL_NOTE,
     DEFAULT_BEAM,
     DEFAULT_SPAN,
     FREQ_METHODS,
@@ -349,6 +350,8 @@ def time_response(strip: Strip | None = None, drive=None, *, duration=None, poin
             # than its cap, the circuit as it is, said
             cap = kw["pnp_options"].get("max_work")
             r = step_response(*args, tol=None, **dict(kw, pnp_options=pnp_options))
+            # the general "no tolerance" note gives way to the reason below (the run asked for one)
+            r.notes = [n for n in r.notes if n != CIRCUIT_NO_TOL_NOTE]
             tol, why = None, ("circuit: no error stated against the PNP: " + (
                 f"the reference PNP run over this drive would cost more than tol='auto' allows ({cap:.3g} "
                 f"cell-evaluations, ~{cap / WORK_PER_SECOND:.0f} s CPU; it grows with the periods and jumps in "

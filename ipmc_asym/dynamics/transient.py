@@ -837,6 +837,8 @@ def _small_signal(t, phi0_fun, vmax, strip, model, material, kw):
     ``vmax/SMALL_SIGNAL_V`` (the shape divided by ``vmax`` first: no overflow at a subnormal
     amplitude); its errors scaled alike plus twice the change per volt from the second."""
     runs = []
+    if kw["max_work"] is not None:  # the cap is on the whole: half of it for each of the two runs
+        kw = dict(kw, max_work=0.5 * kw["max_work"])
     for amp in (SMALL_SIGNAL_V, 2.0 * SMALL_SIGNAL_V):
         def fun(tt, amp=amp):
             return (np.asarray(phi0_fun(tt), dtype=float) / vmax) * amp

@@ -200,6 +200,7 @@ def test_tol_auto_gives_up_a_reference_past_its_cost_cap_or_that_fails_and_says_
         assert r.info["tol"] is None and r.result.fidelity == "circuit"
         assert np.all(np.isnan(r.result.sigma_error)) and np.array_equal(r.result.sigma, bare.sigma)
         assert sum(words in n for n in r.info["notes"]) == 1, r.info["notes"]
+        assert sum("no error stated" in n for n in r.info["notes"]) == 1  # one line says it, with its reason
         with pytest.raises(ReferenceFailed):
             time_response(s, "sine:0.5V@20Hz", duration=0.1, points=41, tol=1e-2, pnp_options=opts)
     # within the cap (the default one), the same drive states its error
