@@ -531,9 +531,7 @@ class CircuitStepper:
         if t[0] != self.t_last:
             raise ValueError("each chunk must start at the last time of the previous one (0 at the start)")
         tau = self.tau
-        tt, idx = substep_grid(t, tau, 5e-3, self.substeps,
-                               "duration is too long for the reduced model's fixed substeps (> 1e6 tau in one "
-                               "chunk); use fewer time constants")
+        tt, idx = substep_grid(t, tau, 5e-3, self.substeps, ("the reduced model's", "use fewer time constants"))
         ps = self.fun(tt * tau) / self.VT
         A = np.empty(tt.size)
         s = np.empty(tt.size)
@@ -583,18 +581,27 @@ class CircuitStepper:
         return self.S * sdot + self.Cg * (dphi - self.VT * Adot)
 
 
+#: The most fixed substeps :func:`substep_grid` lays in one chunk (the grid and the stepper's
+#: arrays: ~40 bytes each)
+MAX_SUBSTEPS = 5_000_000
+
+
 def substep_grid(t, tau, h_max, substeps, too_long):
     """Fixed substeps between the output times ``t`` (s): each interval of ``dt`` (in ``tau``) split
     into ``max(ceil(dt/h_max), substeps)`` equal steps (1 where ``dt <= h_max/2``).
 
     Returns ``(grid, idx)``: the substep times in units of ``tau`` and the index of each output
-    time in the grid.  ``too_long`` is the message refused when the grid would pass 5e6 steps.
+    time in the grid.  ``too_long`` = (whose substeps, what to do) for the refusal where the grid
+    would pass :data:`MAX_SUBSTEPS`; the refusal states the longest chunk in tau and in seconds.
     """
     dt = np.diff(t) / tau
     # counted in floating point first: a duration of 1e30 s would overflow the integer count
     kf = np.maximum(np.ceil(dt / h_max), np.where(dt <= 0.5 * h_max, 1, substeps))
-    if not np.all(np.isfinite(kf)) or kf.sum() > 5_000_000:
-        raise ValueError(too_long)
+    if not np.all(np.isfinite(kf)) or kf.sum() > MAX_SUBSTEPS:
+        span = MAX_SUBSTEPS * h_max
+        whose, advice = too_long
+        raise ValueError(f"duration is too long for {whose} fixed substeps (at most {MAX_SUBSTEPS:.0e} of at most "
+                         f"{h_max:.3g} tau in one chunk: {span:.3g} tau = {span * tau:.3g} s here); {advice}")
     k = kf.astype(np.int64)
     idx = np.concatenate(([0], np.cumsum(k)))
     frac = np.arange(idx[-1]) - np.repeat(idx[:-1], k)

@@ -143,8 +143,7 @@ class LineStepper:
             raise ValueError("each chunk must start at the last time of the previous one (0 at the start)")
         tau = self.tau
         tt, idx = substep_grid(t, tau, self.h_max, self.substeps,
-                               "duration is too long for the line's fixed substeps (> 5e6 in one chunk); "
-                               "use fewer time constants or fewer points a chunk")
+                               ("the line's", "use fewer time constants or fewer points a chunk"))
         ps = self.fun(tt * tau) / self.VT
         out = {}
         L = self.strip.length

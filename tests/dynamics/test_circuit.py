@@ -155,3 +155,22 @@ def test_default_window_resolves_the_nonlinear_rise(model, voltage):
     # and the printed table (11 rows evenly spread over the outputs) shows it: rows inside the rise
     idx = np.unique(np.linspace(0, r.t.size - 1, 11).astype(int))
     assert np.count_nonzero(r.t[idx] < t90) >= 3
+
+
+@pytest.mark.parametrize("h_max", [5e-3, 2.5e-4])
+def test_the_substep_refusal_states_the_longest_chunk_where_it_is(h_max):
+    # the refusal's figure in seconds is the boundary itself: 1 % below it the grid is laid,
+    # 1 % above it refused (it once said 1e6 tau where 2.5e4 tau was the limit)
+    import re
+
+    from ipmc_asym.dynamics.circuit import substep_grid
+
+    tau = 0.0338
+    with pytest.raises(ValueError, match="the reduced model's fixed substeps") as ex:
+        substep_grid(np.array([0.0, 1e30]), tau, h_max, 2, ("the reduced model's", "use fewer time constants"))
+    span = float(re.search(r"= (\S+) s here", str(ex.value)).group(1))
+    assert math.isclose(span, 5e6 * h_max * tau, rel_tol=1e-2)
+    grid, idx = substep_grid(np.array([0.0, 0.99 * span]), tau, h_max, 2, ("x", "y"))
+    assert grid[idx[-1]] * tau == pytest.approx(0.99 * span)
+    with pytest.raises(ValueError, match="use fewer time constants"):
+        substep_grid(np.array([0.0, 1.01 * span]), tau, h_max, 2, ("the reduced model's", "use fewer time constants"))
