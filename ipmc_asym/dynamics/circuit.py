@@ -752,7 +752,9 @@ def step_response(voltage=1.0, duration=None, *, strip: Strip | None = None, mod
         # validity window: from the first output time after which every later one meets tol
         extra["valid_from"] = (float(tgrid[0]) if not bad.any() else
                                float(tgrid[np.nonzero(bad)[0][-1] + 1]) if not bad[-1] else None)
-        extra["circuit_error_max_rel"] = float(np.max(err)) / scale
+        # 0 V: nothing charges, sigma is 0 to the bit and so is a bound that holds
+        emax = float(np.max(err))
+        extra["circuit_error_max_rel"] = emax / scale if scale > 0.0 else (0.0 if emax == 0.0 else math.inf)
         return not bad.any(), (f"the circuit's error bound {extra['circuit_error_max_rel']:.2g} (relative) exceeds "
                                f"tol = {tol:g}")
 

@@ -1069,7 +1069,7 @@ def _solve_direct(t, phi0_fun, strip, model, material, *, cells_per_debye, ratio
                         perm = get_model(model)
                         out.layer_voltage = _layer_voltage(E24, err, perm, material)
                     out.extra = dict(out.extra, refinement=lv, observed_order=p, tol=tol, work=spent[0],
-                                     sigma_error_max_rel=float(np.max(err)) / scale,
+                                     sigma_error_max_rel=float(np.max(err)) / scale if scale > 0 else 0.0,
                                      seconds=time.perf_counter() - t_start)
                     return out
         nxt = 2 * rf

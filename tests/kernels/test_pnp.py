@@ -82,3 +82,10 @@ def test_newton_delta_finds_the_root():
     ex = math.exp(-abs(x))
     d0 = (aL * ex - aR) / (GL * ex + GR) if x > 0 else (aL - aR * ex) / (GL + GR * ex)
     assert abs(d0 - (x + p0 - I0) / W) <= 1e-12 * (1 + abs(x))
+
+
+def test_newton_delta_returns_a_start_that_is_the_root():
+    # d_0(0) = (aL - aR)/(GL + GR) = 1 = (0 + p0 - I0)/W, every number exact in binary: delta = 0
+    # solves the constraint to the bit, and the iteration must not leave it (an empty bracket
+    # once sent it 2 away, to come back within its tolerance only)
+    assert newton_delta(1.5, 0.5, 0.25, 0.75, 2.0, 0.0, 2.0, 0.0) == 0.0
