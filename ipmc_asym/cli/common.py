@@ -50,8 +50,22 @@ class Parser(argparse.ArgumentParser):
     """argparse with a one-line error and exit status 2."""
 
     def error(self, message):
-        sys.stderr.write(f"{self.prog}: error: {message}\n")
+        sys.stderr.write(f"{self.prog}: error: {_named_once(message)}\n")
         raise SystemExit(2)
+
+
+def _named_once(message):
+    """argparse's ``argument --NAME: MSG`` where MSG, from a converter that names its parameter
+    for the library's callers too, begins with ``--NAME: `` or ``NAME: ``: the name said once."""
+    head, sep, rest = message.partition(": ")
+    if not (sep and head.startswith("argument ")):
+        return message
+    for name in head[len("argument "):].split("/"):
+        bare = name.lstrip("-")
+        for lead in (f"--{bare}: ", f"{bare}: "):
+            if bare and rest.startswith(lead):
+                return f"{head}: {rest[len(lead):]}"
+    return message
 
 
 def arg_type(conv, name="value"):

@@ -154,3 +154,20 @@ def test_uq_counts_samples_outside_and_writes_check_variables(tmp_path, capsys):
     assert main(["uq", str(sc), "--samples", "600", "--fidelity", "leading", "--json", "--keep-invalid"]) == 0
     kept = json.loads(capsys.readouterr().out)
     assert kept["n_used"] == kept["n_samples"] and kept["summary"]["rotation"]["n"] == kept["n_samples"]
+
+
+@pytest.mark.parametrize("argv,name", [
+    (["estimate", "--thickness", "200xx"], "thickness"),
+    (["step", "--diffusion", "1e-10xx"], "diffusion"),
+    (["step", "--sheet-resistance", "1Ohm"], "sheet-resistance"),
+    (["drive", "--duration", "1xx"], "duration"),
+])
+def test_a_unit_refusal_names_its_option_once(argv, name, capsys):
+    # argparse says "argument --NAME:" and the converter, which names its parameter for library
+    # callers too, said "--NAME:" again
+    with pytest.raises(SystemExit) as ei:
+        main(argv)
+    line = _one_line(capsys.readouterr().err)
+    assert ei.value.code == 2 and "unknown unit" in line
+    said = line.split(f"argument --{name}: ", 1)[1]
+    assert not said.startswith((f"--{name}", name)), line
