@@ -509,7 +509,9 @@ class _LinearProblem(_Problem):
                 xn = x - F / (dd - 1.0 / W)
                 step = 2.0 * (1.0 + np.abs(x))
                 alt = np.where(np.isinf(hi), x + step, np.where(np.isinf(lo), x - step, 0.5 * (lo + hi)))
-                xn = np.where((lo < xn) & (xn < hi), xn, alt)
+                # a root found to the bit (F = 0, or a step below x's resolution) is kept: its
+                # bracket is empty and would send it away (as newton_delta)
+                xn = np.where((F == 0.0) | (xn == x), x, np.where((lo < xn) & (xn < hi), xn, alt))
                 done = ~ok | (np.abs(xn - x) <= 1e-14 * (1.0 + np.abs(x)))
                 x = np.where(ok, xn, 0.0)
                 if np.all(done):

@@ -89,3 +89,13 @@ def test_newton_delta_returns_a_start_that_is_the_root():
     # solves the constraint to the bit, and the iteration must not leave it (an empty bracket
     # once sent it 2 away, to come back within its tolerance only)
     assert newton_delta(1.5, 0.5, 0.25, 0.75, 2.0, 0.0, 2.0, 0.0) == 0.0
+
+
+def test_the_stacked_constraint_solve_keeps_the_state_at_rest():
+    # uncharged under 0 V: delta = 0 solves the constraint to the bit; the vectorised Newton must
+    # return it, not a value brought back within its tolerance after an empty bracket
+    X = make_fv_mesh(0.02, 0.0, 0.0)
+    P = _LinearProblem(X, 0.02, 0.0, lambda t: 0.0, 0.0)
+    S = np.zeros((3, P.N - 1))
+    d0, lnL, lnR = P.solve_d0(S, np.zeros(3))[:3]
+    assert not np.any(d0) and not np.any(lnL) and not np.any(lnR)
