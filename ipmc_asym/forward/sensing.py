@@ -194,7 +194,15 @@ def sense(strip: Strip | None = None, curvature=None, tip_displacement=None, sup
     # rounded to 0), as for the electrode charge
     err = err + _subnormal_rounding(Q, kap)
     errv = errv + _subnormal_rounding(V, kap)
-    ok = hat.valid.reshape(b0.size, u.size).all(axis=1) & (err < VALIDITY_LIMIT) & (errv < VALIDITY_LIMIT)
+    rung_ok = hat.valid.reshape(b0.size, u.size).all(axis=1)
+    ok = rung_ok & (err < VALIDITY_LIMIT) & (errv < VALIDITY_LIMIT)
+    message = hat.message
+    under = rung_ok & ~ok  # every rung met its bound, the doubles' rounding of the result did not
+    if not message and under.any():
+        j = int(np.argmax(under))
+        count = "" if b0.size == 1 else f" [{int(under.sum())} of {b0.size} points; first shown]"
+        message = (f"relative error estimate above {VALIDITY_LIMIT:g}{count} (Q or V_oc subnormal at curvature "
+                   f"{kap[j]:.6g} 1/m: doubles round it)")
     used = hat.used.reshape(b0.size, u.size)[:, 0]
     strain = np.abs(kap) * strip.e
     strain_ok = strain <= mat.strain_limit
@@ -207,7 +215,7 @@ def sense(strip: Strip | None = None, curvature=None, tip_displacement=None, sup
     return SenseResult(curvature=kap, tip_displacement=w, sigma=sig, Q=Q, V_oc=V, Q_per_w=qpw, error=err,
                        error_V_oc=errv, strain_parameter=b0, max_strain=strain, check_strain=strain_ok,
                        check_beam_regime=beam_ok, valid=ok & strain_ok & beam_ok, fidelity_used=used,
-                       model=perm.name, support=support, load=load, fidelity=req.fidelity, nu=nu, message=hat.message)
+                       model=perm.name, support=support, load=load, fidelity=req.fidelity, nu=nu, message=message)
 
 
 def _root_sigma(b0, lam, perm, mat, req, g0):

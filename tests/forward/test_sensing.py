@@ -62,3 +62,14 @@ def test_bad_input_names_the_parameter(kw, needle):
 def test_strip_must_be_a_strip():
     with pytest.raises(ValueError, match="strip must be"):
         ia.sense({"thickness": 1e-4}, curvature=1.0)
+
+
+def test_an_underflowing_response_is_flagged_with_its_reason():
+    # at a subnormal tip displacement every rung meets its bound, but Q rounds to a few units of
+    # 4.9e-324: the row is kept, flagged, and the reason says so (it was flagged with no reason)
+    w = np.array([1e-3, 1e-320])
+    r = ia.sense(ia.Strip(), tip_displacement=w)
+    assert r.valid.tolist() == [True, False]
+    assert r.error[1] >= 1e-2 and abs(r.Q[1]) < 1e-320
+    assert "subnormal" in r.message and "1 of 2 points" in r.message
+    assert ia.sense(ia.Strip(), tip_displacement=1e-3).message == ""
