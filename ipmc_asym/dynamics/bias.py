@@ -44,6 +44,7 @@ from scipy.linalg import solve_banded
 
 from ipmc_asym.base.settings import BVP_STATED_ERROR
 from ipmc_asym.bvp.problems import y_of_s
+from ipmc_asym.bvp.solver import BVP_MIN_A2
 from ipmc_asym.bvp.solver import solve as solve_static
 from ipmc_asym.integral.charge import charge
 from ipmc_asym.kernels._generated_charge import (
@@ -314,6 +315,21 @@ def bias_reference(f, voltage, strip: Strip | None = None, model="constant",
     f = np.atleast_1d(np.asarray(f, dtype=float))
     if not np.all(np.isfinite(f)) or np.any(f <= 0):
         raise ValueError("frequencies must be finite and > 0 Hz")
+    # the floor of the static solver (bvp.solver: below it C - 1 ~ A2 is lost to rounding), with a
+    # margin so that the floor itself is solved
+    v_floor = (1.0 + 1e-9) * BVP_MIN_A2 / float(groups.inverse_thermal_voltage(m))
+    if 0.0 < abs(V) < v_floor:
+        # below the floor the biased state is the state at rest to first order in V/(R T/F) < 1e-6:
+        # the reference at rest, its error raised by twice its change from rest to the floor (same
+        # sign; the response is linear in the bias there, its second order ~1e-12)
+        r_0 = bias_reference(f, 0.0, s, perm, m)
+        r_1 = bias_reference(f, math.copysign(v_floor, V), s, perm, m)
+        change = np.maximum(np.abs(r_1.Z_area - r_0.Z_area) / np.abs(r_0.Z_area),
+                            np.abs(r_1.charge_transfer - r_0.charge_transfer) / np.abs(r_0.charge_transfer))
+        return BiasReference(f=r_0.f, Z_area=r_0.Z_area, charge_transfer=r_0.charge_transfer,
+                             error=np.maximum(r_0.error, r_1.error) + 2.0 * change, voltage=V,
+                             nodes=max(r_0.nodes, r_1.nodes),
+                             C_diff=float(charge(s.thickness, V, perm, "exact", material=m).C_diff))
     e = s.e
     lam2, r0, lo, xs, profile = _static(s, perm, m, V)
     W = 2.0 * math.pi * f * e * e / m.D

@@ -4,6 +4,8 @@ Independent checks: at 0 V the closed form ``pnp-linear``; at low frequency the 
 differential capacitance ``dsigma/dphi0`` (``charge``, rung ``exact``); the stated error of the
 biased circuit against the reference recomputed on finer meshes."""
 
+import math
+
 import numpy as np
 import pytest
 
@@ -189,3 +191,23 @@ def test_biased_circuit_error_bounds_a_finer_reference(th, model, V, monkeypatch
 def test_reference_points_must_be_a_count(bad):
     with pytest.raises(ValueError, match="reference_points must be an integer >= 0"):
         frequency_response([1.0], method="circuit", voltage=0.5, reference_points=bad)
+
+
+@pytest.mark.parametrize("model,V", [("linear", -1e-9)] + [
+    pytest.param(m, v, marks=pytest.mark.slow) for m in ("constant", "linear", "affine") for v in (1e-9, -1e-9, 1e-320)
+    if (m, v) != ("linear", -1e-9)])
+def test_a_bias_below_the_static_solvers_floor_has_a_reference(model, V):
+    """Below the floor of the static BVP (A2 = 1e-6, 2.6e-8 V) the reference is the one at rest, its
+    error raised by its change up to the floor: it holds against the references at two biases above
+    the floor, extrapolated linearly to V (their own errors added), and the charge per volt's static
+    limit is the exact differential capacitance at V."""
+    s = Strip()
+    f = F[1:3]
+    r = bias_reference(f, V, s, model)
+    a = math.copysign(4e-8, V)
+    ra, r2a = bias_reference(f, a, s, model), bias_reference(f, 2.0 * a, s, model)
+    z = ra.Z_area + (r2a.Z_area - ra.Z_area) * (V - a) / a
+    assert np.all(np.abs(z - r.Z_area) <= (r.error + 3.0 * np.maximum(ra.error, r2a.error)) * np.abs(r.Z_area))
+    assert r.voltage == V and r.error.max() < 1e-6
+    cd = ia.charge(s.thickness, V, model, "exact").C_diff
+    assert r.C_diff == pytest.approx(float(cd), rel=1e-12)
