@@ -98,4 +98,6 @@ def test_the_stacked_constraint_solve_keeps_the_state_at_rest():
     P = _LinearProblem(X, 0.02, 0.0, lambda t: 0.0, 0.0)
     S = np.zeros((3, P.N - 1))
     d0, lnL, lnR = P.solve_d0(S, np.zeros(3))[:3]
-    assert not np.any(d0) and not np.any(lnL) and not np.any(lnR)
+    assert not np.any(d0)
+    # the face concentrations are 1 to their sums' rounding (one ulp below on an aarch64 machine)
+    assert np.all(np.abs(lnL) <= 4e-16) and np.array_equal(lnL, lnR)
