@@ -430,18 +430,28 @@ def test_fit_csv_rows_capped(tmp_path, capsys):
     assert "more than 10 data rows" in err
 
 
-def test_refusal_costs_under_two_cpu_seconds():
-    """The refusal comes before any work: the child's CPU time (not the wall time of a loaded machine)."""
+def test_a_refusal_costs_what_the_commands_help_costs():
+    """The refusal comes before any work: the children's CPU time (not the wall time of a loaded
+    machine), against the same commands' ``--help`` (start-up and parsing, no work) in the same
+    run -- a ratio, the same on a fast machine, a slow one or an emulated one."""
     import resource
 
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    for argv in (["step", "--points", "1e9"], ["uq", UQ_SCENE, "--samples", "1e12"]):
-        r = subprocess.run([sys.executable, "-m", "ipmc_asym", *argv], capture_output=True, text=True,
-                           env={**os.environ, "PYTHONPATH": ROOT}, timeout=60)
-        assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1, r.stderr
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
-    assert cpu < 2 * 2.0
+    def cpu(runs, code):
+        before = resource.getrusage(resource.RUSAGE_CHILDREN)
+        for argv in runs:
+            r = subprocess.run([sys.executable, "-m", "ipmc_asym", *argv], capture_output=True, text=True,
+                               env={**os.environ, "PYTHONPATH": ROOT}, timeout=600)
+            assert r.returncode == code, r.stderr
+            if code == 2:
+                assert len(r.stderr.strip().splitlines()) == 1, r.stderr
+        after = resource.getrusage(resource.RUSAGE_CHILDREN)
+        return (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+
+    refused = cpu((["step", "--points", "1e9"], ["uq", UQ_SCENE, "--samples", "1e12"]), 2)
+    helped = cpu((["step", "--help"], ["uq", "--help"]), 0)
+    # measured 2.06 s against 2.3 s on an x86-64 machine; a refusal after the work would cost
+    # seconds to hours more
+    assert refused < 1.5 * helped + 0.5, (refused, helped)
 
 
 # ---------------------------------------------------------------------------------------
