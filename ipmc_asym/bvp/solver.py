@@ -68,7 +68,7 @@ from ipmc_asym.model import groups
 from ipmc_asym.model.params import NAFION_LI, Groups, Material, Strip, check_finite, check_positive
 from ipmc_asym.model.permittivity import Permittivity, get_model
 
-__all__ = ["BVPResult", "solve", "moment_integral_bvp", "b1_guess", "make_mesh"]
+__all__ = ["BVPResult", "solve", "moment_integral_bvp", "b1_guess", "make_mesh", "min_voltage"]
 
 _SUGGEST = (
     "try a looser tol (e.g. 1e-8), a larger max_nodes, continuation=True, or a voltage/"
@@ -213,6 +213,11 @@ def _bc_res(prob, res) -> float:
 BVP_MIN_A2 = 1e-6
 
 
+def min_voltage(material: Material) -> float:
+    """The smallest ``|phi0|`` (V) that :func:`solve` resolves: :data:`BVP_MIN_A2` thermal voltages."""
+    return BVP_MIN_A2 * float(groups.thermal_voltage(material))
+
+
 def solve(strip: Strip, model="constant", material: Material = NAFION_LI, *, tol: float = BVP_TOL,
           max_nodes: int = BVP_MAX_NODES, continuation: bool = True,
           fallback: bool = True) -> BVPResult:
@@ -257,7 +262,7 @@ def solve(strip: Strip, model="constant", material: Material = NAFION_LI, *, tol
     a2 = float(groups.A2(strip.voltage, material))
     if 0.0 < a2 < BVP_MIN_A2:
         raise ValueError(
-            f"voltage |phi0| = {abs(float(strip.voltage)):.3g} V is below the {BVP_MIN_A2 * groups.thermal_voltage(material):.3g} V "
+            f"voltage |phi0| = {abs(float(strip.voltage)):.3g} V is below the {min_voltage(material):.3g} V "
             "the BVP resolves (C - 1 ~ A2 is lost to rounding); the moment integral there is the "
             "Debye-Hueckel series of ipmc_asym.integral.api.moment (any fidelity)")
     g_signed = perm.groups(strip, material)

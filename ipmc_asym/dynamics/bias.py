@@ -44,7 +44,7 @@ from scipy.linalg import solve_banded
 
 from ipmc_asym.base.settings import BVP_STATED_ERROR
 from ipmc_asym.bvp.problems import y_of_s
-from ipmc_asym.bvp.solver import BVP_MIN_A2
+from ipmc_asym.bvp.solver import min_voltage
 from ipmc_asym.bvp.solver import solve as solve_static
 from ipmc_asym.integral.charge import charge
 from ipmc_asym.kernels._generated_charge import (
@@ -315,9 +315,9 @@ def bias_reference(f, voltage, strip: Strip | None = None, model="constant",
     f = np.atleast_1d(np.asarray(f, dtype=float))
     if not np.all(np.isfinite(f)) or np.any(f <= 0):
         raise ValueError("frequencies must be finite and > 0 Hz")
-    # the floor of the static solver (bvp.solver: below it C - 1 ~ A2 is lost to rounding), with a
-    # margin so that the floor itself is solved
-    v_floor = (1.0 + 1e-9) * BVP_MIN_A2 / float(groups.inverse_thermal_voltage(m))
+    # the floor of the static solver (below it C - 1 ~ A2 is lost to rounding), with a margin so
+    # that the floor itself is solved
+    v_floor = (1.0 + 1e-9) * min_voltage(m)
     if 0.0 < abs(V) < v_floor:
         # below the floor the biased state is the state at rest to first order in V/(R T/F) < 1e-6:
         # the reference at rest, its error raised by twice its change from rest to the floor (same

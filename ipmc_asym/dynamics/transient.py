@@ -509,9 +509,9 @@ class _LinearProblem(_Problem):
                 xn = x - F / (dd - 1.0 / W)
                 step = 2.0 * (1.0 + np.abs(x))
                 alt = np.where(np.isinf(hi), x + step, np.where(np.isinf(lo), x - step, 0.5 * (lo + hi)))
-                # a root found to the bit (F = 0, or a step below x's resolution) is kept: its
-                # bracket is empty and would send it away (as newton_delta)
-                xn = np.where((F == 0.0) | (xn == x), x, np.where((lo < xn) & (xn < hi), xn, alt))
+                # a root found to the bit (F = 0, or a step below x's resolution: xn = x) is kept:
+                # its bracket is empty and would send it away (as newton_delta)
+                xn = np.where(xn == x, x, np.where((lo < xn) & (xn < hi), xn, alt))
                 done = ~ok | (np.abs(xn - x) <= 1e-14 * (1.0 + np.abs(x)))
                 x = np.where(ok, xn, 0.0)
                 if np.all(done):
@@ -924,9 +924,11 @@ def _solve_direct(t, phi0_fun, strip, model, material, *, cells_per_debye, ratio
         return _failed(x, f"{what} needs more than max_work = {max_work:.3g} cell-evaluations "
                           f"({spent[0]:.3g} spent)", levels(), over_budget=True, work=spent[0])
 
+    def entry(q, x):
+        return {"refine": q, "cells": x.extra["cells"], "seconds": x.extra["seconds"], "nfev": x.extra.get("nfev")}
+
     def levels():
-        return dropped + [{"refine": q, "cells": x.extra["cells"], "seconds": x.extra["seconds"],
-                           "nfev": x.extra.get("nfev")} for q, x in runs]
+        return dropped + [entry(q, x) for q, x in runs]
 
     while True:
         if not runs:
@@ -946,9 +948,7 @@ def _solve_direct(t, phi0_fun, strip, model, material, *, cells_per_debye, ratio
             elif r.extra.get("over_budget"):
                 return over_budget(r, "the run")
             elif r.extra["nfev"] >= COARSE_NFEV * int(r2.extra["nfev"]):
-                dropped.append({"refine": rf, "cells": r.extra["cells"], "seconds": r.extra["seconds"],
-                                "nfev": r.extra["nfev"],
-                                "dropped": f"more than {COARSE_NFEV} times the next level's evaluations"})
+                dropped.append(dict(entry(rf, r), dropped=f"more than {COARSE_NFEV} times the next level's evaluations"))
             else:
                 return _failed(r, r.message, [])
             rf, r = 2.0 * rf, r2

@@ -64,14 +64,14 @@ def integrate_circuit(tt, ps, rho, mid, X, Wt, A_out, s_out, state):
         for _ in range(200):
             sx, cx = shat(x, rho, mid, X, Wt)
             g = a0 * sx + 0.5 * h * x - rhs
-            if g == 0.0:  # x is the root as rounded: the bracket below would be empty and send x away
-                break
             if g > 0.0:
                 hi = x
             else:
                 lo = x
             xn = x - g / (a0 * cx + 0.5 * h)
-            if xn == x:  # a step below x's resolution (a subnormal A under a subnormal drive): converged
+            # x is the root as rounded (g = 0), or the step is below x's resolution (a subnormal A
+            # under a subnormal drive): converged; the bracket below would be empty and send x away
+            if xn == x:
                 break
             if not (lo < xn < hi):
                 if math.isinf(lo) or math.isinf(hi):

@@ -83,14 +83,14 @@ def newton_delta(a_L, a_R, GL, GR, W, I0, p0, x):
     for _ in range(200):
         d0, dd = _d0_of(x, a_L, a_R, GL, GR)
         F = d0 - (x + p0 - I0) / W
-        if F == 0.0:  # x is the root as rounded: the bracket below would be empty and send x away
-            return x
         if F > 0.0:
             lo = x
         else:
             hi = x
         xn = x - F / (dd - 1.0 / W)
-        if xn == x:  # a step below x's resolution: converged
+        # x is the root as rounded (F = 0), or the step is below x's resolution: converged; the
+        # bracket below would be empty and send x away
+        if xn == x:
             return x
         if not lo < xn < hi:
             step = 2.0 * (1.0 + abs(x))
