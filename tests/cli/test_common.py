@@ -163,8 +163,8 @@ def test_uq_counts_samples_outside_and_writes_check_variables(tmp_path, capsys):
     (["drive", "--duration", "1xx"], "duration"),
 ])
 def test_a_unit_refusal_names_its_option_once(argv, name, capsys):
-    # argparse says "argument --NAME:" and the converter, which names its parameter for library
-    # callers too, said "--NAME:" again
+    # argparse says "argument --NAME:"; the converter, which names its parameter for library
+    # callers too, must not say "--NAME:" after it
     with pytest.raises(SystemExit) as ei:
         main(argv)
     line = _one_line(capsys.readouterr().err)

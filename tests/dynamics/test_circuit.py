@@ -160,7 +160,7 @@ def test_default_window_resolves_the_nonlinear_rise(model, voltage):
 @pytest.mark.parametrize("h_max", [5e-3, 2.5e-4])
 def test_the_substep_refusal_states_the_longest_chunk_where_it_is(h_max):
     # the refusal's figure in seconds is the boundary itself: 1 % below it the grid is laid,
-    # 1 % above it refused (it once said 1e6 tau where 2.5e4 tau was the limit)
+    # 1 % above it refused
     import re
 
     from ipmc_asym.dynamics.circuit import substep_grid

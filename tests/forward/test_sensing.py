@@ -66,7 +66,7 @@ def test_strip_must_be_a_strip():
 
 def test_an_underflowing_response_is_flagged_with_its_reason():
     # at a subnormal tip displacement every rung meets its bound, but Q rounds to a few units of
-    # 4.9e-324: the row is kept, flagged, and the reason says so (it was flagged with no reason)
+    # 4.9e-324: the row is kept and flagged, and a flagged row carries its reason
     w = np.array([1e-3, 1e-320])
     r = ia.sense(ia.Strip(), tip_displacement=w)
     assert r.valid.tolist() == [True, False]

@@ -111,7 +111,7 @@ def _reference_ode(model, th, v):
     A0, A1, A2, A3 = g.A0, g.A1, g.A2, g.A3
     # B1 from H(ln B1) = H(ln B1 - A2) by brentq (not the generated quadratic)
     def H(yv):  # >= 0; e^y - 1 - y without its cancellation near y = 0, where quad's tolerance
-        # is otherwise lost to rounding (it said so, and one machine's reference was 4e-11 off)
+        # would be lost to rounding (quad warns, and the reference then moves with the machine)
         em = math.expm1(yv)
         return max(A0 * em**2 / 2 + A1 * _em1my(yv), 0.0)
 

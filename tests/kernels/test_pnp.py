@@ -86,8 +86,8 @@ def test_newton_delta_finds_the_root():
 
 def test_newton_delta_returns_a_start_that_is_the_root():
     # d_0(0) = (aL - aR)/(GL + GR) = 1 = (0 + p0 - I0)/W, every number exact in binary: delta = 0
-    # solves the constraint to the bit, and the iteration must not leave it (an empty bracket
-    # once sent it 2 away, to come back within its tolerance only)
+    # solves the constraint to the bit, and the iteration must not leave it (its bracket is then
+    # empty: a bracketing step would send it 2 away, to come back within the tolerance only)
     assert newton_delta(1.5, 0.5, 0.25, 0.75, 2.0, 0.0, 2.0, 0.0) == 0.0
 
 
