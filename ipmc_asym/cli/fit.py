@@ -148,6 +148,8 @@ def run(args) -> int:
     else:
         if res.chi2_red is not None:
             gof = f"chi2_red = {res.chi2_red:.4g} (with the given sigma)"
+        elif res.noise_scale is None:
+            gof = "no goodness of fit (as many free parameters as measured values)"
         else:
             gof = (f"noise scale s = {res.noise_scale:.3g} (relative, estimated from the residuals; no sigma_ "
                    f"columns, so no chi2 goodness of fit)")

@@ -97,8 +97,7 @@ def plot_fit(result, path) -> str:
         return f" [{p['ci95'][0]:.4g}, {p['ci95'][1]:.4g}]"
 
     pars = ", ".join(f"{_SYMBOL.get(n, n)} = {p['value']:.4g}{label(p)} {_unit(n)}" for n, p in result.parameters.items())
-    gof = (f"χ²_red = {result.chi2_red:.3g}" if result.chi2_red is not None
-           else f"noise s = {result.noise_scale:.2g} (relative, estimated)")
+    gof = _goodness(result)
     fig.suptitle(f"fit [{result.model}, {result.fidelity}]: {pars};\n{gof}", fontsize=8, wrap=True)
     print_fonts(fig)
     fig.tight_layout()
@@ -173,9 +172,18 @@ def plot_fit_dynamic(result, path) -> str:
         axr.set_xlabel(xl)
     pars = ", ".join(f"{_SYMBOL.get(nm, nm)} = {p['value']:.4g} {_unit(nm)}" + ("" if p["status"] == "ok" else f" ({p['status']})")
                      for nm, p in result.parameters.items())
-    gof = (f"χ²_red = {result.chi2_red:.3g}" if result.chi2_red is not None
-           else f"noise s = {result.noise_scale:.2g} (relative, estimated)")
+    gof = _goodness(result)
     fig.suptitle(f"fit [{result.model}]: {pars};\n{gof}", fontsize=8, wrap=True)
     print_fonts(fig)
     fig.tight_layout()
     return savefig(fig, path, dpi=300)  # print resolution when the file is a PNG
+
+
+def _goodness(result) -> str:
+    """The suptitle's goodness-of-fit phrase: chi2_red with sigma, the noise scale without, and
+    neither where no degree of freedom is left (n = p)."""
+    if result.chi2_red is not None:
+        return f"χ²_red = {result.chi2_red:.3g}"
+    if result.noise_scale is not None:
+        return f"noise s = {result.noise_scale:.2g} (relative, estimated)"
+    return "n = p: no goodness of fit"

@@ -497,6 +497,9 @@ class CalibrationResult(ResultMixin):
     @property
     def chi2_note(self) -> str:
         """What ``chi2_red`` means here (one sentence)."""
+        if self.chi2_red is None and self.noise_scale is None:
+            return ("as many free parameters as measured values (n = p): no degree of freedom is left, "
+                    "so there is no goodness of fit")
         if self.chi2_red is None:
             return ("no sigma_ columns: the noise scale is estimated from the residuals (noise_scale, relative), "
                     "so chi2_red would be 1 by construction and is not a goodness of fit")
@@ -797,8 +800,9 @@ def _report(prob, res, lo, hi, n, has_sigma, stats, notes, warns, ends=None):
     dof = n - p
     s2_hat = chi2 / dof if dof > 0 else float("nan")
     # chi2_red is a goodness of fit only with known sigma; without it the scale is estimated
-    # (s^2 = chi^2/(n - p)) and chi2/(s^2 (n - p)) = 1 identically
-    chi2_red = s2_hat if has_sigma else None
+    # (s^2 = chi^2/(n - p)) and chi2/(s^2 (n - p)) = 1 identically; with n = p (allowed with
+    # sigma) no degree of freedom is left for either: None, not 0/0
+    chi2_red = s2_hat if has_sigma and dof > 0 else None
     noise_scale = None if has_sigma else math.sqrt(s2_hat)
     s2, thr, cov, sd_log = _interval_scale(res.jac, chi2, n, p, has_sigma, stats)
     if has_sigma and dof > 0:

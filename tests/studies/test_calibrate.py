@@ -4,6 +4,7 @@ The synthetic data come from :func:`ipmc_asym.forward.estimate.evaluate` (the sc
 at ``quadrature``), not from the vectorised predictor the fit uses.
 """
 
+import json
 import math
 
 import numpy as np
@@ -94,6 +95,16 @@ def test_no_sigma_scale_from_residuals(truth_rows, tmp_path):
     for k, true in TRUE.items():
         lo, hi = r.parameters[k]["ci95"]
         assert lo < true < hi
+
+
+def test_no_degree_of_freedom_reports_no_goodness_of_fit(truth_rows, tmp_path):
+    """With sigma, as many free parameters as values is allowed (the fit is exact), but
+    chi2/(n - p) is 0/0 there: no chi2_red, no noise scale, and a note that says why, not NaN."""
+    p = _write(tmp_path / "one.csv", truth_rows[:1], 0, cols=("blocking_force",), sigma=True)
+    r = fit(read_data(p, Strip(width=5e-3)), "modulus", fidelity="leading")
+    assert r.n_points == 1 and r.chi2_red is None and r.noise_scale is None
+    assert "no degree of freedom" in r.chi2_note
+    assert "nan" not in json.dumps(r.as_dict(), allow_nan=False).lower()
 
 
 def test_too_many_parameters_refused(truth_rows, tmp_path):
