@@ -136,18 +136,21 @@ def run(args):
     # the rows stepped on the output grid and streamed (the dynamic beam too: the grid must resolve the
     # first mode), whatever --out or --json do with them; with --tol or the PNP, solved in memory
     first_run_notice("step-pnp" if stated else None)
-    if stated:  # the in-memory PNP run is the long part (seconds to minutes): say so before it starts
+
+    def notice():
+        # the in-memory PNP run is the long part (seconds to minutes): said as it starts, after the refusals
         what = "the PNP" if args.fidelity == "pnp" else f"the circuit and a reference PNP run (tol {tol:g})"
         cap = (f"; under --tol auto at most ~{AUTO_WORK / WORK_PER_SECOND:.0f} s, beyond which no error is stated; "
                f"--tol none skips it" if args.fidelity == "circuit" and args.tol == "auto" else "")
         sys.stderr.write(f"drive: {what} over {args.points} output times, in memory (the nominal strip, a "
                          f"sine over 2 s: ~2-9 s CPU at 1 Hz, ~11 s at 10 Hz{cap})\n")
         sys.stderr.flush()
+
     resp = time_response(strip, args.waveform, duration=args.duration, points=args.points, model=args.model,
                          material=material, fidelity=args.fidelity, tol=args.tol, beam=args.beam,
                          viscous_modulus=args.viscous_modulus, sheet_resistance=args.sheet_resistance,
                          line_segments=args.line_segments, support=support, electrode=electrode, stream=True,
-                         beam_grid="output")
+                         beam_grid="output", notice=notice)
     info = resp.info
     # the tolerance the run met (auto states none where the reference PNP run refuses the strip)
     stated = stated and (args.fidelity == "pnp" or info.get("tol") is not None)

@@ -191,17 +191,23 @@ def run(args):
     time_path(fidelity=args.fidelity, tol=tol, beam=args.beam, sheet_resistance=args.sheet_resistance,
               stream=stream)
     first_run_notice("step-pnp" if args.fidelity == "pnp" or tol is not None else "step")
-    if tol is not None and args.fidelity == "circuit":  # the reference PNP run is the long part: say so first
-        sys.stderr.write(f"step: the circuit and a reference PNP run (tol {tol:g}) that bounds its error, "
-                         f"{len(models)} model{'s' if len(models) > 1 else ''} (nominal strip, each: ~1.5-2.5 s CPU for "
-                         f"a 1 V step, ~6 s for 1 s of a 10 Hz sine; --tol none skips it)\n")
-        sys.stderr.flush()
+    said = []
+
+    def notice():
+        # the reference PNP run is the long part: said when it starts (after the refusals), once
+        if tol is not None and args.fidelity == "circuit" and not said:
+            said.append(True)
+            sys.stderr.write(f"step: the circuit and a reference PNP run (tol {tol:g}) that bounds its error, "
+                             f"{len(models)} model{'s' if len(models) > 1 else ''} (nominal strip, each: ~1.5-2.5 s "
+                             f"CPU for a 1 V step, ~6 s for 1 s of a 10 Hz sine; --tol none skips it)\n")
+            sys.stderr.flush()
+
     # the library chooses the solver (dynamics.entry.time_path): rows streamed to --out where a stepped
     # path serves, the in-memory solve otherwise
     resps = {m: time_response(strip, args.waveform, duration=args.duration, points=args.points, model=m,
                               material=material, fidelity=args.fidelity, tol=args.tol, beam=args.beam,
                               viscous_modulus=args.viscous_modulus, sheet_resistance=args.sheet_resistance,
-                              line_segments=args.line_segments, stream=stream)
+                              line_segments=args.line_segments, stream=stream, notice=notice)
              for m in models}
     path = resps[models[0]].path
     if path == "line" and resps[models[0]].chunks is None:

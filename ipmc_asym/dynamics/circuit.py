@@ -652,7 +652,8 @@ def _pnp_output_errors(tgrid, fun, u, cur_err, M, w, strip, perm, material):
 def step_response(voltage=1.0, duration=None, *, strip: Strip | None = None, model="constant",
                   fidelity="circuit", material: Material | None = None, t=None, points: int = 1000,
                   waveform_kind="step", ramp_time=None, frequency=None, pnp_options=None, beam="quasi-static",
-                  viscous_modulus=0.0, n_modes=TIME_MODES, tol: float | None = None) -> StepResult:
+                  viscous_modulus=0.0, n_modes=TIME_MODES, tol: float | None = None,
+                  notice=None) -> StepResult:
     """Charging transient of the strip under an imposed ``phi0(t)`` (starting uncharged at t = 0).
 
     Parameters
@@ -695,6 +696,10 @@ def step_response(voltage=1.0, duration=None, *, strip: Strip | None = None, mod
         error_pnp``; when it fails, the PNP at ``tol`` is returned (``fidelity`` says which).
         Without ``tol`` the circuit carries no error estimate (``sigma_error`` NaN) and the
         PNP its default tolerance (1e-6).
+    notice : callable, optional
+        Called with no argument once, just before the PNP solver starts (the reference run or the
+        pnp rung: the long part), after the checks and the circuit's own run: a line saying what
+        runs is not printed ahead of a refusal.
 
     Returns
     -------
@@ -736,10 +741,21 @@ def step_response(voltage=1.0, duration=None, *, strip: Strip | None = None, mod
             sigma, u, J = circuit_response(tgrid, fun, s, perm, m)
             err = sig_err
             if tol is not None:
+                _say()
                 r, err = _circuit_error(sigma, tgrid, fun, s, perm, m, opts)
                 pnp_ref.append(r)
             return sigma, u, J, err
-        return pnp_ref[0] if pnp_ref else solve_transient(tgrid, fun, s, perm, m, **opts)
+        if pnp_ref:
+            return pnp_ref[0]
+        _say()
+        return solve_transient(tgrid, fun, s, perm, m, **opts)
+
+    said = []
+
+    def _say():
+        if notice is not None and not said:
+            said.append(True)
+            notice()
 
     def checks(f, r, idx):
         if f == "pnp":

@@ -279,7 +279,7 @@ def time_response(strip: Strip | None = None, drive=None, *, duration=None, poin
                   material: Material | None = None, fidelity="circuit", tol: float | None = None,
                   beam=DEFAULT_BEAM, viscous_modulus=0.0, sheet_resistance=0.0, line_segments=DEFAULT_SEGMENTS,
                   support=None, electrode=None, stream=False, beam_grid="refined", n_modes=TIME_MODES,
-                  pnp_options=None) -> TimeResponse:
+                  pnp_options=None, notice=None) -> TimeResponse:
     """Response of the strip to an applied voltage ``phi0(t)``, starting uncharged at t = 0.
 
     Parameters
@@ -317,6 +317,9 @@ def time_response(strip: Strip | None = None, drive=None, *, duration=None, poin
         How the dynamic beam meets the output grid (:data:`BEAM_GRIDS`).
     pnp_options : dict, optional
         The PNP solver's options (in-memory path).
+    notice : callable, optional
+        In-memory path: called with no argument just before the PNP solver starts (the long
+        part; :func:`~ipmc_asym.dynamics.circuit.step_response`), never ahead of a refusal.
 
     Returns
     -------
@@ -337,7 +340,7 @@ def time_response(strip: Strip | None = None, drive=None, *, duration=None, poin
         kind = "step" if d.kind == "step" else d.source
         args = (d.voltage if d.kind == "step" else s.voltage, duration)
         kw = dict(strip=s, model=model, fidelity=fidelity, material=m, points=points, waveform_kind=kind, beam=beam,
-                  viscous_modulus=viscous_modulus, n_modes=n_modes, pnp_options=pnp_options)
+                  viscous_modulus=viscous_modulus, n_modes=n_modes, pnp_options=pnp_options, notice=notice)
         if auto and tol is not None:  # the reference's cost capped (pnp_options may set its own cap)
             kw["pnp_options"] = {"max_work": AUTO_WORK, **(pnp_options or {})}
         try:

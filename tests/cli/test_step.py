@@ -14,8 +14,11 @@ from ipmc_asym.model.params import NAFION_LI, Strip
 
 def test_step_tol_json_carries_the_error_estimate(capsys):
     assert main(["step", "--voltage", "1V", "--points", "6", "--tol", "1%", "--json"]) == 0
-    out = json.loads(capsys.readouterr().out)
+    cap = capsys.readouterr()
+    out = json.loads(cap.out)
     assert out["fidelity"] == "circuit" and out["tol"] == 0.01 and out["valid_from"] == 0.0
+    # the long part is said once, as it starts
+    assert cap.err.count("a reference PNP run (tol 0.01)") == 1, cap.err
     sig, err = np.array(out["sigma"]), np.array(out["sigma_error"])
     assert np.all(err <= 0.01 * np.max(np.abs(sig)))
     # independent check: the PNP solver at its default tolerance
@@ -42,6 +45,17 @@ def test_step_tol_refusals_are_one_line(argv, capsys):
     assert rc == 2
     err = capsys.readouterr().err.strip().splitlines()[-1]
     assert "tol" in err and "Traceback" not in err
+
+
+@pytest.mark.parametrize("argv", [["step", "--duration", "1e30"],
+                                  ["drive", "--waveform", "sine:1V@1Hz", "--duration", "1e30"]])
+def test_a_duration_past_the_substeps_is_refused_before_anything_is_said(argv, capsys):
+    """The circuit's substep limit (2.5e4 tau) refuses 1e30 s: the refusal is the only line on
+    stderr (the line saying that a reference PNP run starts is printed when it starts)."""
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    lines = [ln for ln in err.splitlines() if ln.strip()]
+    assert len(lines) == 1 and "fixed substeps" in lines[0], err
 
 
 def test_step_csv_is_streamed_and_equals_the_in_memory_run(tmp_path):
