@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 from ipmc_asym.base.jsonio import dumps
 from ipmc_asym.base.registry import model_choices, model_names
 from ipmc_asym.cli import SUMMARIES
@@ -14,7 +16,7 @@ from ipmc_asym.cli.common import (
     strip_from_args,
 )
 from ipmc_asym.io.fileio import check_output_path, make_output_dir
-from ipmc_asym.studies.profiles import PAPER_LAYERS, compute_all, profile_summary
+from ipmc_asym.studies.profiles import LAYER_WIDTHS, PAPER_LAYERS, compute_all, profile_summary
 
 
 def register(sub):
@@ -52,12 +54,21 @@ def run(args) -> int:
           f"phi0={strip.voltage:g} V; layer widths in µm from the face")
     print(f"{'model':9s} {'devoid':>8s} {'depletion':>10s} {'accum(1/e)':>10s} {'accum(1/2)':>10s} {'B1':>9s} "
           f"{'Debye':>8s} {'paper dep':>9s} {'paper acc':>9s}")
+    def width(s, k, spec):
+        # a level never crossed (a small voltage's layer changes C_bar by less than the level): n/a, not NaN
+        v = s[k]
+        return fmt_num(None if v is None or math.isnan(v) else v, spec).rjust(int(spec.split(".")[0]))
+
     for s in out["summaries"]:
         pd = PAPER_LAYERS.get((s["model"], "depletion"))
         pa = PAPER_LAYERS.get((s["model"], "accumulation"))
-        print(f"{s['model']:9s} {s['devoid_um']:8.4g} {s['depletion_um']:10.4g} {s['accumulation_um']:10.4g} "
-              f"{s['accumulation_half_um']:10.4g} {s['B1']:9.4g} {s['debye_um']:8.3g} "
+        print(f"{s['model']:9s} {width(s, 'devoid_um', '8.4g')} {width(s, 'depletion_um', '10.4g')} "
+              f"{width(s, 'accumulation_um', '10.4g')} {width(s, 'accumulation_half_um', '10.4g')} {s['B1']:9.4g} "
+              f"{s['debye_um']:8.3g} "
               f"{fmt_num(pd, '9.3g') if pd is not None else '-':>9s} {fmt_num(pa, '9.3g') if pa is not None else '-':>9s}")
+    if any(s[k] is None or math.isnan(s[k]) for s in out["summaries"] for k in LAYER_WIDTHS if k in s):
+        print("n/a: the profile never crosses that width's level (here C_bar changes by less than it); "
+              "the levels: ipmc_asym.studies.profiles.LAYER_WIDTHS")
     for f in out["files"]:
         print("wrote", f)
     if args.out is None:

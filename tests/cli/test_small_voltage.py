@@ -54,3 +54,16 @@ def test_sweep_tiny_voltages(tmp_path):
     for r in rows:
         assert float(r["I"]) == pytest.approx(ref, rel=1e-9)
         assert abs(float(r["w"])) < 1e-150
+
+
+def test_profiles_just_above_the_bvp_floor(capsys):
+    """At 3e-8 V (the BVP's floor is 2.58e-8 V) C_bar changes by ~1e-6: the anode widths' levels
+    (C_bar = 0.5, 0.01) are never crossed and print as n/a, not NaN; the cathode's 1/e width is the
+    Debye-Hueckel limit's, the Debye length (C_bar - 1 ~ exp(-d/lambda) from the face)."""
+    assert main(["profiles", "--voltage", "3e-8V", "--model", "constant"]) == 0
+    out = capsys.readouterr().out
+    assert "nan" not in out.lower()
+    row = next(ln.split() for ln in out.splitlines() if ln.startswith("constant"))
+    assert row[1] == row[2] == "n/a"
+    acc, debye = float(row[3]), float(row[6])
+    assert acc == pytest.approx(debye, rel=2e-3)
