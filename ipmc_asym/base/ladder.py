@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["climb", "Ladder", "Step", "SkipRung", "rungs_from", "escalation_note"]
+__all__ = ["climb", "Ladder", "Step", "SkipRung", "rungs_from", "escalation_note", "first_shown"]
 
 
 class SkipRung(ValueError):
@@ -91,8 +91,13 @@ class Ladder:
         if self.left.size == 0:
             return ""
         head = "no valid fidelity" + (f" {what}" if what else "") + f" at {where}"
-        count = "" if self.n == 1 else f" [{self.left.size} of {self.n} points; first shown]"
-        return head + count + ": " + "; ".join(self.why[-keep:])
+        return head + first_shown(self.left.size, self.n) + ": " + "; ".join(self.why[-keep:])
+
+
+def first_shown(k: int, n: int) -> str:
+    """``" [k of n points; first shown]"``: appended to a message about the first of ``k``
+    points (of ``n``) that fail a check; empty for a single point."""
+    return "" if n == 1 else f" [{k} of {n} points; first shown]"
 
 
 def climb(rungs, evaluate, checks, n: int = 1) -> Ladder:

@@ -30,7 +30,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ipmc_asym.base.ladder import climb, rungs_from
+from ipmc_asym.base.ladder import climb, first_shown, rungs_from
 from ipmc_asym.base.registry import FIDELITIES as _FIDELITY_SPECS
 from ipmc_asym.base.registry import compiled_fidelities
 from ipmc_asym.base.results import Panel, ResultMixin, ResultSpec
@@ -318,7 +318,7 @@ def assumption_warnings(r: "ForwardResult", index=None) -> list:
         bad = np.flatnonzero(sel & ok_m & ~np.asarray(getattr(r, c), bool).reshape(-1))
         if bad.size == 0:
             continue
-        count = "" if index is not None or size == 1 else f" [{len(bad)} of {size} points; first shown]"
+        count = "" if index is not None else first_shown(len(bad), size)
         out += [x + count for x in _reasons(r, c, int(bad[0]))]
     return out
 

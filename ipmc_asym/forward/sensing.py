@@ -26,6 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ipmc_asym.base.ladder import first_shown
 from ipmc_asym.base.registry import check_choice
 from ipmc_asym.base.results import Panel, ResultMixin, ResultSpec
 from ipmc_asym.base.settings import VALIDITY_LIMIT
@@ -200,7 +201,7 @@ def sense(strip: Strip | None = None, curvature=None, tip_displacement=None, sup
     under = rung_ok & ~ok  # every rung met its bound, the doubles' rounding of the result did not
     if not message and under.any():
         j = int(np.argmax(under))
-        count = "" if b0.size == 1 else f" [{int(under.sum())} of {b0.size} points; first shown]"
+        count = first_shown(int(under.sum()), b0.size)
         message = (f"relative error estimate above {VALIDITY_LIMIT:g}{count} (Q or V_oc subnormal at curvature "
                    f"{kap[j]:.6g} 1/m: doubles round it)")
     used = hat.used.reshape(b0.size, u.size)[:, 0]
