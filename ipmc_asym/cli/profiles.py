@@ -33,8 +33,6 @@ def register(sub):
 
 def run(args) -> int:
     strip = strip_from_args(args)
-    if strip.voltage <= 0:
-        raise ValueError("profiles: voltage must be > 0 (a negative voltage is the mirror image)")
     mat = material_from_args(args)
     models = model_names() if args.model == "all" else (args.model,)
     if args.out is None:

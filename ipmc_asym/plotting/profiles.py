@@ -86,13 +86,16 @@ def plot_profiles(results: dict, quantity: str, path, e: float, dpi: int = 110, 
     axs[0].set_xlim(-1.0, 1.0)
     axs[0].set_xlabel(r"$\bar z = z/e$ ($e$ = HALF thickness = %.4g µm)" % (e * 1e6))
     axs[0].set_title("full thickness, stretched near the faces", fontsize=8)
-    for ax, side in ((axs[1], "anode ($\\bar z=-1$)"), (axs[2], "cathode ($\\bar z=+1$)")):
+    # the anode is the face at the higher potential: z_bar = -1 for a positive voltage, +1 for a negative one
+    neg = any(getattr(getattr(r, "groups", None), "sign", 1.0) < 0 for r in results.values())
+    lo_face, hi_face = ("cathode", "anode") if neg else ("anode", "cathode")
+    for ax, side in ((axs[1], f"{lo_face} ($\\bar z=-1$)"), (axs[2], f"{hi_face} ($\\bar z=+1$)")):
         ax.set_xscale("log")
         ax.set_xlim(ZOOM_MIN_UM, e * 1e6)
         ax.set_xlabel(f"distance from the {side.split(' ')[0]} face (µm)")
         ax.set_title(f"zoom at the {side}, from 1 nm (continuum scale)", fontsize=8)
-    if quantity == "C":
-        axs[2].set_yscale("log")
+    if quantity == "C":  # the cathode's accumulation spans decades
+        axs[1 if neg else 2].set_yscale("log")
     if log_y:
         for ax, top in zip(axs, panel_max):
             ax.set_yscale("log")

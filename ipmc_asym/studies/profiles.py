@@ -217,19 +217,23 @@ def profile_summary(model="constant", strip: Strip | None = None, material: Mate
     w = layer_widths(res, e)
     g = res.groups
     core = np.abs(res.z) < 0.5
+    # the anode is the face at the higher potential: z_bar = -1 for a positive voltage, +1 for a
+    # negative one (the BVP's B1 is C_bar at z_bar = +1 whatever the sign)
+    a, c = (-1, 0) if g.sign < 0 else (0, -1)
+    b1 = float(res.B1) if g.sign > 0 else float(res.C[c])
     out = {
         "model": res.model,
-        "B1": float(res.B1),
-        "C_anode": float(res.C[0]),
+        "B1": b1,
+        "C_anode": float(res.C[a]),
         **w,
-        "D_face": float(res.D[-1]),
+        "D_face": float(res.D[c]),
         "D_core": float(np.max(np.abs(res.D[core]))),
-        "p_anode": float(res.p[0]),
-        "p_cathode": float(res.p[-1]),
-        "E_anode": float(res.E[0]),
-        "E_cathode": float(res.E[-1]),
+        "p_anode": float(res.p[a]),
+        "p_cathode": float(res.p[c]),
+        "E_anode": float(res.E[a]),
+        "E_cathode": float(res.E[c]),
         "I": float(res.I),
-        "cathode_charge": float(material.F * res.B1 * g.C_moy),
+        "cathode_charge": float(material.F * b1 * g.C_moy),
         "debye_um": float(g.debye * e * 1e6),
         "e_um": e * 1e6,
         "n_nodes": int(res.n_nodes),
@@ -239,13 +243,15 @@ def profile_summary(model="constant", strip: Strip | None = None, material: Mate
 
 def write_csv(res, path, e: float):
     """One row per mesh node: z_bar, z (m), distances from anode/cathode (m), and all profiles."""
+    # the anode at z_bar = -1 for a positive voltage, +1 for a negative one
+    s = 1.0 if getattr(getattr(res, "groups", None), "sign", 1.0) > 0 else -1.0
     with atomic_write(path) as fh:
         wr = csv.writer(fh)
         wr.writerow(["z_bar", "z_m", "dist_anode_m", "dist_cathode_m", "C_bar", "phi_bar", "D_bar",
                      "E_bar", "rhoZ_bar", "p_bar"])
         for i in range(len(res.z)):
             z = float(res.z[i])
-            wr.writerow([f"{z:.17g}", f"{z * e:.10g}", f"{(z + 1) * e:.10g}", f"{(1 - z) * e:.10g}",
+            wr.writerow([f"{z:.17g}", f"{z * e:.10g}", f"{(1 + s * z) * e:.10g}", f"{(1 - s * z) * e:.10g}",
                          f"{res.C[i]:.12g}", f"{res.phi[i]:.12g}", f"{res.D[i]:.12g}",
                          f"{res.E[i]:.12g}", f"{res.rhoZ[i]:.12g}", f"{res.p[i]:.12g}"])
 

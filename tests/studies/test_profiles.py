@@ -61,3 +61,24 @@ def test_transition_width_of_an_exponential_layer_is_its_length_times_ln_9():
     assert transition_width(r, e, "D", "cathode") == pytest.approx(2 * lam * math.log(9) * e * 1e6, rel=1e-6)
     with pytest.raises(ValueError, match="face"):
         transition_width(r, e, "D", "middle")
+
+
+@pytest.mark.parametrize("model", ["constant", "affine"])
+def test_a_negative_voltage_is_the_mirror_image(model, tmp_path):
+    """-phi0 is +phi0 mirrored (z_bar -> -z_bar): every face value named by its electrode (the
+    anode is the face at the higher potential) is the same; the field, the induction and I change
+    sign; the CSV's distances are measured from the right faces."""
+    from ipmc_asym.studies.profiles import profile, write_csv
+
+    pos, neg = (profile_summary(model, Strip(voltage=v)) for v in (1.0, -1.0))
+    for k in ("B1", "C_anode", "depletion_um", "devoid_um", "accumulation_um", "accumulation_half_um",
+              "cathode_charge", "debye_um"):
+        assert neg[k] == pytest.approx(pos[k], rel=1e-9, abs=1e-15), k
+    for k in ("E_anode", "E_cathode", "D_face", "I"):
+        assert neg[k] == pytest.approx(-pos[k], rel=1e-9), k
+    for v in (1.0, -1.0):
+        path = tmp_path / f"p{v:+g}.csv"
+        write_csv(profile(model, Strip(voltage=v)), path, 100e-6)
+        rows = np.genfromtxt(path, delimiter=",", names=True)
+        anode = rows["C_bar"][np.argmin(rows["dist_anode_m"])]
+        assert anode == pytest.approx(pos["C_anode"], rel=1e-9, abs=1e-15)
