@@ -176,6 +176,8 @@ CHEAP = {
               "--load": ["short", "open", "100"], "--nu": ["0", "0.3", "0.7"], "--json": None},
     "drive": {**STRIP, "--model": MODELS[:3], "--points": COUNTS, "--duration": TIMES,
               "--beam": ["quasi-static", "dynamic", "x"], "--json": None},
+    # the layer summary only (no --out): one BVP per model, the cheaper models
+    "profiles": {**STRIP, "--voltage": VOLTS, "--model": ["constant", "affine", "nope"], "--json": None},
 }
 MATERIAL_NAMES = ["nafion-li", "nafion-117-h", "nope", "/nonexistent.toml", "x.csv"]
 WAVEFORMS = ["step:1V", "sine:1V@10Hz", "dc:0.2V+sine:0.5V@10Hz", "square:1V@5Hz", "ramp:1V/1s", "sine:1V@-1Hz",
