@@ -11,6 +11,8 @@ else:  # pragma: no cover
 
 from pathlib import Path
 
+from references import REPO
+
 import ipmc_asym as ia
 from ipmc_asym.base.registry import MODELS
 from ipmc_asym.model import material_data
@@ -158,3 +160,22 @@ def test_datasheet_sets_derived_values():
         assert m.C_moy == pytest.approx(0.62 * 1980.0 * 0.98 / 0.38, rel=1e-14)
         assert m.E == 114e6
         assert "phi4" in material_data.load_set(name).fallbacks()
+
+
+def test_a_material_file_has_the_input_cap_of_every_input_file(tmp_path):
+    """A material file is read by the one input reader: the size cap is --max-input-size's (a 1.2 MB
+    file, a long comment and the paper's values, is read; it had a cap of its own, 1 MB), a
+    directory or a missing file is refused in one line."""
+    from ipmc_asym.base.inputs import input_size_cap
+
+    src = REPO / "examples" / "materials" / "paper-values-with-units.toml"
+    big = tmp_path / "big.toml"
+    big.write_text("# " + "x" * 1_200_000 + "\n" + src.read_text())
+    assert material_data.read_set(big).parameters == material_data.read_set(src).parameters
+    with input_size_cap(1000), pytest.raises(ValueError, match="more than the cap 1000"):
+        material_data.read_set(big)
+    with pytest.raises(ValueError, match="does not exist"):
+        material_data.read_set(tmp_path / "none.toml")
+    (tmp_path / "d.toml").mkdir()
+    with pytest.raises(ValueError, match="is a directory"):
+        material_data.read_set(tmp_path / "d.toml")
