@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import math
 import re
+from decimal import Decimal
 
 import numpy as np
 
@@ -33,6 +34,16 @@ _RESISTANCE = {"Ohm": 1.0, "ohm": 1.0, "Ω": 1.0, "kOhm": 1e3, "kohm": 1e3, "kΩ
 _NUM = re.compile(r"^\s*([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)\s*([^\s\d].*?)?\s*$")
 
 
+def _scaled(number: str, factor: float) -> float:
+    """``number * factor`` rounded once: a power-of-ten unit shifts the decimal exponent exactly
+    (``"200um"`` is the double nearest 2e-4, as ``"200e-6"`` is; the product of the doubles 200 and
+    1e-6 is one ulp below it); any other factor (min, h) multiplies."""
+    k = round(math.log10(factor))
+    if float(f"1e{k}") == factor:
+        return float(Decimal(number).scaleb(k))
+    return float(number) * factor
+
+
 def parse_quantity(name: str, text, units: dict, unit_name: str, case_sensitive: bool = True) -> float:
     """Parse ``text`` (number or number+unit from ``units``) into SI; ``ValueError`` naming ``name``."""
     if isinstance(text, (int, float)) and not isinstance(text, bool):
@@ -53,7 +64,7 @@ def parse_quantity(name: str, text, units: dict, unit_name: str, case_sensitive:
                 raise ValueError(
                     f"{name}: unknown unit {u!r} for a {unit_name}; allowed: {', '.join(units)}"
                 )
-            v *= units[key]
+            v = _scaled(m.group(1), units[key])
     if not math.isfinite(v):
         raise ValueError(f"{name} must be finite; got {text!r}")
     return v

@@ -22,6 +22,7 @@ from ipmc_asym.io.datasets import uq_dataset, write_netcdf
 from ipmc_asym.io.fileio import FIGURE_FORMATS, check_output_path
 from ipmc_asym.model.electrode import beam_label
 from ipmc_asym.parallel.executors import check_scheduler
+from ipmc_asym.studies.scene_schema import load_scene
 from ipmc_asym.studies.uq import SOBOL_BATCHES, STORE_SAMPLES, run_uq
 
 #: model runs of one uq: a time cap (memory does not grow with the runs: the design is streamed
@@ -76,7 +77,9 @@ def run(args) -> int:
         check_output_path(args.plot, "file", "--plot", formats=FIGURE_FORMATS)
     if args.scheduler is not None:
         check_scheduler(args.scheduler)
-    scene = scene_with_material(args.scene, args)  # read and checked first: a refusal is one line
+    scene = scene_with_material(args.scene, args)
+    if not isinstance(scene, dict):  # read here, before the notice: a refused file is one line
+        scene = load_scene(scene)
     first_run_notice()
     res = run_uq(scene, args.samples, seed=args.seed, fidelity=args.fidelity,
                  scheduler=args.scheduler, keep_invalid=args.keep_invalid, store_samples=args.store_samples,

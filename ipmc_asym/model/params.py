@@ -30,7 +30,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ipmc_asym.base.settings import MIN_THICKNESS, STRAIN_LIMIT
-from ipmc_asym.base.units import parse_pressure
+from ipmc_asym.base.units import parse_length, parse_pressure, parse_voltage
 from ipmc_asym.model import material_data
 from ipmc_asym.model.electrode import NO_ELECTRODE, Electrode, composite_stiffness, electrode_from_spec
 from ipmc_asym.model.groups import Groups, debye_length, make_groups, moment_scale
@@ -435,7 +435,8 @@ def set_thickness(spec):
 
 @dataclass(frozen=True)
 class Strip:
-    """Cantilever strip.  ``width`` and ``thickness`` are TOTAL (2l, 2e); SI units.
+    """Cantilever strip.  ``width`` and ``thickness`` are TOTAL (2l, 2e); SI units, or strings
+    with units (``Strip(thickness="200um", voltage="500mV")``), kept as SI floats.
 
     ``voltage`` may be negative (mirror image) or zero (no bending).
     """
@@ -446,6 +447,11 @@ class Strip:
     voltage: float = 1.0
 
     def __post_init__(self):
+        # the units people write, at the edge (as the command line and moment_integral take them)
+        for name, parse in (("length", parse_length), ("width", parse_length), ("thickness", parse_length),
+                            ("voltage", parse_voltage)):
+            if isinstance(getattr(self, name), str):
+                object.__setattr__(self, name, parse(name, getattr(self, name)))
         check_positive("length", self.length, "m")
         check_positive("width (total, 2l)", self.width, "m")
         check_positive("thickness (total, 2e)", self.thickness, "m")

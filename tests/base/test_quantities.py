@@ -59,3 +59,21 @@ def test_unknown_unit_names_the_parameter_and_the_allowed_units():
 
     with pytest.raises(ValueError, match=r"--diffusion: unknown unit 'parsec'.*allowed: m2/s"):
         units.parse_diffusion("--diffusion", "5parsec")
+
+
+@pytest.mark.parametrize("text", ["200um", "0.1mm", "2 cm", "3e-3mm", "123.456789nm", "7um", "1.1e-300m",
+                                  "-500mV", "0.3mV", "130MPa", "1.3e-2GPa", "1e-6cm2/s", "20ms", "5e-324m"])
+def test_a_power_of_ten_unit_rounds_once(text):
+    """A value with a power-of-ten unit is the double nearest the decimal it names (as the same
+    number written with an exponent is): ``200um`` is 2e-4 to the bit, not 200 * 1e-6 (one ulp
+    below). Reference: the exact rational rounded once by ``float(Fraction)``."""
+    import re
+    from fractions import Fraction
+
+    import ipmc_asym.base.units as units
+
+    num, unit = re.match(r"\s*([-+0-9.eE]+)\s*(.*)", text).groups()
+    table = {"m": 0, "mm": -3, "cm": -2, "um": -6, "nm": -9, "mV": -3, "MPa": 6, "GPa": 9, "cm2/s": -4, "ms": -3}
+    parse = {"V": units.parse_voltage, "Pa": units.parse_pressure, "/s": units.parse_diffusion}
+    fn = next((f for k, f in parse.items() if unit.endswith(k)), units.parse_time if unit == "ms" else units.parse_length)
+    assert fn("x", text) == float(Fraction(num) * Fraction(10) ** table[unit])

@@ -88,3 +88,17 @@ def test_117_diffusion_from_the_measured_conductivity():
     kappa = m.phi4 * m.F**2 * m.D * m.C_moy / (m.R * m.T)
     assert kappa == pytest.approx(8.2, rel=1e-3)
     assert math.isclose(m.C_moy, 0.62 * 1980.0 * 0.98 / 0.38, rel_tol=1e-12)
+
+
+def test_a_strip_takes_the_units_people_write():
+    """Strings with units are read at the edge, as on the command line, into the same SI floats
+    (rounded once: "200um" is 200e-6 to the bit); a bad one is refused naming the parameter."""
+    from ipmc_asym.model.params import Strip
+
+    s = Strip(length="2cm", width="5 mm", thickness="200um", voltage="-500mV")
+    assert s == Strip(length=0.02, width=5e-3, thickness=200e-6, voltage=-0.5)
+    assert all(type(getattr(s, k)) is float for k in ("length", "width", "thickness", "voltage"))
+    with pytest.raises(ValueError, match="^thickness: cannot read 'abc' as a length"):
+        Strip(thickness="abc")
+    with pytest.raises(ValueError, match="below 1e-07 m"):
+        Strip(thickness="50nm")
