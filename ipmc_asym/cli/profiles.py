@@ -67,6 +67,11 @@ def run(args) -> int:
     if any(s[k] is None or math.isnan(s[k]) for s in out["summaries"] for k in LAYER_WIDTHS if k in s):
         print("n/a: the profile never crosses that width's level (here C_bar changes by less than it); "
               "the levels: ipmc_asym.studies.profiles.LAYER_WIDTHS")
+    from ipmc_asym.bvp.solver import min_voltage  # deferred: SciPy (start-up); the profiles have loaded it
+
+    if 0.0 < abs(strip.voltage) < min_voltage(mat):
+        print(f"note: |phi0| is below the {min_voltage(mat):.3g} V the BVP resolves: these are the Debye-Hueckel "
+              f"profiles (leading order in A2 = |phi0|/V_T, relative error about A2)")
     for f in out["files"]:
         print("wrote", f)
     if args.out is None:

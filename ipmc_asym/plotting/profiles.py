@@ -127,13 +127,16 @@ def write_all(out_dir, models=model_names(), strip: Strip | None = None, materia
         write_csv(res, p, strip.e)
         files.append(p)
     figno = {"C": 4, "phi": 5, "D": 6, "p": 7}
+    # below the BVP's floor the profiles are the Debye-Hueckel solution (studies.profiles.profile)
+    dh = any(r.message.startswith("Debye-Hueckel") for r in results.values())
+    how = "Debye-Hückel solution (below the BVP's floor)" if dh else "full BVP"
     for q in quantities:
         p = os.path.join(out_dir, f"profile_{q}.{fmt}")
         t = f"{q} profile (paper Fig. {figno[q]})" if q in figno else f"{q} profile"
         t += "\n"
         plot_profiles(results, q, p, strip.e, dpi=dpi,
                       title=f"{t}$L$ = {strip.length*100:g} cm, $2e$ = {strip.thickness*1e6:g} µm, "
-                            f"$\\varphi_0$ = {strip.voltage:g} V, full BVP")
+                            f"$\\varphi_0$ = {strip.voltage:g} V, {how}")
         files.append(p)
     sums = [profile_summary(m, strip, material, res=r) for m, r in results.items()]
     return {"summaries": sums, "files": files}

@@ -50,9 +50,8 @@ from ipmc_asym.base.settings import (
 from ipmc_asym.io.fileio import atomic_write
 from ipmc_asym.model.params import NAFION_LI, Material, Strip
 
-__all__ = ["QUANTITIES", "profile", "layer_widths", "profile_summary", "transition_width", "TRANSITION_LEVELS",
-           "write_csv",
-           "compute_all", "PAPER_LAYERS", "LAYER_WIDTHS"]
+__all__ = ["QUANTITIES", "profile", "debye_hueckel_profile", "DH_MIN_A2", "layer_widths", "profile_summary",
+           "transition_width", "TRANSITION_LEVELS", "write_csv", "compute_all", "PAPER_LAYERS", "LAYER_WIDTHS"]
 
 #: quantity key -> (BVPResult attribute, axis label)
 QUANTITIES = {
@@ -82,15 +81,95 @@ PAPER_LAYERS = {
 }
 
 
+#: below this A2 (|phi0| ~ 2.6e-292 V) the Debye-Hueckel profiles are not computed: their
+#: ``C - 1 = A2 s`` would leave the normal doubles, and ``p = C/A2`` (B2 = 0) overflows near 1e-308
+DH_MIN_A2 = 1e-290
+
+
 def profile(model="constant", strip: Strip | None = None, material: Material = NAFION_LI):
-    """Full-BVP profiles (a :class:`ipmc_asym.bvp.solver.BVPResult`) at ``strip`` (default nominal)."""
-    from ipmc_asym.bvp.solver import solve  # deferred: SciPy's solve_bvp (start-up)
+    """Profiles (a :class:`ipmc_asym.bvp.solver.BVPResult`) at ``strip`` (default nominal): the
+    full BVP, and below the voltage it resolves (:func:`ipmc_asym.bvp.solver.min_voltage`) the
+    Debye-Hueckel solution (:func:`debye_hueckel_profile`; its ``message`` says so)."""
+    from ipmc_asym.bvp.solver import min_voltage, solve  # deferred: SciPy's solve_bvp (start-up)
 
     strip = Strip() if strip is None else strip
+    if 0.0 < abs(strip.voltage) < min_voltage(material):
+        return debye_hueckel_profile(model, strip, material)
     res = solve(strip, model, material)
     if not res.success:
         raise RuntimeError(f"BVP for the {model} profiles did not converge: {res.message}")
     return res
+
+
+def debye_hueckel_profile(model="constant", strip: Strip | None = None, material: Material = NAFION_LI,
+                          nodes: int = 4001):
+    """The profiles at a small voltage: the Debye-Hueckel solution, leading order in ``A2``.
+
+    The BVP of :mod:`ipmc_asym.bvp.solver` linearised about rest (``C = 1 + A2 c``, ``eps`` at
+    ``C = 1``: the order ``x_0`` of ``derivations/debye_hueckel.py``), with ``u = phi - 1/2``,
+    ``u'' = u / lam^2``, ``u(-+1) = +-1/2`` and neutrality::
+
+        phi = 1/2 - S,   C - 1 = A2 S,   E = lam S',   D = (A2 lam^2) E,
+        S = sinh(z/lam) / (2 sinh(1/lam)),   B1 = 1 + A2/2
+
+    (``lam`` the core Debye length over ``e``, ``groups.debye``), written with ``expm1`` so that no
+    ``sinh`` overflows at thick strips nor cancels at thin ones.  The terms left out are of relative
+    order ``A2`` (< 1e-6 below the BVP's floor; the tests hold the profiles to ``A2`` against the
+    BVP just above it).  ``I`` is the moment integral's own small-voltage series
+    (:func:`ipmc_asym.integral.api.moment_integral`, exact rung).
+
+    Parameters
+    ----------
+    model : str or Permittivity
+    strip : Strip
+        ``0 < A2 = |phi0|/V_T`` (``A2 >= DH_MIN_A2``); a negative voltage is the mirror image.
+    material : Material
+    nodes : int
+        Mesh nodes per half thickness, graded towards the faces from ``1e-4 lam``.
+
+    Returns
+    -------
+    BVPResult
+        On the same conventions as the BVP's (``status`` 0, no spline ``sol``).
+    """
+    import math
+    import time
+
+    from ipmc_asym.bvp.solver import BVPResult
+    from ipmc_asym.integral.api import moment_integral
+    from ipmc_asym.model.permittivity import get_model
+
+    t0 = time.perf_counter()
+    strip = Strip() if strip is None else strip
+    perm = get_model(model)
+    g = perm.groups(strip, material)
+    A2, A3, lam = float(g.A2), float(g.A3), float(g.debye)
+    if not A2 >= DH_MIN_A2:
+        raise ValueError(f"voltage |phi0| = {abs(float(strip.voltage)):.3g} V is too small for profiles: C - 1 "
+                         f"~ A2 = {A2:.3g} leaves the normal doubles below A2 = {DH_MIN_A2:g} (and p = C/A2 "
+                         f"overflows); the moment integral is answered at any voltage (ipmc-asym estimate)")
+    # the mesh: from each face, geometric from 1e-4 lam up to the mid-plane
+    d = np.concatenate(([0.0], np.geomspace(min(1e-4 * lam, 1e-6), 1.0, nodes - 1)))
+    z = np.concatenate((d - 1.0, (1.0 - d)[-2::-1]))
+    k, a = 1.0 / lam, np.abs(z) / lam
+    f = np.exp(a - k) / -math.expm1(-2.0 * k)  # e^{|z|/lam - 1/lam} / (1 - e^{-2/lam})
+    S = np.sign(z) * f * -np.expm1(-2.0 * a) / 2.0  # sinh(z/lam) / (2 sinh(1/lam))
+    E = k * f * (1.0 + np.exp(-2.0 * a)) / 2.0  # -phi' = cosh(z/lam) / (2 lam sinh(1/lam))
+    phi = 0.5 - S
+    rho = A2 * S
+    D = (A2 * lam * lam) * E  # eps at C = 1 is A2 lam^2 (the core Debye length)
+    B1 = 1.0 + 0.5 * A2
+    if g.sign < 0:  # mirror image z -> -z, potential referenced to the face z = +1 (as the BVP)
+        z, rho, D, E, phi = -z[::-1], rho[::-1], -D[::-1], -E[::-1], phi[::-1] - 1.0
+        B1 = 1.0 + float(rho[-1])
+    C = 1.0 + rho
+    I = float(moment_integral(strip.thickness, strip.voltage, perm, "exact", material=material))
+    return BVPResult(z=z, C=C, phi=phi, E=E, D=D, rhoZ=rho, p=C / A2 - A3 * phi, y=np.log1p(rho), B1=B1, I=I,
+                     groups=g, model=perm.name, success=True, status=0,
+                     message=(f"Debye-Hueckel solution (|phi0| below the BVP's floor): leading order in A2, "
+                              f"relative error about A2 = {A2:.2g}"),
+                     niter=0, n_nodes=int(z.size), max_rms_residual=0.0, bc_residual=0.0,
+                     seconds=time.perf_counter() - t0)
 
 
 def _crossing(d, f, level):
@@ -123,11 +202,14 @@ def layer_widths(res, e: float) -> dict:
         ``accumulation_1pct_um`` (NaN where the level is never crossed).
     """
     z, C = np.asarray(res.z, dtype=float), np.asarray(res.C, dtype=float)
+    # C - 1 from rhoZ where the result has it: C itself rounds to 1 at a small voltage
+    rz = getattr(res, "rhoZ", None)
+    Cm1 = np.asarray(rz, dtype=float) if rz is not None else C - 1.0
     if getattr(getattr(res, "groups", None), "sign", 1.0) < 0:
-        z, C = -z[::-1], C[::-1]
+        z, C, Cm1 = -z[::-1], C[::-1], Cm1[::-1]
     da = (z + 1.0) * e * 1e6  # from the anode, µm, increasing
     dc = ((1.0 - z) * e * 1e6)[::-1]  # from the cathode, increasing
-    Cc = C[::-1] - 1.0
+    Cc = Cm1[::-1]
     B1m1 = Cc[0]
     return {"depletion_um": _crossing(da, C, DEPLETION_LEVEL),
             "devoid_um": _crossing(da, C, DEVOID_LEVEL),

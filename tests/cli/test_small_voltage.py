@@ -56,12 +56,15 @@ def test_sweep_tiny_voltages(tmp_path):
         assert abs(float(r["w"])) < 1e-150
 
 
-def test_profiles_just_above_the_bvp_floor(capsys):
-    """At 3e-8 V (the BVP's floor is 2.58e-8 V) C_bar changes by ~1e-6: the anode widths' levels
-    (C_bar = 0.5, 0.01) are never crossed and print as n/a, not NaN; the cathode's 1/e width is the
-    Debye-Hueckel limit's, the Debye length (C_bar - 1 ~ exp(-d/lambda) from the face)."""
-    assert main(["profiles", "--voltage", "3e-8V", "--model", "constant"]) == 0
+@pytest.mark.parametrize("volts", ["3e-8V", "1e-9V", "-1e-200V"])
+def test_profiles_near_and_below_the_bvp_floor(volts, capsys):
+    """At 3e-8 V (the BVP's floor is 2.58e-8 V; below it the Debye-Hueckel profiles) C_bar changes
+    by ~1e-6 or less: the anode widths' levels (C_bar = 0.5, 0.01) are never crossed and print as
+    n/a, not NaN; the cathode's 1/e width is the Debye-Hueckel limit's, the Debye length
+    (C_bar - 1 ~ exp(-d/lambda) from the face)."""
+    assert main(["profiles", "--voltage", volts, "--model", "constant"]) == 0
     out = capsys.readouterr().out
+    assert ("Debye-Hueckel profiles" in out) == (volts != "3e-8V")
     assert "nan" not in out.lower()
     row = next(ln.split() for ln in out.splitlines() if ln.startswith("constant"))
     assert row[1] == row[2] == "n/a"

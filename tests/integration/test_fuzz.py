@@ -358,7 +358,7 @@ def test_fuzz_design_files(tmp_path_factory, text, json_):
 #: writers and long commands: their refusals and --help in process (a real run of each is tested
 #: in its own module)
 REFUSALS = [
-    ["profiles", "--voltage", "1e-9V"], ["profiles", "--out", "/nonexistent/a/b"], ["profiles", "--thickness", "abc"],
+    ["profiles", "--voltage", "1e-300V"], ["profiles", "--out", "/nonexistent/a/b"], ["profiles", "--thickness", "abc"],
     ["figures", "--dpi", "1e6"], ["figures", "--dpi", "5"], ["figures", "--out", "/proc/x/y"],
     ["validate", "--out", "/proc/r.md"], ["validate", "--out", "r.html"], ["derive", "--nope"],
     ["bench", "--points", "0"], ["bench", "--figure", "x.txt"], ["bench", "--layout", "spiral"],
