@@ -64,7 +64,7 @@ from ipmc_asym.dynamics.electrode import (
     time_constant,
 )
 from ipmc_asym.dynamics.transient import solve_transient
-from ipmc_asym.dynamics.waveforms import check_drive_voltage
+from ipmc_asym.dynamics.waveforms import check_drive_voltage, voltage_rate
 from ipmc_asym.forward.model import assumption_warnings, forward, voltage_reason
 from ipmc_asym.integral.api import paper_model_id
 from ipmc_asym.kernels import _generated_charge as GC
@@ -292,6 +292,8 @@ def waveform(kind, voltage, *, ramp_time=None, frequency=None):
     ``step``: ``voltage`` for ``t >= 0``; ``ramp``: ``voltage * min(t/ramp_time, 1)``;
     ``sine``: ``voltage * sin(2 pi frequency t)``; a callable is used as given (volts).
     """
+    if callable(kind) and hasattr(kind, "derivative"):  # a parsed Waveform: vectorised, checked, differentiable
+        return kind
     if callable(kind):
         def user(t):
             t = np.asarray(t, dtype=float)
@@ -532,7 +534,14 @@ class CircuitStepper:
             raise ValueError("each chunk must start at the last time of the previous one (0 at the start)")
         tau = self.tau
         tt, idx = substep_grid(t, tau, 5e-3, self.substeps, ("the reduced model's", "use fewer time constants"))
-        ps = self.fun(tt * tau) / self.VT
+        # the layers are integrated up to each output time with phi0's value just before it: at a
+        # jump there (a step after 0, a square wave's flip) the layer charge is continuous and the
+        # output is the state just after the jump (the core's displacement charge and the current
+        # take phi0(t), below); and (t/tau) tau, rounded past a jump at t, would let the layers
+        # respond to it early
+        tp = tt * tau
+        tp[idx] = np.where(t > 0.0, np.nextafter(t, -np.inf), t)
+        ps = self.fun(tp) / self.VT
         A = np.empty(tt.size)
         s = np.empty(tt.size)
         integrate_circuit(tt, ps, self.rho, self.mid, GL_X, GL_W, A, s, self.state)
@@ -561,9 +570,9 @@ class CircuitStepper:
         From the model's own equations, not from differences over the output times:
         ``J = S ds/dt + C_g d(phi0 - u)/dt`` with ``ds/dt = (psi0 - A)/(2 tau)`` (the charging law
         integrated by :meth:`advance`) and ``du/dt = (R T/F) (ds/dt)/s'(A)`` (the layers'
-        differential capacitance ``s'(A)``); ``dphi0/dt`` by a central difference of ``phi0`` over
-        ``1e-7 max(t, tau/1000)`` (0 across a step's discontinuity at ``t = 0``: the ideal step's
-        displacement impulse is not a current density).
+        differential capacitance ``s'(A)``); ``dphi0/dt`` by
+        :func:`ipmc_asym.dynamics.waveforms.voltage_rate` (a jump's impulse is not a current
+        density: at a jump the output is the current just after it).
         """
         t = np.asarray(t, dtype=float)
         A = np.asarray(u, dtype=float) / self.VT
@@ -575,9 +584,7 @@ class CircuitStepper:
         # A on psi0 within a substep and psi0 - A is the Newton residual -- so the rate is taken over
         # the substep there (a saturated linear-model layer has s' ~ e^{-A}: 1e-34 at 2 V)
         Adot = (ps - A) / (2.0 * np.maximum(cx, 2.5e-3) * self.tau)
-        dt = 1e-7 * np.maximum(t, 1e-3 * self.tau)
-        lo = np.maximum(t - dt, 0.0)
-        dphi = np.where(t > 0.0, (self.fun(t + dt) - self.fun(lo)) / (t + dt - lo), 0.0)
+        dphi = voltage_rate(self.fun, t, 1e-3 * self.tau)
         return self.S * sdot + self.Cg * (dphi - self.VT * Adot)
 
 

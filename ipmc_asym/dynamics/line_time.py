@@ -144,7 +144,11 @@ class LineStepper:
         tau = self.tau
         tt, idx = substep_grid(t, tau, self.h_max, self.substeps,
                                ("the line's", "use fewer time constants or fewer points a chunk"))
-        ps = self.fun(tt * tau) / self.VT
+        # integrated up to each output time with phi0 just before it, as the uniform strip's stepper
+        # (CircuitStepper.advance): at a jump there the output is the state just after it
+        tp = tt * tau
+        tp[idx] = np.where(t > 0.0, np.nextafter(t, -np.inf), t)
+        ps = self.fun(tp) / self.VT
         out = {}
         L = self.strip.length
         for name, lad in (("fine", self.fine), ("coarse", self.coarse)):

@@ -33,7 +33,7 @@ from ipmc_asym.base.inputs import read_input_text
 from ipmc_asym.base.settings import MAX_DRIVE_VOLTAGE, VALIDATED_VOLTAGE
 from ipmc_asym.base.units import parse_length, parse_quantity, parse_time, parse_voltage
 
-__all__ = ["Waveform", "parse_waveform", "WAVEFORM_KINDS", "MAX_CSV_ROWS"]
+__all__ = ["Waveform", "parse_waveform", "WAVEFORM_KINDS", "MAX_CSV_ROWS", "voltage_rate"]
 
 WAVEFORM_KINDS = ("dc", "step", "ramp", "sine", "square", "triangle", "csv")
 
@@ -256,6 +256,28 @@ def parse_waveform(spec, quantity="voltage") -> Waveform:
     if quantity == "voltage":
         check_drive_voltage("waveform", peak)
     return Waveform(spec, terms)
+
+
+def voltage_rate(fun, t, dt_min: float):
+    """``dphi0/dt`` (V/s) at the times ``t`` (s) for the displacement current ``C_g dphi0/dt``.
+
+    A :class:`Waveform` gives the regular part of its derivative (:meth:`Waveform.derivative`);
+    any other callable a difference over ``1e-7 max(t, dt_min)``: central where both sides agree,
+    else the side without the jump (a jump of ``dV`` makes its side ``~dV/dt``, orders of
+    magnitude above any slope the output grid resolves); 0 at ``t = 0``.  A jump's displacement
+    impulse (an ideal step, at 0 or later, a square wave's flip) is not a current density: at a
+    jump the rate is the one just after it.
+    """
+    t = np.asarray(t, dtype=float)
+    regular = getattr(fun, "derivative", None)
+    if regular is not None:
+        return np.asarray(regular(t), dtype=float)
+    dt = 1e-7 * np.maximum(t, dt_min)
+    f0, fp, fm = (np.asarray(fun(x), dtype=float) for x in (t, t + dt, np.maximum(t - dt, 0.0)))
+    right, left = (fp - f0) / dt, (f0 - fm) / dt
+    jump = np.abs(right - left) > 1e3 * np.minimum(np.abs(right), np.abs(left)) + 1e-300
+    side = np.where(np.abs(right) <= np.abs(left), right, left)
+    return np.where(t > 0.0, np.where(jump, side, 0.5 * (right + left)), 0.0)
 
 
 def check_drive_voltage(name, volts) -> float:

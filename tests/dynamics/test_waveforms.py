@@ -62,3 +62,21 @@ def test_drive_voltage_cap_refuses_by_name_and_is_finite_at_the_cap():
         sigma, M = np.asarray(rows["sigma"] if isinstance(rows, dict) else rows.sigma), \
             np.asarray(rows["M_A"] if isinstance(rows, dict) else rows.M_A)
         assert np.all(np.isfinite(sigma)) and np.all(np.isfinite(M)), (v, sigma, M)
+
+
+def test_voltage_rate_of_a_plain_callable_is_one_sided_at_a_jump():
+    """A jump's impulse is no current density: at the jump the rate just after it, just before it
+    the rate before; a smooth function's rate is its derivative (central difference, ~1e-14)."""
+    from ipmc_asym.dynamics.waveforms import voltage_rate
+
+    def square(t):
+        return np.where(np.asarray(t) >= 0.5, -1.0, 1.0) + 0.1 * np.asarray(t)
+
+    r = voltage_rate(square, np.array([0.0, 0.25, 0.5, np.nextafter(0.5, 0.0)]), 1e-5)
+    assert r[0] == 0.0 and r[1:] == pytest.approx([0.1, 0.1, 0.1], rel=1e-6)
+    t = np.linspace(0.01, 1.0, 7)
+    assert voltage_rate(lambda x: np.sin(3.0 * x), t, 1e-5) == pytest.approx(3.0 * np.cos(3.0 * t), rel=1e-7,
+                                                                            abs=1e-7)
+    # a parsed waveform: the regular part of its own derivative (its jumps left out)
+    w = parse_waveform("sine:1V@2Hz+square:0.5V@1Hz")
+    assert voltage_rate(w, t, 1e-5) == pytest.approx(2.0 * math.pi * 2.0 * np.cos(2.0 * math.pi * 2.0 * t))
