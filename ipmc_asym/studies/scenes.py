@@ -44,7 +44,7 @@ from ipmc_asym.base.registry import fidelity_names
 from ipmc_asym.base.settings import BVP_STATED_ERROR
 from ipmc_asym.forward.model import assumption_warnings, forward
 from ipmc_asym.studies.fits import fit_power_law
-from ipmc_asym.studies.profiles import LAYER_WIDTHS, layer_widths
+from ipmc_asym.studies.profiles import LAYER_WIDTHS, layer_widths, profile, profile_summary
 from ipmc_asym.studies.scene_schema import OUTPUTS, Scene, load_scene, read_scene
 
 __all__ = ["run_scene", "load_scene", "OUTPUTS", "LADDER", "Scene"]
@@ -87,17 +87,18 @@ def _scaling_fit(x, y, what):
 
 
 def _profiles(sc: Scene):
-    from ipmc_asym.bvp.solver import solve  # deferred: heavy import (start-up): scipy.integrate
-
     prof = []
     for i in range(sc.n):
         s = sc.strip(i)
-        r = solve(s, sc.model, sc.material)
-        if not r.success:
-            raise RuntimeError(f"profiles: BVP did not converge at point {i} ({r.message})")
+        # the profiles command's own (the BVP; below its floor, the Debye-Hueckel solution), and
+        # its summary's B1: the cathode's concentration, whatever the voltage's sign
+        try:
+            r = profile(sc.model, s, sc.material)
+        except RuntimeError as exc:
+            raise RuntimeError(f"profiles: at point {i}: {exc}") from None
         w = layer_widths(r, s.e)
         wa, wc = w[_ANODE_WIDTH] * 1e-6, w[_CATHODE_WIDTH] * 1e-6
-        item = {"B1": float(r.B1), "I": float(r.I), "n_nodes": int(r.n_nodes),
+        item = {"B1": profile_summary(sc.model, s, sc.material, res=r)["B1"], "I": float(r.I), "n_nodes": int(r.n_nodes),
                 "anode_layer": {"width_e": wa / s.e, "width_m": wa},
                 "cathode_layer": {"width_e": wc / s.e, "width_m": wc},
                 "C_min": float(r.C.min()), "C_max": float(r.C.max())}

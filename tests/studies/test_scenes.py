@@ -203,3 +203,17 @@ def test_pressure_term_scene():
         run_scene({**sc, "pressure_term": "yes"})
     with pytest.raises(ValueError, match="profiles"):
         run_scene({**sc, "outputs": ["profiles"]})
+
+
+def test_scene_profiles_of_a_negative_voltage_are_the_mirror_image():
+    """-V is +V mirrored: the cathode's concentration B1 and the layer widths are the same, I
+    changes sign (B1 was read at z = +1, the anode of a negative voltage: 4.8e-34 for 2)."""
+    from ipmc_asym.studies.scenes import run_scene
+
+    res = run_scene({"name": "pm", "model": "linear", "outputs": ["profiles", "I"], "strip": {"thickness": "100um"},
+                     "sweep": {"voltage": ["-2V", "2V"]}})
+    neg, pos = res["outputs"]["profiles"]["values"]
+    assert pos["B1"] > 1.5 and neg["B1"] == pytest.approx(pos["B1"], rel=1e-9)
+    assert neg["I"] == pytest.approx(-pos["I"], rel=1e-9)
+    for k in ("anode_layer", "cathode_layer"):
+        assert neg[k]["width_m"] == pytest.approx(pos[k]["width_m"], rel=1e-9)
