@@ -4,6 +4,7 @@ or, with ``--waveform``, in time (the tip displacement following the ``drive`` g
 from __future__ import annotations
 
 import csv
+import math
 
 import numpy as np
 
@@ -18,6 +19,7 @@ from ipmc_asym.cli.common import (
     count_type,
     duration_type,
     first_run_notice,
+    fmt_num,
     load_type,
     nu_type,
     strip_and_material,
@@ -172,7 +174,8 @@ def _run_time(args, strip, material):
         print(f"{m}: stated relative error {r.error:.2g} (circuit {r.error_circuit:.2g}, EMF {r.error_emf:.2g} up to "
               f"{r.f_top:.3g} Hz, interpolation {r.error_interp:.1g}, linearisation {r.error_linear:.1g}); relaxed rows "
               f"{r.error_settled:.1g}; tau = {r.tau:.4g} s, f_stream = {r.f_stream:.4g} Hz"
-              + (f"; mean power {r.mean_power:.4g} W" if not isinstance(args.load, str) else ""))
+              + ("" if isinstance(args.load, str) else
+                 f"; mean power {fmt_num(None if math.isnan(r.mean_power) else r.mean_power, '.4g')} W"))
         print("  " + " ".join(f"{c + ' [' + _TIME_UNITS[c] + ']':>13s}" for c in cols))
         for i in show:
             print("  " + " ".join(f"{float(getattr(r, c)[i]):13.5g}" for c in cols)

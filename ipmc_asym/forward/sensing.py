@@ -192,9 +192,11 @@ def sense(strip: Strip | None = None, curvature=None, tip_displacement=None, sup
     if support == "tip-force":  # the length average of V_oc(kappa(x)) is exact at linear order only
         errv = errv + 2.0 * np.abs(np.where(b0 != 0, np.arctanh(b0) / np.where(b0 != 0, b0, 1.0) - 1.0, 0.0))
     # a curvature so small that the response underflows: the rounding of a subnormal (1 where it
-    # rounded to 0), as for the electrode charge
-    err = err + _subnormal_rounding(Q, kap)
-    errv = errv + _subnormal_rounding(V, kap)
+    # rounded to 0), as for the electrode charge; a response that is 0 exactly (no bend, or
+    # nu = 1/2: the drained volume does not change, so neither does C_moy) has no rounding
+    moved = np.where((kap != 0.0) & (1.0 - 2.0 * nu != 0.0), 1.0, 0.0)
+    err = err + _subnormal_rounding(Q, moved)
+    errv = errv + _subnormal_rounding(V, moved)
     rung_ok = hat.valid.reshape(b0.size, u.size).all(axis=1)
     ok = rung_ok & (err < VALIDITY_LIMIT) & (errv < VALIDITY_LIMIT)
     message = hat.message

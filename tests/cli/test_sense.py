@@ -152,3 +152,15 @@ def test_waveform_refusals_one_line_exit_2_and_no_file(capsys, tmp_path, argv, n
     assert rc == 2 and out == ""
     assert len(err.strip().splitlines()) == 1 and needle in err, err
     assert not p.exists() and list(tmp_path.iterdir()) == []
+
+
+def test_time_domain_with_a_load_prints_no_nan_mean_power(capsys):
+    """Too few rows in the power's window: the mean power is not computed; the text says n/a
+    (it printed 'mean power nan W') and a note says why, as the JSON's null does."""
+    assert main(["sense", "--waveform", "step:1mm", "--duration", "1s", "--points", "5", "--model", "constant",
+                 "--load", "10kOhm"]) == 0
+    out = capsys.readouterr().out
+    import re
+
+    assert not re.search(r"(?<![A-Za-z_])nan(?![A-Za-z_])", out, re.I)  # ("Donnan" is a word)
+    assert "mean power n/a W" in out and "mean power not computed" in out

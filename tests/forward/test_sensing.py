@@ -73,3 +73,14 @@ def test_an_underflowing_response_is_flagged_with_its_reason():
     assert r.error[1] >= 1e-2 and abs(r.Q[1]) < 1e-320
     assert "subnormal" in r.message and "1 of 2 points" in r.message
     assert ia.sense(ia.Strip(), tip_displacement=1e-3).message == ""
+
+
+def test_an_incompressible_drained_matrix_senses_nothing_exactly():
+    """nu = 1/2: the bend leaves the solution's volume, so C_moy and the response, unchanged: Q and
+    V_oc are 0 exactly, with no error and valid (they were flagged as a rounded subnormal); any
+    other nu is proportional to 1 - 2 nu at linear order."""
+    r = ia.sense(ia.Strip(), curvature=np.array([0.0, 2.0, -3.0]), nu=0.5)
+    assert r.Q.tolist() == [0.0, 0.0, 0.0] and r.V_oc.tolist() == [0.0, 0.0, 0.0]
+    assert r.valid.all() and np.all(r.error == 0.0) and r.message == ""
+    small = [ia.sense(ia.Strip(), curvature=1e-3, nu=nu).Q[0] for nu in (0.0, 0.25)]
+    assert small[1] == pytest.approx(0.5 * small[0], rel=1e-6)
