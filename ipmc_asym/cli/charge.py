@@ -6,7 +6,7 @@ from ipmc_asym.base.jsonio import dumps
 from ipmc_asym.base.registry import fidelity_names, model_choices
 from ipmc_asym.base.units import fmt_length
 from ipmc_asym.cli import SUMMARIES
-from ipmc_asym.cli.common import add_strip_options, first_run_notice, strip_and_material, warn
+from ipmc_asym.cli.common import add_strip_options, first_run_notice, spread_count, strip_and_material, warn
 from ipmc_asym.forward.charge import charge_report
 
 
@@ -45,7 +45,11 @@ def run(args):
     print("note: " + doc["notes"][0])
     print(f"model-form spread over {len(spread['variants'])} variants ({'; '.join(spread['over'])}):")
     for k, d in spread["quantities"].items():
+        if d["min"] is None:
+            print(f"  {k:8s} n/a")
+            continue
         ratio = "" if d["ratio"] is None else f" (x{d['ratio']:.3g})"
-        print(f"  {k:8s} {d['min']:.4g} .. {d['max']:.4g}{ratio}   numerical rel.err <= {d['numerical_error']:.1e}")
+        print(f"  {k:8s} {d['min']:.4g} .. {d['max']:.4g}{ratio}   numerical rel.err <= {d['numerical_error']:.1e}"
+              + spread_count(d))
     print("  note: " + spread["note"])
     return 0

@@ -35,7 +35,7 @@ __all__ = ["UsageError", "Parser", "add_strip_options", "add_material_options", 
            "material_from_args", "strip_from_args", "strip_and_material",
            "arg_type", "count_type", "join_negative_values", "fmt_num", "c_moy_label", "length_type", "pressure_type",
            "voltage_type", "tol_type", "time_tol_type",
-           "first_run_notice", "diffusion_type", "sidecar_path", "add_size_option", "check_size_caps",
+           "first_run_notice", "spread_count", "diffusion_type", "sidecar_path", "add_size_option", "check_size_caps",
            "add_output_option", "check_outputs",
            "seed_type", "model_help", "viscous_modulus_type", "duration_type", "waveform_type", "sheet_resistance_type",
            "frequency_type", "add_beam_options", "SOLVER_ALIASES", "add_solver_option", "add_line_options",
@@ -79,6 +79,14 @@ def arg_type(conv, name="value"):
 
     f.__name__ = name
     return f
+
+
+def spread_count(d: dict) -> str:
+    """What a model-form spread line adds where some variants have no value (withheld, or not
+    computed): over how many it was taken; empty where every variant has one."""
+    vals = list(d["values"].values())
+    k = sum(v is not None for v in vals)
+    return "" if k == len(vals) else f"   (over {k} of {len(vals)} variants; the others n/a)"
 
 
 def warn(line):

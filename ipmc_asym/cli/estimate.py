@@ -11,6 +11,7 @@ from ipmc_asym.cli.common import (
     c_moy_label,
     first_run_notice,
     fmt_num,
+    spread_count,
     strip_and_material,
     tol_type,
 )
@@ -119,5 +120,5 @@ def _print_spread(spread):
             continue
         ratio = "" if d["ratio"] is None else f" (x{d['ratio']:.3g})"
         print(f"  {k + ' [' + u + ']':18s} {fmt_num(d['min'] * f, '.4g'):>10s} .. {fmt_num(d['max'] * f, '.4g'):<10s}"
-              f"{ratio}   numerical rel.err <= {fmt_num(d['numerical_error'], '.1e')}")
+              f"{ratio}   numerical rel.err <= {fmt_num(d['numerical_error'], '.1e')}{spread_count(d)}")
     print("  note: " + SPREAD_NOTE)

@@ -49,8 +49,16 @@ def charge_report(strip: Strip, material: Material = NAFION_LI, model: str = "al
             labels.append(m if cm is None else f"{m}/{cm}")
             if not (m in models and mat.c_moy == material.c_moy):
                 jobs.append((m, mat))
-    got = [charge_escalated(strip.thickness, strip.voltage, m, fidelity, width=strip.width, length=strip.length,
-                            material=mat) for m, mat in jobs]
+    def one(m, mat, spread_only):
+        try:
+            return charge_escalated(strip.thickness, strip.voltage, m, fidelity, width=strip.width,
+                                    length=strip.length, material=mat)
+        except ValueError as exc:
+            if not spread_only:  # a row the caller asked for: refused, one line
+                raise
+            return exc  # a spread variant alone: n/a in the spread (the caller's rows stand)
+
+    got = [one(m, mat, i >= len(models)) for i, (m, mat) in enumerate(jobs)]
     rows = []
     for m, r in zip(models, got):
         rows.append({"model": m, "fidelity": fidelity, "fidelity_used": r.fidelity,
@@ -74,10 +82,16 @@ def charge_report(strip: Strip, material: Material = NAFION_LI, model: str = "al
                 out[label] = done[m]
                 continue
             c = next(extra)
+            if isinstance(c, ValueError):
+                out[label] = dict.fromkeys(("sigma", "Q", "C_diff", "eps_app", "error_estimate",
+                                            "error_estimate_C_diff"))
+                warnings.append(f"model-form spread: {label} left out (n/a): {c}")
+                continue
             out[label] = {"sigma": float(c.sigma), "Q": float(c.Q), "C_diff": float(c.C_diff),
                           "eps_app": float(c.eps_app), "error_estimate": float(c.error),
                           "error_estimate_C_diff": float(c.error_C_diff)}
-    err = max(max(r["error_estimate"], r["error_estimate_C_diff"]) for r in out.values())
+    err = max(max(r["error_estimate"], r["error_estimate_C_diff"]) for r in out.values()
+              if r["error_estimate"] is not None)
     over = ["permittivity model: " + ", ".join(MODELS)]
     if len(variants) > 1:
         over.append("C_moy: paper and formula (eq. (17))")

@@ -266,7 +266,10 @@ def charge_escalated(thickness: float, voltage: float, model="constant", fidelit
             # no rung helps: the value itself is below the normal range of a double; its
             # rounding is the stated error (sigma -> C_d(0) phi0 down to the subnormals)
             return True, ""
-        return False, f"error estimates {float(r.error):.2g} / {float(r.error_C_diff):.2g}"
+        ec = float(r.error_C_diff)
+        cd = (f"{ec:.2g}" if math.isfinite(ec) else
+              f"none (C_diff = {float(r.C_diff):.3g} F/m^2 is below what the rung's differences resolve)")
+        return False, f"error estimates of sigma {float(r.error):.2g}, of C_diff {cd}"
 
     lad = climb(rungs_from(fidelity_names(), fidelity), lambda f, idx: charge_at(*args, f), checks)
     if lad.left.size:

@@ -47,3 +47,20 @@ def test_subnormal_flagged_where_its_rounding_is_above_the_limit(capsys):
     assert rc == 0
     (row,) = out["results"]
     assert row["valid"] is False and row["error_estimate"] > 0.01 and "subnormal" in err
+
+
+def test_a_spread_variant_without_a_valid_rung_does_not_refuse_the_rows_asked_for(capsys):
+    """--fidelity bvp: the linear model's C_diff (6.5e-14 F/m^2 at 1 V, the corrected rung) is below
+    what the BVP's differences resolve, so the linear variants of the model-form spread have no
+    valid rung from bvp up. The constant row asked for is answered; those variants are n/a in the
+    spread, each said once on stderr; the linear row asked for alone is still refused."""
+    import json
+
+    assert main(["charge", "--fidelity", "bvp", "--model", "constant", "--json"]) == 0
+    cap = capsys.readouterr()
+    doc = json.loads(cap.out)
+    assert [r["model"] for r in doc["results"]] == ["constant"] and doc["results"][0]["valid"]
+    vals = doc["model_spread"]["quantities"]["sigma"]["values"]
+    assert [k for k, v in vals.items() if v is None] == ["linear/paper", "linear/formula"]
+    assert cap.err.count("left out (n/a)") == 2 and "inf" not in cap.err
+    assert main(["charge", "--fidelity", "bvp", "--model", "linear"]) == 2
