@@ -82,8 +82,8 @@ def register(sub):
                    help="sensing data: the load on the electrodes (default short; a V column needs open or a "
                         "resistance, e.g. 10kOhm)")
     p.add_argument("--support", default=None, choices=SENSE_SUPPORTS,
-                   help="sensing data: how the tip displacement bends the strip (default free, as sense: a file "
-                        "sense --out wrote reads with the same defaults)")
+                   help="sensing data: how the tip displacement bends the strip (default tip-force, as sense: a "
+                        "file sense --out wrote reads with the same defaults)")
     p.add_argument("--nu", type=nu_type, default=DEFAULT_NU,
                    help="sensing data: drained Poisson ratio when nu is not free, the start when free (default 0, "
                         "an assumption)")

@@ -219,7 +219,8 @@ def _run_sensing(args):
                       (args.beam == "dynamic", "--beam dynamic (the tip displacement is imposed quasi-statically; base "
                                                "excitation through the beam's modes is not modelled)"),
                       (args.viscous_modulus != 0.0, "--viscous-modulus"),
-                      (args.support is not None and args.support.startswith("clamped"), f"--support {args.support}")):
+                      (args.support is not None and args.support.startswith("clamped"),
+                       f"--support {args.support} (it takes free or tip-force)")):
         if bad:
             raise ValueError(f"--mode sensing does not take {what}")
     strip, material, _ = strip_and_material(args)

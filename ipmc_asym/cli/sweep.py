@@ -24,10 +24,12 @@ from ipmc_asym.cli.common import (
     model_help,
     strip_and_material,
     tol_type,
+    warn,
 )
 from ipmc_asym.forward.model import ASSUMPTION_CHECKS, ASSUMPTION_LIMITS
 from ipmc_asym.io.datasets import sweep_dataset, write_netcdf
 from ipmc_asym.io.fileio import atomic_write
+from ipmc_asym.model.limits import bare_number_warning, range_warning
 from ipmc_asym.model.materials import material_comments
 from ipmc_asym.parallel.executors import check_scheduler
 from ipmc_asym.studies.fits import axis_fits
@@ -117,6 +119,14 @@ def run(args) -> int:
     if args.spread and (to_nc or args.scheduler is not None):
         raise ValueError("--spread: written to CSV or JSON only (stdout or --out F.csv / F.json), "
                          "not with --out F.nc or --scheduler")
+    # each axis' ends held to the plausible ranges, as --thickness is (a bare 200 is 200 m): one line an axis
+    for text in args.vary:
+        name, rng = (x.strip() for x in text.split("=", 1))
+        for end, v in zip(rng.split(":")[:2], specs[name][1:3]):
+            line = bare_number_warning(name, end.strip(), v, f"--vary {name}") or range_warning(name, v, f"--vary {name}")
+            if line:
+                warn(line)
+                break
     vary = {k: vary_values(*sp[1:]) for k, sp in specs.items()}
     # --out: its path and format checked before any work with every output (add_output_option)
     if args.scheduler is not None:

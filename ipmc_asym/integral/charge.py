@@ -40,7 +40,8 @@ from ipmc_asym.base.registry import FIDELITIES as _FIDELITY_SPECS
 from ipmc_asym.base.registry import fidelity_names
 from ipmc_asym.base.results import Panel, ResultMixin, ResultSpec
 from ipmc_asym.base.settings import BVP_STATED_ERROR, VALIDATED_VOLTAGE, VALIDITY_LIMIT
-from ipmc_asym.integral.api import check_fidelity, check_min_thickness, paper_model_id, run_parallel
+from ipmc_asym.base.units import parse_length, parse_voltage
+from ipmc_asym.integral.api import as_numbers, check_fidelity, check_min_thickness, paper_model_id, run_parallel
 from ipmc_asym.kernels.charge import GL_W, GL_X, closed_sweep, exact_sweep, near_sweep
 from ipmc_asym.model import groups
 from ipmc_asym.model.params import NAFION_LI, Material, Strip, check_positive
@@ -133,13 +134,18 @@ def charge_inputs(thickness, voltage, model="constant", width=5.0e-3, length=0.0
     mat = NAFION_LI if material is None else material
     w = check_positive("width (total, 2l)", width, "m")
     L = check_positive("length", length, "m")
-    th = np.asarray(thickness, dtype=float)
-    v = np.asarray(voltage, dtype=float)
+    # numbers, arrays or the units people write ("200um", "1V"), as moment_integral takes them
+    th = np.asarray(as_numbers("thickness (total, 2e)", thickness, parse_length), dtype=float)
+    v = np.asarray(as_numbers("voltage", voltage, parse_voltage), dtype=float)
     if not np.all(np.isfinite(th)) or np.any(th <= 0):
         raise ValueError("thickness (total, 2e) must be finite and > 0 m")
     if not np.all(np.isfinite(v)):
         raise ValueError("voltage must be finite (volts)")
-    th, v = np.broadcast_arrays(th, v)
+    try:
+        th, v = np.broadcast_arrays(th, v)
+    except ValueError:
+        raise ValueError(f"thickness and voltage must broadcast to one shape; got shapes {th.shape} and "
+                         f"{v.shape}") from None
     check_min_thickness(th)
     return th, v, perm, w, L, mat
 

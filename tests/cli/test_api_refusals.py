@@ -89,3 +89,15 @@ def test_uq_file_with_a_nan_parameter_refused_by_name(tmp_path, capsys):
     rc = main(["uq", str(f), "--samples", "128"])
     err = capsys.readouterr().err
     assert rc == 2 and err.count("\n") == 1 and "uncertain.c_moy.mean" in err and "finite" in err, err
+
+
+def test_charge_takes_units_and_names_what_does_not_broadcast():
+    """ia.charge reads the units people write as moment_integral does ("200um" is 2e-4 to the
+    bit); shapes that do not broadcast, or a bad string, are one line naming the parameters."""
+    import ipmc_asym as ia
+
+    assert ia.charge("200um", "1V").sigma == ia.charge(2e-4, 1.0).sigma
+    with pytest.raises(ValueError, match=r"^thickness and voltage must broadcast to one shape; got shapes \(2,\) and \(3,\)$"):
+        ia.charge([1e-4, 2e-4], [1.0, -1.0, 2.0])
+    with pytest.raises(ValueError, match="^thickness \\(total, 2e\\): cannot read 'abc' as a length"):
+        ia.charge("abc", 1.0)

@@ -61,7 +61,7 @@ def test_text_table(capsys):
 @pytest.mark.parametrize("argv,needle", [
     (["--mode", "sensing", "--voltage", "0.5V"], "--mode sensing does not take --voltage"),
     (["--mode", "sensing", "--beam", "dynamic"], "--mode sensing does not take --beam dynamic"),
-    (["--mode", "sensing", "--support", "clamped-free"], "--mode sensing does not take --support clamped-free"),
+    (["--mode", "sensing", "--support", "clamped-free"], "--support clamped-free (it takes free or tip-force)"),
     (["--mode", "sensing", "--sheet-resistance", "2.5"], "--mode sensing does not take --sheet-resistance"),
     (["--mode", "sensing", "--load", "-5ohm"], "--load must be short, open or a resistance > 0"),
     (["--mode", "sensing", "--load", "10parsec"], "unknown unit 'parsec'"),

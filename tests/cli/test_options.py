@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from ipmc_asym.cli import build_parser
+from ipmc_asym.cli import build_parser, main
 
 CLI = Path(__file__).resolve().parents[2] / "ipmc_asym" / "cli"
 SHARED = {"common", "__init__"}  # the modules every command may import from
@@ -93,3 +93,16 @@ def test_phases_in_degrees_in_and_out(tmp_path, capsys):
     a, b = read_file(str(deg), Strip()), read_file(str(rad), Strip())
     assert np.allclose(a.measured["Z_phase"], b.measured["Z_phase"], rtol=1e-14, atol=0)
     assert np.allclose(a.measured["Z_phase"], [-np.pi / 4, -np.pi / 6], rtol=1e-14)
+
+
+def test_a_sweep_axis_of_bare_numbers_is_held_to_the_plausible_range(capsys, tmp_path):
+    """--vary thickness=200:400:2 is 200 m to 400 m (a bare number is SI), as --thickness 200 is:
+    the same one-line warning suggests the unit; an axis with units says nothing."""
+    out = tmp_path / "s.csv"
+    assert main(["sweep", "--vary", "thickness=200:400:2", "--fidelity", "leading", "--no-progress",
+                 "--out", str(out)]) == 0
+    err = capsys.readouterr().err
+    assert err.count("--vary thickness 200 is read as 200 m") == 1 and "did you mean 200um?" in err
+    assert main(["sweep", "--vary", "thickness=200um:400um:2", "--fidelity", "leading", "--no-progress",
+                 "--out", str(out)]) == 0
+    assert "read as" not in capsys.readouterr().err
