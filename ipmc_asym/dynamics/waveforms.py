@@ -262,11 +262,11 @@ def voltage_rate(fun, t, dt_min: float):
     """``dphi0/dt`` (V/s) at the times ``t`` (s) for the displacement current ``C_g dphi0/dt``.
 
     A :class:`Waveform` gives the regular part of its derivative (:meth:`Waveform.derivative`);
-    any other callable a difference over ``1e-7 max(t, dt_min)``: central where both sides agree,
-    else the side without the jump (a jump of ``dV`` makes its side ``~dV/dt``, orders of
-    magnitude above any slope the output grid resolves); 0 at ``t = 0``.  A jump's displacement
-    impulse (an ideal step, at 0 or later, a square wave's flip) is not a current density: at a
-    jump the rate is the one just after it.
+    any other callable a difference over ``dt = 1e-7 max(t, dt_min)``: central, or one-sided where
+    the other side jumps (its value moves by more than 1e-4 of the function's size within ``dt``,
+    which a slope the outputs resolve does not; a smooth side taken for one changes the rate by
+    ``O(dt)`` only); 0 at ``t = 0``.  A jump's displacement impulse (an ideal step, at 0 or later,
+    a square wave's flip) is not a current density: at a jump the rate is the one just after it.
     """
     t = np.asarray(t, dtype=float)
     regular = getattr(fun, "derivative", None)
@@ -274,10 +274,11 @@ def voltage_rate(fun, t, dt_min: float):
         return np.asarray(regular(t), dtype=float)
     dt = 1e-7 * np.maximum(t, dt_min)
     f0, fp, fm = (np.asarray(fun(x), dtype=float) for x in (t, t + dt, np.maximum(t - dt, 0.0)))
+    size = 1e-4 * np.maximum(np.maximum(np.abs(f0), np.abs(fp)), np.abs(fm))
+    jr, jl = np.abs(fp - f0) > size, np.abs(f0 - fm) > size
     right, left = (fp - f0) / dt, (f0 - fm) / dt
-    jump = np.abs(right - left) > 1e3 * np.minimum(np.abs(right), np.abs(left)) + 1e-300
-    side = np.where(np.abs(right) <= np.abs(left), right, left)
-    return np.where(t > 0.0, np.where(jump, side, 0.5 * (right + left)), 0.0)
+    rate = np.where(jl & ~jr, right, np.where(jr & ~jl, left, 0.5 * (right + left)))
+    return np.where(t > 0.0, rate, 0.0)
 
 
 def check_drive_voltage(name, volts) -> float:
