@@ -37,6 +37,8 @@ Layer rule: stdlib + numpy at import; SciPy (via bvp) is imported lazily; figure
 from __future__ import annotations
 
 import csv
+import math
+import time
 
 import numpy as np
 
@@ -49,6 +51,7 @@ from ipmc_asym.base.settings import (
 )
 from ipmc_asym.io.fileio import atomic_write
 from ipmc_asym.model.params import NAFION_LI, Material, Strip
+from ipmc_asym.model.permittivity import get_model
 
 __all__ = ["QUANTITIES", "profile", "debye_hueckel_profile", "DH_MIN_A2", "layer_widths", "profile_summary",
            "transition_width", "TRANSITION_LEVELS", "write_csv", "compute_all", "PAPER_LAYERS", "LAYER_WIDTHS"]
@@ -132,12 +135,8 @@ def debye_hueckel_profile(model="constant", strip: Strip | None = None, material
     BVPResult
         On the same conventions as the BVP's (``status`` 0, no spline ``sol``).
     """
-    import math
-    import time
-
-    from ipmc_asym.bvp.solver import BVPResult
-    from ipmc_asym.integral.api import moment_integral
-    from ipmc_asym.model.permittivity import get_model
+    from ipmc_asym.bvp.solver import BVPResult  # deferred: SciPy's solve_bvp (start-up)
+    from ipmc_asym.integral.api import moment_integral  # deferred: the compiled kernels (start-up)
 
     t0 = time.perf_counter()
     strip = Strip() if strip is None else strip
