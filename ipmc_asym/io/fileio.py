@@ -25,6 +25,7 @@ from __future__ import annotations
 import contextlib
 import errno
 import os
+import stat
 import tempfile
 
 from ipmc_asym.base import interrupt
@@ -153,15 +154,25 @@ def atomic_write(path, mode: str = "w", **open_kw):
         ``OSError`` is raised naming ``path``.
     """
     p = os.fspath(path)
+    if "b" not in mode:
+        open_kw.setdefault("encoding", "utf-8")
+        open_kw.setdefault("newline", "")
+    try:
+        kind = os.stat(p).st_mode
+    except OSError:
+        kind = None
+    if kind is not None and not stat.S_ISREG(kind) and not stat.S_ISDIR(kind):
+        # a device or a FIFO (/dev/null, /dev/stdout): written in place; renaming a file over it
+        # would replace the device with a regular file (as root, /dev/null itself)
+        with open(p, mode, **open_kw) as fh:
+            yield _Checked(fh)
+        return
     d = os.path.dirname(os.path.abspath(p))
     try:
         fd, tmp = tempfile.mkstemp(prefix=f".{os.path.basename(p)}.", suffix=".part", dir=d)
     except OSError as exc:
         raise _named(exc, p) from None
     try:
-        if "b" not in mode:
-            open_kw.setdefault("encoding", "utf-8")
-            open_kw.setdefault("newline", "")
         with os.fdopen(fd, mode, **open_kw) as fh:
             yield _Checked(fh)
         interrupt.check()  # an interruption swallowed during the work: nothing committed
