@@ -26,7 +26,7 @@ from ipmc_asym.base.units import (
 )
 from ipmc_asym.io.fileio import check_output_path
 from ipmc_asym.model.electrode import METALS
-from ipmc_asym.model.limits import bare_number_warning, material_warnings, range_warning
+from ipmc_asym.model.limits import material_warnings, range_warning, value_warning
 from ipmc_asym.model.materials import bibliography, material_comments
 from ipmc_asym.model.params import Strip, check_min_thickness, material_from_spec, set_thickness
 
@@ -138,7 +138,7 @@ def _plausible_length(name):
     def check(text, v):
         if name == "thickness" and v < MIN_THICKNESS:
             return  # refused by the Strip (its thickness floor), the one check every command shares
-        line = bare_number_warning(name, text, v, f"--{name}") or range_warning(name, v, f"--{name}")
+        line = value_warning(name, text, v, f"--{name}")
         if line:
             warn(line)
 

@@ -29,7 +29,7 @@ from ipmc_asym.cli.common import (
 from ipmc_asym.forward.model import ASSUMPTION_CHECKS, ASSUMPTION_LIMITS
 from ipmc_asym.io.datasets import sweep_dataset, write_netcdf
 from ipmc_asym.io.fileio import atomic_write
-from ipmc_asym.model.limits import bare_number_warning, range_warning
+from ipmc_asym.model.limits import value_warning
 from ipmc_asym.model.materials import material_comments
 from ipmc_asym.parallel.executors import check_scheduler
 from ipmc_asym.studies.fits import axis_fits
@@ -123,7 +123,7 @@ def run(args) -> int:
     for text in args.vary:
         name, rng = (x.strip() for x in text.split("=", 1))
         for end, v in zip(rng.split(":")[:2], specs[name][1:3]):
-            line = bare_number_warning(name, end.strip(), v, f"--vary {name}") or range_warning(name, v, f"--vary {name}")
+            line = value_warning(name, end.strip(), v, f"--vary {name}")
             if line:
                 warn(line)
                 break

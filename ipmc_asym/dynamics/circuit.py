@@ -534,14 +534,7 @@ class CircuitStepper:
             raise ValueError("each chunk must start at the last time of the previous one (0 at the start)")
         tau = self.tau
         tt, idx = substep_grid(t, tau, 5e-3, self.substeps, ("the reduced model's", "use fewer time constants"))
-        # the layers are integrated up to each output time with phi0's value just before it: at a
-        # jump there (a step after 0, a square wave's flip) the layer charge is continuous and the
-        # output is the state just after the jump (the core's displacement charge and the current
-        # take phi0(t), below); and (t/tau) tau, rounded past a jump at t, would let the layers
-        # respond to it early
-        tp = tt * tau
-        tp[idx] = np.where(t > 0.0, np.nextafter(t, -np.inf), t)
-        ps = self.fun(tp) / self.VT
+        ps = self.fun(drive_times(t, tt, idx, tau)) / self.VT
         A = np.empty(tt.size)
         s = np.empty(tt.size)
         integrate_circuit(tt, ps, self.rho, self.mid, GL_X, GL_W, A, s, self.state)
@@ -613,6 +606,18 @@ def substep_grid(t, tau, h_max, substeps, too_long):
     idx = np.concatenate(([0], np.cumsum(k)))
     frac = np.arange(idx[-1]) - np.repeat(idx[:-1], k)
     return np.concatenate((np.repeat(t[:-1] / tau, k) + np.repeat(dt / k, k) * frac, [t[-1] / tau])), idx
+
+
+def drive_times(t, tt, idx, tau):
+    """The times (s) at which a stepper samples ``phi0`` on the grid ``(tt, idx)`` of
+    :func:`substep_grid`: the substeps, and at each output time ``t`` the instant just before it.
+    The layers are integrated up to an output time with phi0's value before it: at a jump there (a
+    step after 0, a square wave's flip) the layer charge is continuous and the output is the state
+    just after the jump (the core's displacement charge and the current take ``phi0(t)``); and
+    ``(t/tau) tau``, rounded past a jump at ``t``, would let the layers respond to it early."""
+    tp = tt * tau
+    tp[idx] = np.where(t > 0.0, np.nextafter(t, -np.inf), t)
+    return tp
 
 
 def circuit_response(t, phi0_fun, strip: Strip, perm: Permittivity, material: Material, substeps: int = 2):
@@ -748,21 +753,16 @@ def step_response(voltage=1.0, duration=None, *, strip: Strip | None = None, mod
             sigma, u, J = circuit_response(tgrid, fun, s, perm, m)
             err = sig_err
             if tol is not None:
-                _say()
+                if notice is not None:
+                    notice()
                 r, err = _circuit_error(sigma, tgrid, fun, s, perm, m, opts)
                 pnp_ref.append(r)
             return sigma, u, J, err
-        if pnp_ref:
+        if pnp_ref:  # the reference run is the pnp rung: no second run, no second notice
             return pnp_ref[0]
-        _say()
-        return solve_transient(tgrid, fun, s, perm, m, **opts)
-
-    said = []
-
-    def _say():
-        if notice is not None and not said:
-            said.append(True)
+        if notice is not None:
             notice()
+        return solve_transient(tgrid, fun, s, perm, m, **opts)
 
     def checks(f, r, idx):
         if f == "pnp":

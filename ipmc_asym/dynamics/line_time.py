@@ -32,7 +32,7 @@ from __future__ import annotations
 import numpy as np
 
 from ipmc_asym.beam.dynamics import _propagate, mode_shape, modes, moment_kernels, natural_frequencies
-from ipmc_asym.dynamics.circuit import strip_beam, substep_grid
+from ipmc_asym.dynamics.circuit import drive_times, strip_beam, substep_grid
 from ipmc_asym.dynamics.electrode import charge_scale, core_resistance, time_constant
 from ipmc_asym.integral.api import paper_model_id
 from ipmc_asym.kernels.charge import GL_W, GL_X
@@ -144,11 +144,7 @@ class LineStepper:
         tau = self.tau
         tt, idx = substep_grid(t, tau, self.h_max, self.substeps,
                                ("the line's", "use fewer time constants or fewer points a chunk"))
-        # integrated up to each output time with phi0 just before it, as the uniform strip's stepper
-        # (CircuitStepper.advance): at a jump there the output is the state just after it
-        tp = tt * tau
-        tp[idx] = np.where(t > 0.0, np.nextafter(t, -np.inf), t)
-        ps = self.fun(tp) / self.VT
+        ps = self.fun(drive_times(t, tt, idx, tau)) / self.VT
         out = {}
         L = self.strip.length
         for name, lad in (("fine", self.fine), ("coarse", self.coarse)):

@@ -16,7 +16,7 @@ import numpy as np
 from ipmc_asym.base.settings import MIN_THICKNESS
 
 __all__ = ["SLENDER_LIMITS", "PLAUSIBLE", "slender_ok", "slender_warnings", "range_warning", "material_warnings",
-           "bare_number_warning", "strip_warnings"]
+           "bare_number_warning", "value_warning", "strip_warnings"]
 
 #: geometry ratio -> (smallest, largest, reason) for the slender-beam model of the paper (sections
 #: 3-4); None where a side is unbounded
@@ -137,6 +137,13 @@ def bare_number_warning(name, text, value, label=None):
     hint = f"; did you mean {' or '.join(sugg)}?" if sugg else ""
     return (f"{label or name} {t} is read as {v:g} m (a bare number is SI), implausible for an IPMC strip "
             f"(plausible {lo:g}-{hi:g} m){hint}")
+
+
+def value_warning(name, text, value, label=None):
+    """The one line on a length as written (``text``) and read (``value``): the bare-number hint
+    (:func:`bare_number_warning`) where it applies, else the plausible range (:func:`range_warning`);
+    None where neither has anything to say."""
+    return bare_number_warning(name, text, value, label) or range_warning(name, value, label)
 
 
 def strip_warnings(length, width, thickness) -> list:

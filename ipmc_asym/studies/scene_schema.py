@@ -54,7 +54,7 @@ from ipmc_asym.base.registry import model_names
 from ipmc_asym.base.settings import DEFAULT_SCENE_TOL, MAX_ROWS
 from ipmc_asym.base.units import parse_length, parse_voltage
 from ipmc_asym.forward.escalation import check_tol
-from ipmc_asym.model.limits import bare_number_warning, material_warnings, range_warning
+from ipmc_asym.model.limits import material_warnings, range_warning, value_warning
 from ipmc_asym.model.params import NOMINAL_STRIP, Material, Strip, material_from_spec
 
 __all__ = ["Scene", "OUTPUTS", "AXES", "load_scene", "parse_scene", "read_scene"]
@@ -278,7 +278,7 @@ def parse_scene(scene: dict) -> Scene:
     warns = []
     for k, v in strip.items():  # the rules of the command line's length options (model.limits)
         text = v if isinstance(v, str) else str(v) if isinstance(v, int) else repr(float(v))
-        line = bare_number_warning(k, text, base[k], f"strip.{k}") or range_warning(k, base[k], f"strip.{k}")
+        line = value_warning(k, text, base[k], f"strip.{k}")
         if line:
             warns.append(line)
     for k, a in axes.items():  # swept lengths: the first implausible value

@@ -44,7 +44,7 @@ from ipmc_asym.base.registry import fidelity_names
 from ipmc_asym.base.settings import BVP_STATED_ERROR
 from ipmc_asym.forward.model import assumption_warnings, forward
 from ipmc_asym.studies.fits import fit_power_law
-from ipmc_asym.studies.profiles import LAYER_WIDTHS, layer_widths, profile, profile_summary
+from ipmc_asym.studies.profiles import LAYER_WIDTHS, profile, profile_summary
 from ipmc_asym.studies.scene_schema import OUTPUTS, Scene, load_scene, read_scene
 
 __all__ = ["run_scene", "load_scene", "OUTPUTS", "LADDER", "Scene"]
@@ -96,9 +96,9 @@ def _profiles(sc: Scene):
             r = profile(sc.model, s, sc.material)
         except RuntimeError as exc:
             raise RuntimeError(f"profiles: at point {i}: {exc}") from None
-        w = layer_widths(r, s.e)
-        wa, wc = w[_ANODE_WIDTH] * 1e-6, w[_CATHODE_WIDTH] * 1e-6
-        item = {"B1": profile_summary(sc.model, s, sc.material, res=r)["B1"], "I": float(r.I), "n_nodes": int(r.n_nodes),
+        summary = profile_summary(sc.model, s, sc.material, res=r)  # its layer widths and B1, once
+        wa, wc = summary[_ANODE_WIDTH] * 1e-6, summary[_CATHODE_WIDTH] * 1e-6
+        item = {"B1": summary["B1"], "I": float(r.I), "n_nodes": int(r.n_nodes),
                 "anode_layer": {"width_e": wa / s.e, "width_m": wa},
                 "cathode_layer": {"width_e": wc / s.e, "width_m": wc},
                 "C_min": float(r.C.min()), "C_max": float(r.C.max())}
