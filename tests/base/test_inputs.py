@@ -52,7 +52,7 @@ def test_parse_size_refused(text):
     ["drive", "--waveform", "csv:/dev/zero", "--duration", "1s"],
 ])
 def test_commands_refuse_non_regular_inputs(argv, capsys, tmp_path):
-    # a FIFO made here (it stands for a device: /dev/null itself was once a regular file here)
+    # a FIFO made here (it stands for a device: a test must not write to the machine's /dev/null)
     fifo = tmp_path / "fifo"
     os.mkfifo(fifo)
     argv = [str(fifo) if a == "FIFO" else a for a in argv]

@@ -156,7 +156,7 @@ def test_waveform_refusals_one_line_exit_2_and_no_file(capsys, tmp_path, argv, n
 
 def test_time_domain_with_a_load_prints_no_nan_mean_power(capsys):
     """Too few rows in the power's window: the mean power is not computed; the text says n/a
-    (it printed 'mean power nan W') and a note says why, as the JSON's null does."""
+    and a note says why, as the JSON's null does."""
     assert main(["sense", "--waveform", "step:1mm", "--duration", "1s", "--points", "5", "--model", "constant",
                  "--load", "10kOhm"]) == 0
     out = capsys.readouterr().out

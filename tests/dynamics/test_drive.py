@@ -141,7 +141,7 @@ def test_a_later_step_is_the_step_at_zero_shifted(solver, capsys):
     """Nothing happens before a step at 0.1 s: from 0.1 s the response is the step response at 0
     (time invariance; independent of how either run treats the jump). At the jump the output is
     the state just after it: the core's displacement charge C_g V, the current V/R; the current is
-    not a difference across the jump (it was 1.25e6 A/m^2 there, 570 times V/R)."""
+    not a difference across the jump (that would be ~dV C_g/dt, hundreds of times V/R)."""
     import json
 
     from ipmc_asym.cli import main

@@ -77,7 +77,7 @@ def test_an_underflowing_response_is_flagged_with_its_reason():
 
 def test_an_incompressible_drained_matrix_senses_nothing_exactly():
     """nu = 1/2: the bend leaves the solution's volume, so C_moy and the response, unchanged: Q and
-    V_oc are 0 exactly, with no error and valid (they were flagged as a rounded subnormal); any
+    V_oc are 0 exactly, with no error and valid (an exact 0 is no rounded subnormal); any
     other nu is proportional to 1 - 2 nu at linear order."""
     r = ia.sense(ia.Strip(), curvature=np.array([0.0, 2.0, -3.0]), nu=0.5)
     assert r.Q.tolist() == [0.0, 0.0, 0.0] and r.V_oc.tolist() == [0.0, 0.0, 0.0]

@@ -164,7 +164,7 @@ def test_datasheet_sets_derived_values():
 
 def test_a_material_file_has_the_input_cap_of_every_input_file(tmp_path):
     """A material file is read by the one input reader: the size cap is --max-input-size's (a 1.2 MB
-    file, a long comment and the paper's values, is read; it had a cap of its own, 1 MB), a
+    file, a long comment and the paper's values, is read), a
     directory or a missing file is refused in one line."""
     from ipmc_asym.base.inputs import input_size_cap
 

@@ -207,7 +207,7 @@ def test_pressure_term_scene():
 
 def test_scene_profiles_of_a_negative_voltage_are_the_mirror_image():
     """-V is +V mirrored: the cathode's concentration B1 and the layer widths are the same, I
-    changes sign (B1 was read at z = +1, the anode of a negative voltage: 4.8e-34 for 2)."""
+    changes sign (B1 is the cathode's concentration: at z = +1 for a positive voltage only)."""
     from ipmc_asym.studies.scenes import run_scene
 
     res = run_scene({"name": "pm", "model": "linear", "outputs": ["profiles", "I"], "strip": {"thickness": "100um"},
