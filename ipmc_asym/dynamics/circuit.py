@@ -308,7 +308,7 @@ def waveform(kind, voltage, *, ramp_time=None, frequency=None):
             return v
         return user
     check_choice("waveform", kind, WAVEFORMS)
-    V = check_finite("voltage", voltage, "a finite number of volts")
+    V = check_drive_voltage("voltage", voltage)
     if kind == "step":
         return lambda t: np.full(np.shape(t), V)
     if kind == "ramp":
@@ -1085,7 +1085,7 @@ def frequency_response(f, *, strip: Strip | None = None, model="constant", mater
     f = np.asarray(f, dtype=float)
     if not np.all(np.isfinite(f)) or np.any(f <= 0):
         raise ValueError("frequencies must be finite and > 0 Hz")
-    bias = check_drive_voltage("voltage (DC bias)", check_finite("voltage (DC bias)", voltage, "a finite number of volts"))
+    bias = check_drive_voltage("voltage (DC bias)", voltage)
     support = check_support(support)
     el = check_electrode(electrode, s.length)
     if bias != 0.0 and method != "circuit":

@@ -108,15 +108,14 @@ class Drive:
         if isinstance(drive, bool) or drive is None:
             raise ValueError(f"drive must be a voltage (V), a waveform SPEC such as 'sine:1V@10Hz' or a callable "
                              f"phi0(t) in volts; got {drive!r}")
-        if isinstance(drive, (int, float, np.floating, np.integer)):
-            self.kind, self.spec = "step", "step"
-            self.voltage = check_drive_voltage("drive", check_finite("drive", drive, "a finite number of volts"))
-            self.function = self.source = waveform("step", self.voltage)
-        elif isinstance(drive, str):
-            wave = parse_waveform(drive)
-            self.kind, self.voltage, self.spec, self.function, self.source = "waveform", float("nan"), wave.spec, wave, wave
-        elif isinstance(drive, Waveform):
+        if isinstance(drive, str):
+            drive = parse_waveform(drive)
+        if isinstance(drive, Waveform):
             self.kind, self.voltage, self.spec, self.function, self.source = "waveform", float("nan"), drive.spec, drive, drive
+        elif isinstance(drive, (int, float, np.floating, np.integer)):
+            self.kind, self.spec = "step", "step"
+            self.voltage = check_drive_voltage("drive", drive)
+            self.function = self.source = waveform("step", self.voltage)
         elif callable(drive):
             self.kind, self.voltage, self.spec = "function", float("nan"), "function"
             self.function, self.source = waveform(drive, 0.0), drive

@@ -282,9 +282,14 @@ def voltage_rate(fun, t, dt_min: float):
 
 
 def check_drive_voltage(name, volts) -> float:
-    """``volts`` (the largest ``|phi0|`` a drive reaches) within :data:`MAX_DRIVE_VOLTAGE`, else a
-    one-line ``ValueError`` naming ``name``."""
-    v = abs(float(volts))
+    """``volts`` (the largest ``|phi0|`` a drive reaches) as a float, finite and within
+    :data:`MAX_DRIVE_VOLTAGE`, else a one-line ``ValueError`` naming ``name``."""
+    try:
+        v = abs(float(volts))
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a finite number of volts; got {volts!r}") from None
+    if not math.isfinite(v):
+        raise ValueError(f"{name} must be a finite number of volts; got {volts!r}")
     if not v <= MAX_DRIVE_VOLTAGE:
         raise ValueError(f"{name}: |phi0| up to {MAX_DRIVE_VOLTAGE:g} V allowed (the time-domain kernels are "
                          f"checked finite up to there; the model is validated to {VALIDATED_VOLTAGE:g} V); "

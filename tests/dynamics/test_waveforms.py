@@ -56,6 +56,16 @@ def test_drive_voltage_cap_refuses_by_name_and_is_finite_at_the_cap():
             ia.Drive(bad)
     with pytest.raises(ValueError, match=r"waveform: \|phi0\| up to"):
         parse_waveform(f"dc:{0.6 * MAX_DRIVE_VOLTAGE}V+sine:{0.6 * MAX_DRIVE_VOLTAGE}V@1Hz")
+    # the library's own waveforms and the DC bias go through the same check as a Drive
+    from ipmc_asym.dynamics.circuit import waveform
+
+    with pytest.raises(ValueError, match=r"voltage: \|phi0\| up to"):
+        waveform("step", 2 * MAX_DRIVE_VOLTAGE)
+    for bad in (float("nan"), "x"):
+        with pytest.raises(ValueError, match="voltage must be a finite number of volts"):
+            waveform("ramp", bad, ramp_time=1.0)
+    with pytest.raises(ValueError, match=r"DC bias\)?: \|phi0\| up to"):
+        ia.spectrum([1.0], ia.Strip(), voltage=2 * MAX_DRIVE_VOLTAGE)
     for v in (MAX_DRIVE_VOLTAGE, -MAX_DRIVE_VOLTAGE):
         r = ia.time_response(ia.Strip(), ia.Drive(v), duration=0.1, points=3)
         rows = r.result if r.result is not None else r.columns
