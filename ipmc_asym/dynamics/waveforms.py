@@ -32,6 +32,7 @@ import numpy as np
 from ipmc_asym.base.inputs import read_input_text
 from ipmc_asym.base.settings import MAX_DRIVE_VOLTAGE, VALIDATED_VOLTAGE
 from ipmc_asym.base.units import parse_length, parse_quantity, parse_time, parse_voltage
+from ipmc_asym.model.params import check_finite
 
 __all__ = ["Waveform", "parse_waveform", "WAVEFORM_KINDS", "MAX_CSV_ROWS", "voltage_rate"]
 
@@ -284,12 +285,7 @@ def voltage_rate(fun, t, dt_min: float):
 def check_drive_voltage(name, volts) -> float:
     """``volts`` (the largest ``|phi0|`` a drive reaches) as a float, finite and within
     :data:`MAX_DRIVE_VOLTAGE`, else a one-line ``ValueError`` naming ``name``."""
-    try:
-        v = abs(float(volts))
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a finite number of volts; got {volts!r}") from None
-    if not math.isfinite(v):
-        raise ValueError(f"{name} must be a finite number of volts; got {volts!r}")
+    v = abs(check_finite(name, volts, "a finite number of volts"))
     if not v <= MAX_DRIVE_VOLTAGE:
         raise ValueError(f"{name}: |phi0| up to {MAX_DRIVE_VOLTAGE:g} V allowed (the time-domain kernels are "
                          f"checked finite up to there; the model is validated to {VALIDATED_VOLTAGE:g} V); "
