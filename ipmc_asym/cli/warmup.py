@@ -4,8 +4,8 @@ Numba compiles a kernel the first time it is called after install (``cache=True`
 code then lives in the cache directory, ``kernels.jit.CACHE_DIR``).  Each command compiles what
 it needs on its first run; this command calls every compiled path once on a few points (each
 rung of the ladder for the three models, the charge, the circuit and PNP transients, the
-spectrum with the modal beam and the electrode line, a waveform drive, a sweep written to CSV),
-says how long each took, and marks the cache as warm.  ``--jobs N`` compiles the groups in N
+spectrum with the modal beam and the electrode line, a waveform drive (also through the line), a
+sweep written to CSV), says how long each took, and marks the cache as warm.  ``--jobs N`` compiles the groups in N
 processes side by side (Numba compiles in one thread; the cache files are written atomically).
 """
 
@@ -77,6 +77,7 @@ def _steps():
 
     def drive():
         ia.drive_response("sine:0.5V@10Hz", 0.2, 400)
+        ia.drive_response("step:0.5V", 0.05, 20, sheet_resistance=2.5)  # the electrode line
 
     def sweep_csv():
         from ipmc_asym.cli import main  # deferred: cli/__init__ imports this module
@@ -96,7 +97,7 @@ def _steps():
             ("forward model and beam (a sweep)", forward),
             ("charging transient: circuit and PNP solver", transient),
             ("spectrum: modal beam and electrode line", spectrum),
-            ("waveform drive", drive)]
+            ("waveform drive: uniform strip and electrode line", drive)]
 
 
 def _group(i):

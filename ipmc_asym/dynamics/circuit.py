@@ -69,7 +69,7 @@ from ipmc_asym.forward.model import assumption_warnings, forward, voltage_reason
 from ipmc_asym.integral.api import paper_model_id
 from ipmc_asym.kernels import _generated_charge as GC
 from ipmc_asym.kernels.charge import GL_W, GL_X
-from ipmc_asym.kernels.charge_time import integrate_circuit, shat
+from ipmc_asym.kernels.charge_time import cd_hat_many, integrate_circuit
 from ipmc_asym.model import groups
 from ipmc_asym.model.electrode import beam_label
 from ipmc_asym.model.params import (
@@ -440,14 +440,21 @@ def output_errors(u_lo, u_hi, values: dict, strip: Strip, perm: Permittivity, ma
     return res
 
 
-def quasi_static_forward(u, strip: Strip, perm: Permittivity, material: Material, checked_voltage=None):
+def quasi_static_forward(u, strip: Strip, perm: Permittivity, material: Material, applied=None):
     """The forward model (:class:`ipmc_asym.forward.model.ForwardResult`, withheld outputs NaN)
     of the static strip at the layer voltage(s) ``u`` (V); see :func:`quasi_static_mechanics`.
-    ``checked_voltage``: the voltage its ``voltage`` check concerns (default ``u``)."""
+    ``applied``: the drive's voltage(s) ``phi0`` (V, broadcast against ``u``); the ``voltage`` check
+    then concerns the larger of the two in magnitude at each point (the layers' voltage lags behind
+    the applied one, which the validated range is about too)."""
     fid = "corrected" if paper_model_id(perm) >= 0 else "quadrature"
+    u = np.asarray(u, dtype=float)
+    checked = None
+    if applied is not None:
+        applied = np.broadcast_to(np.asarray(applied, dtype=float), u.shape)
+        checked = np.where(np.abs(applied) > np.abs(u), applied, u)
     with np.errstate(all="ignore"):
-        return forward(strip.length, strip.width, strip.thickness, np.asarray(u, dtype=float), material=material,
-                       model=perm, fidelity=fid, checked_voltage=checked_voltage).withhold()
+        return forward(strip.length, strip.width, strip.thickness, u, material=material,
+                       model=perm, fidelity=fid, checked_voltage=checked).withhold()
 
 
 def quasi_static_mechanics(u, strip: Strip, perm: Permittivity, material: Material):
@@ -570,7 +577,9 @@ class CircuitStepper:
         t = np.asarray(t, dtype=float)
         A = np.asarray(u, dtype=float) / self.VT
         ps = self.fun(t) / self.VT
-        cx = np.array([shat(float(a), self.rho, self.mid, GL_X, GL_W)[1] for a in A])
+        cx = np.empty(A.size)
+        cd_hat_many(np.ascontiguousarray(A).reshape(-1), self.rho, self.mid, GL_X, GL_W, cx)
+        cx = cx.reshape(A.shape)
         sdot = (ps - A) / (2.0 * self.tau)
         # dA/dt = (psi0 - A)/(2 s'(A)) per tau: the layers relax on 2 s'(A) tau; below the largest
         # substep (5e-3 tau, substep_grid) that relaxation is not resolved -- the L-stable BDF2 settles
@@ -808,8 +817,7 @@ def step_response(voltage=1.0, duration=None, *, strip: Strip | None = None, mod
         extra = dict(extra, M_A_profiles=r.M_A_profiles)
     # every time point through the forward model and its checks (the same as estimate's)
     applied = fun(tgrid)
-    # the voltage check concerns the applied voltage too (the layers' one lags behind it)
-    fr = quasi_static_forward(u, s, perm, m, checked_voltage=np.where(np.abs(applied) > np.abs(u), applied, u))
+    fr = quasi_static_forward(u, s, perm, m, applied=applied)
     checks = {c: a.reshape(-1) for c, a in fr.checks_mask.items()}
     warns = assumption_warnings(fr)
     M, th, w, Fb = (np.asarray(getattr(fr, k), dtype=float) for k in ("M_A", "theta", "w", "F_block"))

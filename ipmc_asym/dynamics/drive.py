@@ -5,10 +5,10 @@ mechanics of each time point from the one forward model and its checks
 (:func:`ipmc_asym.dynamics.circuit.quasi_static_forward`; ``check_*`` and ``valid`` columns,
 one ``warnings`` list per chunk) and, with ``beam="dynamic"``, the
 strip's inertia and damping (:class:`ipmc_asym.dynamics.circuit.BeamDynamics`), each carrying
-its state from one chunk to the next: the rows are those of one run over the whole grid (the
-circuit's current from its model, :meth:`~ipmc_asym.dynamics.circuit.CircuitStepper.current`; the
-electrode line's displacement part by central differences over the rows, so a row is handed out
-once its successor is known).
+its state from one chunk to the next: the rows are those of one run over the whole grid.  The
+current is the model's own at each row, not a difference over the rows (which would straddle a
+jump of the drive): :meth:`~ipmc_asym.dynamics.circuit.CircuitStepper.current`, and the electrode
+line's :meth:`~ipmc_asym.dynamics.line_time.LineStepper.current`.
 """
 
 from __future__ import annotations
@@ -19,7 +19,6 @@ import numpy as np
 
 from ipmc_asym.base import interrupt
 from ipmc_asym.base.registry import check_choice
-from ipmc_asym.base.settings import VALIDATED_VOLTAGE
 from ipmc_asym.beam.dynamics import CLAMPED_OUTPUTS, natural_frequencies
 from ipmc_asym.beam.statics import solve_beam
 from ipmc_asym.dynamics.circuit import (
@@ -47,7 +46,7 @@ from ipmc_asym.dynamics.line_time import (
     line_weights,
 )
 from ipmc_asym.dynamics.waveforms import Waveform, parse_waveform
-from ipmc_asym.forward.model import CHECKS, assumption_warnings, voltage_reason
+from ipmc_asym.forward.model import CHECKS, assumption_warnings
 from ipmc_asym.model.params import (
     NAFION_LI,
     SHEET_RESISTANCE_SOURCE,
@@ -231,26 +230,23 @@ def drive_chunks(wave, duration, points, *, strip: Strip | None = None, model="c
         ldyn = (LineBeamDynamics(s, m, viscous_modulus, n_modes, line.x),
                 LineBeamDynamics(s, m, viscous_modulus, n_modes, line.x_coarse))
     stepper = line if line is not None else CircuitStepper(fun, s, perm, m)
-    R = float(core_resistance(s.thickness, m))
-    Cg = stepper.Cg
     lcols = LINE_COLUMNS if line is not None else ()
     if line is not None:
         # the forward model runs on every node of both ladders: keep its arrays at ~2e5 points a chunk
         chunk = max(16, min(chunk, 200_000 // (3 * line.segments + 2)))
     peak = {"sigma": 0.0, "w": 0.0}
-    held = None  # last computed row, waiting for its successor (central difference of phi0 - u)
-    prev = None  # (t, ub) of the row before it
     start = 0
-    while start < n - 1 or held is None:
+    while True:
         stop = min(start + chunk, n - 1)
         idx = np.arange(start, stop + 1)
         t = idx * h if times is None else np.asarray(times(idx), dtype=float)
         t[-1] = d if stop == n - 1 else t[-1]
         lc = {}
+        phi = fun(t)
         if line is None:
-            u, ub, sigma = stepper.advance(t)
+            u, _, sigma = stepper.advance(t)
             # every time point through the forward model and its checks (the same as step's and estimate's)
-            fr = quasi_static_forward(u, s, perm, m)
+            fr = quasi_static_forward(u, s, perm, m, applied=phi)
             M, th, w, Fb = (np.asarray(getattr(fr, k), dtype=float) for k in ("M_A", "theta", "w", "F_block"))
             checks = {c: np.asarray(getattr(fr, c), bool).reshape(-1) for c in CHECKS}
             if el is not None:  # the moment on [x1, x2] only: its small-displacement statics
@@ -258,11 +254,11 @@ def drive_chunks(wave, duration, points, *, strip: Strip | None = None, model="c
                 th = _linear_statics(lb, M, "clamped-free", ("theta",))["theta"]
                 Fb = _linear_statics(lb, M, "clamped-pinned", ("F",))["F"]
             cc = _linear_statics(lb, M, "clamped-clamped") if clamped else {}
-            lc = {"_J": stepper.current(t, u)}  # the model's current (not a difference over the rows)
+            lc = {"_J": stepper.current(t, u)}
         else:
             o = line.advance(t)
             # every node at every time through the forward model; a time point passes a check where every node does
-            fr = quasi_static_forward(o["u"].ravel(), s, perm, m)
+            fr = quasi_static_forward(o["u"].ravel(), s, perm, m, applied=np.repeat(phi, o["u"].shape[1]))
             checks = {c: np.asarray(getattr(fr, c), bool).reshape(o["u"].shape).all(axis=1) for c in CHECKS}
             Mn = np.asarray(fr.M_A, dtype=float).reshape(o["u"].shape)
             M, th, w, Fb = _line_mechanics(Mn, line.x, s, m)
@@ -274,8 +270,9 @@ def drive_chunks(wave, duration, points, *, strip: Strip | None = None, model="c
                 th, w, Fb = ldyn[0].advance(t, Mn, (th, w), Fb)
                 wc = ldyn[1].advance(t, Mc, (thc, wc), Fc)[1]
             u = o["u"] @ line_weights(2 * line.segments, s.length)[1] / s.length
-            ub, sigma = o["ub_mean"], o["sigma_mean"]
-            lc = {"sigma_error": o["sigma_error"], "w_error": ERROR_FACTOR * np.abs(w - wc)}
+            sigma = o["sigma_mean"]
+            lc = {"sigma_error": o["sigma_error"], "w_error": ERROR_FACTOR * np.abs(w - wc),
+                  "_J": line.current(t, o["u"], o["v"])}
             for k, v in (("sigma", sigma), ("w", np.maximum(np.abs(w), np.abs(w_qs)))):
                 # the error bound against the largest response so far (a numerical check: refuse, not flag);
                 # for w the quasi-static deflection too (the strip's inertia delays the dynamic one)
@@ -287,41 +284,21 @@ def drive_chunks(wave, duration, points, *, strip: Strip | None = None, model="c
                                      f"{LINE_TOL:g} of the response at t = {t[i]:.4g} s with {2 * line.segments} "
                                      f"segments; raise line_segments (now {line.segments}, at most {MAX_SEGMENTS})")
                 peak[k] = float(scale[-1])
-        phi = fun(t)
         warns = assumption_warnings(fr)
-        over = np.abs(phi) > VALIDATED_VOLTAGE  # the applied voltage too: the layers' one lags behind it
-        if np.any(over & checks["voltage"]):
-            checks["voltage"] = checks["voltage"] & ~over
-            warns = [x for x in warns if "VALIDATED_VOLTAGE" not in x] + [voltage_reason(np.max(np.abs(phi)))]
         valid = np.logical_and.reduce([checks[c] for c in CHECKS])
         if dyn is not None and line is None:
             th, w, Fb = dyn.advance(t, M, th, w, Fb)
             if clamped:
                 cc = dyn.advance_clamped(t, M, cc)
         cols = {"t": t, "phi0": phi, "sigma": sigma, "layer_voltage": u, "M_A": M, "theta": th, "w": w,
-                "F_block": Fb, "_ub": ub, **{f"check_{c}": checks[c].astype(float) for c in CHECKS},
+                "F_block": Fb, "current_density": lc.pop("_J"),
+                **{f"check_{c}": checks[c].astype(float) for c in CHECKS},
                 "valid": valid.astype(float), **lc, **(cc if line is None else {})}
-        if held is not None:  # the first row of this chunk repeats the held one
-            cols = {k: v[1:] for k, v in cols.items()}
-            cols = {k: np.concatenate(([held[k]], cols[k])) for k in cols}
-        # derivative of ub at every row but the last (central; one-sided at t = 0)
-        tt = cols["t"]
-        uu = cols["_ub"]
-        tb = np.concatenate(([prev[0]], tt)) if prev is not None else tt
-        ubb = np.concatenate(([prev[1]], uu)) if prev is not None else uu
+        # every row is the model's own (its current too): a chunk after the first drops its first
+        # row, the previous chunk's last
+        emit = slice(1, None) if start > 0 else slice(None)
+        out = {k: cols[k][emit] for k in DRIVE_COLUMNS + CHECK_COLUMNS + lcols + ccols}
         last = stop == n - 1
-        g = np.gradient(ubb, tb) if tb.size > 1 else np.zeros(tb.size)
-        if prev is not None:
-            g = g[1:]
-        emit = slice(None) if last else slice(0, -1)
-        J = cols["_J"] if line is None else uu / R + Cg * g
-        out = {k: cols[k][emit] for k in DRIVE_COLUMNS + CHECK_COLUMNS + lcols + ccols if k != "current_density"}
-        out["current_density"] = J[emit]
-        if not last:
-            held = {k: v[-1] for k, v in cols.items()}
-            prev = (tt[-2], uu[-2])
-        else:
-            held = {}
         interrupt.check()  # a Ctrl-C/SIGTERM swallowed inside the chunk's compiled code stops here
         yield {**{k: out[k] for k in DRIVE_COLUMNS + CHECK_COLUMNS + lcols + ccols}, "warnings": warns}
         start = stop

@@ -30,13 +30,15 @@ the Richardson estimate for ``N`` = 8-32 at 2.5 and 25 Ohm/sq (0.85-1.03).
 from __future__ import annotations
 
 import numpy as np
+from scipy.linalg import solve_banded
 
 from ipmc_asym.beam.dynamics import _propagate, mode_shape, modes, moment_kernels, natural_frequencies
 from ipmc_asym.dynamics.circuit import drive_times, strip_beam, substep_grid
 from ipmc_asym.dynamics.electrode import charge_scale, core_resistance, time_constant
+from ipmc_asym.dynamics.waveforms import voltage_rate
 from ipmc_asym.integral.api import paper_model_id
 from ipmc_asym.kernels.charge import GL_W, GL_X
-from ipmc_asym.kernels.charge_time import integrate_line
+from ipmc_asym.kernels.charge_time import cd_hat_many, integrate_line
 from ipmc_asym.model import groups
 from ipmc_asym.model.params import Material, Strip, check_finite
 from ipmc_asym.model.permittivity import Permittivity
@@ -67,9 +69,29 @@ class _Ladder:
         self.x, self.w = line_weights(n, strip.length)
         h = strip.length / n
         self.G = 2.0 * Rs * self.w * h / R
+        # Kirchhoff's law at nodes 1..N as a banded matrix (solve_banded's layout): the node voltages are
+        # algebraic in the layers' and the drive's, psi_{j-1} - (2 + G_j) psi_j + psi_{j+1} = -G_j A_j
+        # (the open end: psi_{N-1} - (1 + G_N) psi_N = -G_N A_N)
+        self.band = np.zeros((3, n))
+        self.band[0, 1:] = 1.0
+        self.band[1] = -2.0 - self.G[1:]
+        self.band[1, -1] = -1.0 - self.G[-1]
+        self.band[2, :-1] = 1.0
         k = n + 1
         self.A, self.A_prev, self.s, self.s_prev, self.P = (np.zeros(k) for _ in range(5))
         self.hp = np.zeros(1)
+
+
+def _node_voltages(lad, A, ps):
+    """The node voltages (n, N+1) of ladder ``lad`` where the layers hold ``A`` (n, N+1) and the drive is
+    ``ps`` (n,) (all in R T/F).  Linear, so the same call turns the layers' and the drive's rates
+    into the nodes' rates (Kirchhoff's law differentiated in time)."""
+    rhs = -lad.G[1:] * A[:, 1:]
+    rhs[:, 0] -= ps
+    P = np.empty(A.shape)
+    P[:, 0] = ps
+    P[:, 1:] = solve_banded((1, 1), lad.band, rhs.T).T
+    return P
 
 
 class LineStepper:
@@ -147,8 +169,18 @@ class LineStepper:
         ps = self.fun(drive_times(t, tt, idx, tau)) / self.VT
         out = {}
         L = self.strip.length
+        # the layers are integrated with phi0 just before each output time (drive_times); at a jump there
+        # the layers' charge is continuous but the node voltages follow phi0 at once: recomputed with
+        # phi0(t), the row is the state just after the jump (as the circuit's; its core displacement
+        # charge and current take phi0(t)); so is the start, whose nodes the stepper holds at rest.
+        # Elsewhere the two drives agree to rounding.
+        ps_t = self.fun(t) / self.VT
+        jump = np.abs(ps_t - ps[idx]) > 1e-12 * (1.0 + np.abs(ps_t))
+        jump[0] |= t[0] == 0.0
         for name, lad in (("fine", self.fine), ("coarse", self.coarse)):
             A, P, s = self._run(lad, tt, ps, idx)
+            if np.any(jump):
+                P[jump] = _node_voltages(lad, A[jump], ps_t[jump])
             u, v = self.VT * A, self.VT * P
             sig = self.S * s + self.Cg * (v - u)
             out[name] = (u, v, sig, sig @ lad.w / L, (v - u) @ lad.w / L, u @ self._ww[id(lad)])
@@ -158,6 +190,32 @@ class LineStepper:
         return {"u": u, "v": v, "sigma": sig, "sigma_mean": sm, "ub_mean": ub, "u_w": uw,
                 "sigma_error": ERROR_FACTOR * np.abs(sm - sm2), "u_w_error": ERROR_FACTOR * np.abs(uw - uw2),
                 "u_coarse": out["coarse"][0], "sigma_coarse": sm2}
+
+    def current(self, t, u, v):
+        """The model's current density (A/m^2, over the electrode area) at the output times ``t`` (s)
+        where the reported line's layers and nodes hold ``u`` and ``v`` (V, (n, N+1), from :meth:`advance`).
+
+        From the model's own equations, as :meth:`ipmc_asym.dynamics.circuit.CircuitStepper.current`
+        at every node, not from differences over the output times: ``J_j = S ds_j/dt +
+        C_g d(v_j - u_j)/dt`` with ``ds_j/dt = (psi_j - A_j)/(2 tau)``, ``dA_j/dt = (ds_j/dt)/s'(A_j)``
+        and the nodes' rates from Kirchhoff's law differentiated (:func:`_node_voltages`) with the
+        drive's ``dphi0/dt`` (:func:`ipmc_asym.dynamics.waveforms.voltage_rate`: at a jump, the current
+        just after it); ``J`` is their mean over the area (trapezoidal weights).
+        """
+        lad = self.fine
+        A = np.asarray(u, dtype=float) / self.VT
+        P = np.asarray(v, dtype=float) / self.VT
+        cx = np.empty(A.size)
+        cd_hat_many(np.ascontiguousarray(A).reshape(-1), self.rho, self.mid, GL_X, GL_W, cx)
+        cx = cx.reshape(A.shape)
+        sdot = (P - A) / (2.0 * self.tau)
+        # below the largest substep the layers' relaxation on 2 s'(A) tau is not resolved (the BDF2
+        # settles A on psi within a substep, psi - A its Newton residual): the rate over half a substep
+        Adot = (P - A) / (2.0 * np.maximum(cx, 0.5 * self.h_max) * self.tau)
+        dps = voltage_rate(self.fun, np.asarray(t, dtype=float), 1e-3 * self.tau) / self.VT
+        Pdot = _node_voltages(lad, Adot, dps)
+        Jn = self.S * sdot + self.Cg * self.VT * (Pdot - Adot)
+        return Jn @ lad.w / self.strip.length
 
 
 def _hat_integrals(x, fn, panel_points=8):

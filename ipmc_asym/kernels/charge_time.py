@@ -17,7 +17,7 @@ import numpy as np
 from ipmc_asym.kernels.charge import charge_hat_point
 from ipmc_asym.kernels.jit import jit
 
-__all__ = ["shat", "integrate_circuit", "integrate_line"]
+__all__ = ["shat", "cd_hat_many", "integrate_circuit", "integrate_line"]
 
 
 @jit
@@ -25,6 +25,14 @@ def shat(A, rho, mid, X, Wt):
     """Signed ``sigma_hat(A)`` and ``Cd_hat(|A|)`` at the thermal voltage ``A = F u/(R T)``."""
     s, c, _ = charge_hat_point(abs(A), rho, mid, 0, X, Wt)
     return (s if A >= 0.0 else -s), c
+
+
+@jit
+def cd_hat_many(A, rho, mid, X, Wt, out):
+    """``Cd_hat(|A|)`` of every entry of the flat array ``A`` into ``out``: the layers' differential
+    capacitance (per ``A``) that turns the charging rate into the layer voltage's rate."""
+    for i in range(A.shape[0]):
+        out[i] = shat(A[i], rho, mid, X, Wt)[1]
 
 
 @jit

@@ -50,6 +50,33 @@ def test_small_signal_step_against_the_inverse_laplace_transform_of_the_exact_li
     assert np.max(o["sigma_error"]) < 5e-3 * np.max(np.abs(ref))
 
 
+def test_current_and_charge_at_a_jump_against_the_exact_line():
+    # a 1 uV step at t0 > 0, on an output time: the row at t0 is the state just after the jump (as the
+    # circuit's).  Exact line as above: the electrode charge jumps at once by the bulk's displacement
+    # charge, sigma(t0+) = lim s sigma(s) = V0 C_g tanh(g_inf)/g_inf, g_inf = L sqrt(2 R_s/R) (the
+    # uncharged layers are shorts, the line purely resistive), and J = dsigma/dt after it is the inverse
+    # transform of s sigma(s) - sigma(t0+).  A difference over the output rows would straddle the jump.
+    V0, Rs = 1e-6, 2.5
+    t = np.linspace(0.0, 2 * TAU, 81)
+    k0 = 20
+    r = drive_response(f"step:{V0}V@{float(t[k0])!r}", float(t[-1]), t.size, beam="quasi-static", sheet_resistance=Rs,
+                       line_segments=16)
+    mp.mp.dps = 30
+    g_inf = S.length * mp.sqrt(2 * Rs / R)
+    jump = V0 * CG * mp.tanh(g_inf) / g_inf
+
+    def F(p):
+        g = _g(p, Rs)
+        return V0 * mp.tanh(g) / g * (1 + p * R * CG) * C / (1 + p * R * C) - jump
+
+    assert np.all(r["current_density"][:k0] == 0.0) and np.all(r["sigma"][:k0] == 0.0)
+    assert abs(r["sigma"][k0] - float(jump)) <= r["sigma_error"][k0]
+    idx = [k0, k0 + 1, k0 + 2, k0 + 5, k0 + 20, t.size - 1]
+    ref = _exact(F, np.maximum(t[idx] - t[k0], 1e-9 * TAU))
+    # the 32-segment line's own error, as its charge's above (a few 1e-3)
+    assert np.all(np.abs(r["current_density"][idx] - ref) <= 5e-3 * np.abs(ref))
+
+
 def test_small_signal_deflection_against_the_exact_line():
     # w(s) = (V0/s) k_w F_w(g)/(1 + s R C): the layers' moment follows u = sigma_L/C_d(0), the line's
     # deflection factor F_w (derivations/line.py item 3), k_w the static deflection per volt
