@@ -160,8 +160,11 @@ def _det3(m):
 
 
 @functools.lru_cache(maxsize=None)
-def perturbation(n: int = 3) -> dict:
-    """``{k: I_k(u, E, rho, A3)}`` for even ``k < n`` (``E = e^u``), from ``x_1 .. x_n``.
+@functools.lru_cache(maxsize=None)
+def solutions(n: int = 3):
+    """``(xs, env, rhs)``: the orders ``x_1 .. x_n`` of ``X = ln C = sum_k A2^k x_k`` (``env`` maps
+    each ``x_k`` and its derivative ``dx_k`` to a function of s, ``{(m, j): c}``) and ``(C - 1)/A2``
+    as a series in ``a = A2``.
 
     Orders up to 2 are simplified (they become kernels); higher orders are left as they come
     (only evaluated numerically, for the remainder bound).
@@ -198,6 +201,13 @@ def perturbation(n: int = 3) -> dict:
             xk = _add(part, _scale(_SINH, coef[0]), _scale(_COSH, coef[1]))
         env[xs[order]] = xk
         env[dxs[order]] = _diff(xk)
+    return xs, env, rhs
+
+
+def perturbation(n: int = 3) -> dict:
+    """``{k: I_k(u, E, rho, A3)}`` for even ``k < n`` (``E = e^u``), from ``x_1 .. x_n``
+    (:func:`solutions`); orders up to 2 simplified."""
+    xs, env, rhs = solutions(n)
     # p z: C/A2 - A3 phi with phi = (ln B1 - X)/A2; constants drop (int s ds = 0)
     Ia = sp.expand(rhs + A3 * sum(a**k * xs[k] for k in range(n)))
     out = {}
@@ -205,6 +215,44 @@ def perturbation(n: int = 3) -> dict:
         val = _integ(_mul(_evalpoly(Ia.coeff(a, order), env), {(1, 0): sp.Integer(1)})) / u**2
         out[order] = sp.factor(sp.together(val)) if order <= 2 else val
     return out
+
+
+def profile_leading():
+    """The Debye-Hueckel profiles: order 0, in the overflow-free form that is evaluated.
+
+    ``X = A2 x_1 + O(A2^2)`` with ``x_1 = sinh(s)/(2 sinh u)`` (checked here), so ``C - 1 = A2 S``
+    with ``S = x_1``; ``phi = (ln B1 - X)/A2 = 1/2 - S`` (``ln B1 = A2 x_1(u) + ..., x_1(u) = 1/2``);
+    the field ``E = -dphi/dz_bar = u dS/ds``.  ``S`` is odd and ``E`` even in ``s``: at ``a = |s|``,
+    ``k = u``,
+
+        |S| = e^{a - k} (1 - e^{-2a}) / (2 (1 - e^{-2k})),   E = k e^{a - k} (1 + e^{-2a}) / (2 (1 - e^{-2k}))
+
+    (checked against ``x_1``): every exponential is at most 1 (no overflow at thick strips) and each
+    ``1 - e^{-x}`` is ``-expm1(-x)`` (no cancellation at thin ones).
+
+    Returns
+    -------
+    list of (name, args, expression, doc)
+        ``dh_profile_s(a, k)`` = ``|S|`` and ``dh_profile_e(a, k)`` = ``E``.
+    """
+    from sympy.codegen.cfunctions import expm1
+
+    xs, env, _ = solutions()
+    x1 = sum(c * s**m * sp.exp(j * s) for (m, j), c in env[xs[0]].items()).subs(E, sp.exp(u))
+    assert sp.simplify((x1 - sp.sinh(s) / (2 * sp.sinh(u))).rewrite(sp.exp)) == 0, x1
+    assert sp.simplify(x1.subs(s, u)) == sp.Rational(1, 2)
+    ka, kk = sp.symbols("a k", positive=True)
+    S_abs = sp.exp(ka - kk) * (-expm1(-2 * ka)) / (2 * (-expm1(-2 * kk)))
+    E_abs = kk * sp.exp(ka - kk) * (1 + sp.exp(-2 * ka)) / (2 * (-expm1(-2 * kk)))
+    at = {ka: s, kk: u}  # s > 0: a = s
+    assert sp.simplify((S_abs.subs(at).rewrite(sp.exp) - x1).rewrite(sp.exp)) == 0
+    assert sp.simplify((E_abs.subs(at).rewrite(sp.exp) - u * sp.diff(x1, s)).rewrite(sp.exp)) == 0
+    return [
+        ("dh_profile_s", (ka, kk), S_abs,
+         "|S| at a = |z_bar|/lam, k = 1/lam: C - 1 = A2 S, phi = 1/2 - S (S odd in z_bar), leading order in A2."),
+        ("dh_profile_e", (ka, kk), E_abs,
+         "E = -dphi/dz_bar at a = |z_bar|/lam, k = 1/lam (even in z_bar), leading order in A2."),
+    ]
 
 
 def check_leading():

@@ -37,7 +37,6 @@ Layer rule: stdlib + numpy at import; SciPy (via bvp) is imported lazily; figure
 from __future__ import annotations
 
 import csv
-import math
 import time
 
 import numpy as np
@@ -109,7 +108,8 @@ def debye_hueckel_profile(model="constant", strip: Strip | None = None, material
     """The profiles at a small voltage: the Debye-Hueckel solution, leading order in ``A2``.
 
     The BVP of :mod:`ipmc_asym.bvp.solver` linearised about rest (``C = 1 + A2 c``, ``eps`` at
-    ``C = 1``: the order ``x_0`` of ``derivations/debye_hueckel.py``), with ``u = phi - 1/2``,
+    ``C = 1``: the first order ``x_1`` of ``derivations/debye_hueckel.py``, ``profile_leading``,
+    whose overflow-free form is generated), with ``u = phi - 1/2``,
     ``u'' = u / lam^2``, ``u(-+1) = +-1/2`` and neutrality::
 
         phi = 1/2 - S,   C - 1 = A2 S,   E = lam S',   D = (A2 lam^2) E,
@@ -137,6 +137,7 @@ def debye_hueckel_profile(model="constant", strip: Strip | None = None, material
     """
     from ipmc_asym.bvp.solver import BVPResult  # deferred: SciPy's solve_bvp (start-up)
     from ipmc_asym.integral.api import moment_integral  # deferred: the compiled kernels (start-up)
+    from ipmc_asym.kernels._generated_dh import dh_profile_e, dh_profile_s  # deferred: loads Numba (start-up)
 
     t0 = time.perf_counter()
     strip = Strip() if strip is None else strip
@@ -151,16 +152,15 @@ def debye_hueckel_profile(model="constant", strip: Strip | None = None, material
     d = np.concatenate(([0.0], np.geomspace(min(1e-4 * lam, 1e-6), 1.0, nodes - 1)))
     z = np.concatenate((d - 1.0, (1.0 - d)[-2::-1]))
     k, a = 1.0 / lam, np.abs(z) / lam
-    f = np.exp(a - k) / -math.expm1(-2.0 * k)  # e^{|z|/lam - 1/lam} / (1 - e^{-2/lam})
-    S = np.sign(z) * f * -np.expm1(-2.0 * a) / 2.0  # sinh(z/lam) / (2 sinh(1/lam))
-    E = k * f * (1.0 + np.exp(-2.0 * a)) / 2.0  # -phi' = cosh(z/lam) / (2 lam sinh(1/lam))
+    # S = sinh(z/lam)/(2 sinh(1/lam)) and E = cosh(z/lam)/(2 lam sinh(1/lam)), overflow-free (generated)
+    S = np.sign(z) * dh_profile_s(a, k)
+    E = dh_profile_e(a, k)
     phi = 0.5 - S
     rho = A2 * S
     D = (A2 * lam * lam) * E  # eps at C = 1 is A2 lam^2 (the core Debye length)
-    B1 = 1.0 + 0.5 * A2
     if g.sign < 0:  # mirror image z -> -z, potential referenced to the face z = +1 (as the BVP)
         z, rho, D, E, phi = -z[::-1], rho[::-1], -D[::-1], -E[::-1], phi[::-1] - 1.0
-        B1 = 1.0 + float(rho[-1])
+    B1 = 1.0 + float(rho[-1])  # C at the face z = +1 (1 + A2/2, or its mirror)
     C = 1.0 + rho
     I = float(moment_integral(strip.thickness, strip.voltage, perm, "exact", material=material))
     return BVPResult(z=z, C=C, phi=phi, E=E, D=D, rhoZ=rho, p=C / A2 - A3 * phi, y=np.log1p(rho), B1=B1, I=I,
