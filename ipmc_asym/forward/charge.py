@@ -50,17 +50,19 @@ def charge_report(strip: Strip, material: Material = NAFION_LI, model: str = "al
             if not (m in models and mat.c_moy == material.c_moy):
                 jobs.append((m, mat))
     def one(m, mat, spread_only):
+        """``(result, None)``; a spread variant alone with no valid rung: ``(None, why)``, n/a in the
+        spread (the caller's rows stand)."""
         try:
             return charge_escalated(strip.thickness, strip.voltage, m, fidelity, width=strip.width,
-                                    length=strip.length, material=mat)
+                                    length=strip.length, material=mat), None
         except ValueError as exc:
             if not spread_only:  # a row the caller asked for: refused, one line
                 raise
-            return exc  # a spread variant alone: n/a in the spread (the caller's rows stand)
+            return None, str(exc)
 
     got = [one(m, mat, i >= len(models)) for i, (m, mat) in enumerate(jobs)]
     rows = []
-    for m, r in zip(models, got):
+    for m, (r, _) in zip(models, got):
         rows.append({"model": m, "fidelity": fidelity, "fidelity_used": r.fidelity,
                      "escalated": r.fidelity != fidelity, "sigma": float(r.sigma), "Q": float(r.Q),
                      "C_diff": float(r.C_diff), "eps_app": float(r.eps_app), "error_estimate": float(r.error),
@@ -81,11 +83,11 @@ def charge_report(strip: Strip, material: Material = NAFION_LI, model: str = "al
             if m in done and mat.c_moy == material.c_moy:
                 out[label] = done[m]
                 continue
-            c = next(extra)
-            if isinstance(c, ValueError):
+            c, why = next(extra)
+            if c is None:
                 out[label] = dict.fromkeys(("sigma", "Q", "C_diff", "eps_app", "error_estimate",
                                             "error_estimate_C_diff"))
-                warnings.append(f"model-form spread: {label} left out (n/a): {c}")
+                warnings.append(f"model-form spread: {label} left out (n/a): {why}")
                 continue
             out[label] = {"sigma": float(c.sigma), "Q": float(c.Q), "C_diff": float(c.C_diff),
                           "eps_app": float(c.eps_app), "error_estimate": float(c.error),
