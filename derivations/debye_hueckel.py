@@ -41,6 +41,7 @@ import functools
 
 import mpmath as mp
 import sympy as sp
+from sympy.codegen.cfunctions import expm1
 
 from . import model as M
 from .kernel import Kernel
@@ -235,8 +236,6 @@ def profile_leading():
     list of (name, args, expression, doc)
         ``dh_profile_s(a, k)`` = ``|S|`` and ``dh_profile_e(a, k)`` = ``E``.
     """
-    from sympy.codegen.cfunctions import expm1
-
     xs, env, _ = solutions()
     x1 = sum(c * s**m * sp.exp(j * s) for (m, j), c in env[xs[0]].items()).subs(E, sp.exp(u))
     assert sp.simplify((x1 - sp.sinh(s) / (2 * sp.sinh(u))).rewrite(sp.exp)) == 0, x1
