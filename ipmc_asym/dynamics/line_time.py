@@ -173,9 +173,10 @@ class LineStepper:
         # the layers' charge is continuous but the node voltages follow phi0 at once: recomputed with
         # phi0(t), the row is the state just after the jump (as the circuit's; its core displacement
         # charge and current take phi0(t)); so is the start, whose nodes the stepper holds at rest.
-        # Elsewhere the two drives agree to rounding.
+        # Elsewhere the two drives agree to rounding (relative: a jump of any size is one, down to subnormal
+        # drives; a false one near a zero crossing only solves Kirchhoff's law again, to the same rounding).
         ps_t = self.fun(t) / self.VT
-        jump = np.abs(ps_t - ps[idx]) > 1e-12 * (1.0 + np.abs(ps_t))
+        jump = np.abs(ps_t - ps[idx]) > 1e-12 * np.maximum(np.abs(ps_t), np.abs(ps[idx]))
         jump[0] |= t[0] == 0.0
         for name, lad in (("fine", self.fine), ("coarse", self.coarse)):
             A, P, s = self._run(lad, tt, ps, idx)
