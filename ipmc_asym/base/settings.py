@@ -39,12 +39,16 @@ MIN_THICKNESS = 100e-9
 #: (IPMCs are driven at a few volts): above this voltage every result carries a warning
 VALIDATED_VOLTAGE = 20.0
 
-#: largest |phi0| (V) a time-domain drive (``step``, ``drive``, ``Drive``) accepts: a numerical
-#: guard, not a physical limit.  The charge kernels' closed forms lose finite values somewhere
-#: above ~1e100 V (measured: NaN charge at a 1e200 V step); 50x the validated range is far past
-#: any use and keeps every output finite (tests/dynamics/test_waveforms.py); beyond
+#: largest |phi0| (V) any command or library entry accepts (a Strip, the voltages of the moment
+#: integral, the charge and a sweep; a time-domain drive): a numerical guard, not a physical
+#: limit.  The charge kernels' closed forms lose finite values somewhere above ~1e100 V (measured:
+#: NaN charge at a 1e200 V step), and near the overflow of A2 = F |phi0|/(R T) (~4e306 V) the
+#: static charge did not return at all; 50x the validated range is far past any use and keeps
+#: every output finite (tests/dynamics/test_waveforms.py, tests/integration/test_extremes.py); beyond
 #: VALIDATED_VOLTAGE results still carry the warning
-MAX_DRIVE_VOLTAGE = 1e3
+MAX_VOLTAGE = 1e3
+#: the same cap under its former name (time-domain drives)
+MAX_DRIVE_VOLTAGE = MAX_VOLTAGE
 
 #: relative rounding floor of the error estimate of corrected / quadrature (the two terms are
 #: assembled with cancellations; measured <= 2.3e-12 against the BVP on 1 um - 10 mm x 0.1 mV - 20 V)

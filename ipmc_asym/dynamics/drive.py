@@ -86,15 +86,15 @@ DRIVE_ERROR_NOTE = ("no error of the reduced circuit against the PNP is stated f
                     "run over the same waveform (in memory, at most "
                     f"{MAX_STATED_POINTS} points); freq --method circuit states it in "
                     "the small signal ('error')")
-LINE_NOTE = ("electrodes: sheet resistance R_s = {Rs:g} Ohm/sq each: the RC line along the strip discretised in "
-             "{n2} segments (trapezoidal ladder, a reduced circuit at each node, driven at the clamp, open at the tip); "
+LINE_NOTE = ("electrodes: sheet resistance R_s = {Rs:g} Ohm/sq each: the RC line along the strip discretised in {n2} "
+             "segments (trapezoidal ladder, a reduced circuit at each node, driven at the clamp, open at the tip); "
              "sigma, current density and layer voltage are means over the electrode; sigma_error and w_error are twice "
              "the Richardson estimate against {n} segments (none is stated for the current density, which that "
-             "estimate does not bound: ~2e-3 of it off the exact line at 2.5 Ohm/sq); the quasi-static beam takes the distributed moment as the "
-             "uniform moments of equal tip rotation (theta, M_A = its mean) and of equal tip deflection (w, F_block): "
-             "exact for small displacements and for a uniform moment; with beam dynamics the node moments (linear "
-             "between nodes) drive the modes through int M phi_n'' dx; the bulk's geometric capacitance is "
-             "instantaneous (its displacement charge is added to sigma)")
+             "estimate does not bound: ~2e-3 of it off the exact line at 2.5 Ohm/sq); the quasi-static beam takes the "
+             "distributed moment as the uniform moments of equal tip rotation (theta, M_A = its mean) and of equal tip "
+             "deflection (w, F_block): exact for small displacements and for a uniform moment; with beam dynamics the "
+             "node moments (linear between nodes) drive the modes through int M phi_n'' dx; the bulk's geometric "
+             "capacitance is instantaneous (its displacement charge is added to sigma)")
 
 #: the electrode line's stated error may reach this fraction of the largest |sigma| and |w| so far;
 #: beyond it the run is refused (more segments hold it): the numbers are not handed out

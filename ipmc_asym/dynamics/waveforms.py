@@ -30,9 +30,8 @@ import re
 import numpy as np
 
 from ipmc_asym.base.inputs import read_input_text
-from ipmc_asym.base.settings import MAX_DRIVE_VOLTAGE, VALIDATED_VOLTAGE
 from ipmc_asym.base.units import parse_length, parse_quantity, parse_time, parse_voltage
-from ipmc_asym.model.params import check_finite
+from ipmc_asym.model.params import check_finite, check_voltage_cap
 
 __all__ = ["Waveform", "parse_waveform", "WAVEFORM_KINDS", "MAX_CSV_ROWS", "voltage_rate"]
 
@@ -284,10 +283,7 @@ def voltage_rate(fun, t, dt_min: float):
 
 def check_drive_voltage(name, volts) -> float:
     """``volts`` (the largest ``|phi0|`` a drive reaches) as a float, finite and within
-    :data:`MAX_DRIVE_VOLTAGE`, else a one-line ``ValueError`` naming ``name``."""
-    v = abs(check_finite(name, volts, "a finite number of volts"))
-    if not v <= MAX_DRIVE_VOLTAGE:
-        raise ValueError(f"{name}: |phi0| up to {MAX_DRIVE_VOLTAGE:g} V allowed (the time-domain kernels are "
-                         f"checked finite up to there; the model is validated to {VALIDATED_VOLTAGE:g} V); "
-                         f"got {v:.3g} V")
+    :data:`~ipmc_asym.base.settings.MAX_VOLTAGE`, else a one-line ``ValueError`` naming ``name``."""
+    v = check_finite(name, volts, "a finite number of volts")
+    check_voltage_cap(v, name)
     return float(volts)

@@ -56,6 +56,7 @@ from ipmc_asym.base.settings import (
     BVP_STATED_ERROR,
     EXACT_STATED_ERROR,
     INTERPRET_BUDGET_S,
+    MAX_VOLTAGE,
     MIN_THICKNESS,
     ROUNDING_ERROR,
     VALIDITY_LIMIT,
@@ -67,7 +68,7 @@ from ipmc_asym.kernels.exact import exact_frozen, moment_exact
 from ipmc_asym.kernels.jit import interpreted, jit, jit_parallel, prange
 from ipmc_asym.kernels.quadrature import moment_quadrature
 from ipmc_asym.model import groups
-from ipmc_asym.model.params import NAFION_LI, Material, Strip, check_min_thickness
+from ipmc_asym.model.params import NAFION_LI, Material, Strip, check_min_thickness, check_voltages
 from ipmc_asym.model.permittivity import MODELS, Permittivity, get_model
 from ipmc_asym.model.request import check_fidelity
 
@@ -142,14 +143,15 @@ def groups_arrays(thickness, voltage, perm: Permittivity, material: Material):
 
 
 def _groups_arrays(thickness, voltage, perm: Permittivity, material: Material, floor: bool = True):
-    """:func:`groups_arrays`; ``floor=False``: the thickness floor is known to hold."""
+    """:func:`groups_arrays`; ``floor=False``: the thickness floor and the voltage cap are known to hold."""
     th = np.asarray(thickness, dtype=float)
     v = np.asarray(voltage, dtype=float)
     if not np.all(np.isfinite(th)) or np.any(th <= 0):
         raise ValueError("thickness (total, 2e) must be finite and > 0 m")
-    if floor:
+    if floor:  # an entry: the thickness floor and the voltage cap (else the caller's edge check holds them)
         check_min_thickness(th)
-    if not np.all(np.isfinite(v)):
+        check_voltages(v)
+    elif not np.all(np.isfinite(v)):
         raise ValueError("voltage must be finite (volts)")
     th, v = np.broadcast_arrays(th, v)
     eps_core = perm.eps0 + perm.deps
@@ -335,13 +337,20 @@ def _fused_driver(order: int):
     return _fused_blocks if order in (1, 2) else _fused_points
 
 
+#: the compiled drivers' own guard on |phi0| (V): twice the cap the entries hold (settings.MAX_VOLTAGE),
+#: so that points just past it inside the library (a central difference at the cap, a stepper's
+#: rounding past its drive) are evaluated, not dropped; the kernels are checked finite up to here
+_VOLTAGE_CAP = 2.0 * MAX_VOLTAGE
+
+
 @jit(inline="always")
 def _input_code(t, vv):
     """0 for a usable point, 2 if the thickness is not finite or <= 0, 3 if the voltage is not
-    finite (the codes of :func:`_put`)."""
+    finite or past :data:`_VOLTAGE_CAP` (the codes of :func:`_put`; the same comparison costs nothing
+    more than the finiteness test, and the caller says which)."""
     if not (t > 0.0 and t < math.inf):
         return 2
-    if not (abs(vv) < math.inf):
+    if not (abs(vv) <= _VOLTAGE_CAP):
         return 3
     return 0
 
@@ -656,7 +665,8 @@ def _moment(thickness, voltage, perm: Permittivity, fidelity: str, mat: Material
                                                                        full=True, floor=not floor_checked)
         if bad_th:
             raise ValueError("thickness (total, 2e) must be finite and > 0 m")
-        if bad_v:
+        if bad_v:  # not finite or past the cap: the line that says which
+            check_voltages(voltage)
             raise ValueError("voltage must be finite (volts)")
         return MomentResult(I=I, error=err, B1=B1, core=core, lam=lam, A2=A2, valid=valid,
                             fidelity=fidelity, model=perm.name, success=np.ones(I.shape, bool))
@@ -789,7 +799,7 @@ def moment_integral(thickness, voltage, model="constant", fidelity="quadrature",
                 consts += (exact_frozen(consts[3], True),)
             _SCALAR_CACHE[(model, fidelity)] = consts
         t, vv = float(thickness), float(voltage)
-        if consts is not None and t >= MIN_THICKNESS and math.isfinite(t) and math.isfinite(vv):
+        if consts is not None and t >= MIN_THICKNESS and math.isfinite(t) and abs(vv) <= MAX_VOLTAGE:
             Ii, ok = _run_driver(_scalar_driver(consts[5]), 1, fidelity, (t, vv, *consts))
             if ok:
                 return Ii
@@ -851,8 +861,12 @@ def _fused(thickness, voltage, perm: Permittivity, mat: Material, fidelity: str,
     I = np.empty(shape)
     valid = np.empty(shape, dtype=np.bool_)
     extra = tuple(np.empty(shape) for _ in range(5)) if full else ()
-    if floor:  # False: the caller's Strip or edge check holds it
+    if floor:  # False: the caller's Strip or edge check holds the thickness floor and the voltage cap
         check_min_thickness(th)
+        if v.size:  # max and min: no temporary array (NaN and inf are the driver's to report)
+            m = max(float(np.max(v)), -float(np.min(v)))
+            if MAX_VOLTAGE < m < math.inf:
+                check_voltages(v)
     outs = [a.reshape(-1) for a in extra] if full else [np.empty(0)] * 5
     counts = _run_driver(_fused_driver(_FIDELITY_SPECS[fidelity].kernel_code), I.size, fidelity, (
         _flat_input(th, shape), _flat_input(v, shape), *_driver_constants(perm, mat, fidelity),

@@ -44,7 +44,7 @@ from ipmc_asym.base.units import parse_length, parse_voltage
 from ipmc_asym.integral.api import as_numbers, check_fidelity, check_min_thickness, paper_model_id, run_parallel
 from ipmc_asym.kernels.charge import GL_W, GL_X, closed_sweep, exact_sweep, near_sweep
 from ipmc_asym.model import groups
-from ipmc_asym.model.params import NAFION_LI, Material, Strip, check_positive
+from ipmc_asym.model.params import NAFION_LI, Material, Strip, check_positive, check_voltages
 from ipmc_asym.model.permittivity import Permittivity, get_model
 
 __all__ = ["ChargeResult", "charge", "charge_escalated", "charge_inputs", "charge_at", "charge_scale", "capacitance_scale", "SUBNORMAL"]
@@ -139,8 +139,7 @@ def charge_inputs(thickness, voltage, model="constant", width=5.0e-3, length=0.0
     v = np.asarray(as_numbers("voltage", voltage, parse_voltage), dtype=float)
     if not np.all(np.isfinite(th)) or np.any(th <= 0):
         raise ValueError("thickness (total, 2e) must be finite and > 0 m")
-    if not np.all(np.isfinite(v)):
-        raise ValueError("voltage must be finite (volts)")
+    check_voltages(v)
     try:
         th, v = np.broadcast_arrays(th, v)
     except ValueError:

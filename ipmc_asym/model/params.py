@@ -29,7 +29,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ipmc_asym.base.settings import MIN_THICKNESS, STRAIN_LIMIT
+from ipmc_asym.base.settings import MAX_VOLTAGE, MIN_THICKNESS, STRAIN_LIMIT, VALIDATED_VOLTAGE
 from ipmc_asym.base.units import parse_length, parse_pressure, parse_voltage
 from ipmc_asym.model import material_data
 from ipmc_asym.model.electrode import NO_ELECTRODE, Electrode, composite_stiffness, electrode_from_spec
@@ -56,6 +56,8 @@ __all__ = [
     "check_positive",
     "check_finite",
     "check_min_thickness",
+    "check_voltage_cap",
+    "check_voltages",
     "make_groups",
     "moment_scale",
     "debye_length",
@@ -124,6 +126,25 @@ def check_finite(name: str, value, allowed: str = "a finite number") -> float:
     if not math.isfinite(v):
         raise ValueError(f"{name} must be {allowed}; got {value!r}")
     return v
+
+
+def check_voltage_cap(voltage, name: str = "voltage") -> None:
+    """One-line ``ValueError`` naming ``name`` where a finite voltage (V, scalar or array) passes
+    :data:`ipmc_asym.base.settings.MAX_VOLTAGE` in magnitude (a numerical guard, for every entry)."""
+    v = np.abs(np.asarray(voltage, dtype=float))
+    m = float(np.max(v)) if v.size else 0.0
+    if m > MAX_VOLTAGE:
+        raise ValueError(f"{name}: |phi0| up to {MAX_VOLTAGE:g} V allowed (the kernels are checked finite up to "
+                         f"there; the model is validated to {VALIDATED_VOLTAGE:g} V); got {m:.3g} V")
+
+
+def check_voltages(voltage, name: str = "voltage") -> None:
+    """One-line ``ValueError`` naming ``name`` where a voltage (V, scalar or array) is not finite
+    (NaN, inf) or passes :data:`ipmc_asym.base.settings.MAX_VOLTAGE` in magnitude."""
+    v = np.asarray(voltage, dtype=float)
+    if not np.all(np.isfinite(v)):
+        raise ValueError(f"{name} must be finite (volts)")
+    check_voltage_cap(v, name)
 
 
 def check_min_thickness(thickness) -> None:
@@ -456,7 +477,7 @@ class Strip:
         check_positive("width (total, 2l)", self.width, "m")
         check_positive("thickness (total, 2e)", self.thickness, "m")
         check_min_thickness(self.thickness)  # a Strip is checked once, here: its users trust it
-        check_finite("voltage", self.voltage, "a finite number of volts")
+        check_voltage_cap(check_finite("voltage", self.voltage, "a finite number of volts"))
 
     @property
     def e(self) -> float:

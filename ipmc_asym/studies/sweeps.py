@@ -45,7 +45,7 @@ from ipmc_asym.forward.model import CHECKS, FREE_STRIP_KEYS, MECHANICAL_KEYS, WI
 from ipmc_asym.integral.api import check_fidelity
 from ipmc_asym.io.fileio import atomic_write
 from ipmc_asym.io.textfmt import SHORTEST, format_table, shortest_text
-from ipmc_asym.model.params import NAFION_LI, Material, Strip
+from ipmc_asym.model.params import NAFION_LI, Material, Strip, check_voltages
 from ipmc_asym.model.permittivity import get_model
 
 __all__ = ["VARIABLES", "DTYPE", "LABELS", "CHECK_COLS", "SPREAD_COLS", "SPREAD_DTYPE", "parse_vary",
@@ -91,8 +91,10 @@ def _axes(vary: dict):
     for k, a in zip(vary, axes):
         if a.size == 0:
             raise ValueError(f"vary: {k} has no values")
-        if not np.all(np.isfinite(a)) or (k != "voltage" and np.any(a <= 0)):
-            raise ValueError(f"{k} must be finite and > 0" if k != "voltage" else "voltage must be finite")
+        if k == "voltage":
+            check_voltages(a)
+        elif not np.all(np.isfinite(a)) or np.any(a <= 0):
+            raise ValueError(f"{k} must be finite and > 0")
     return axes
 
 

@@ -126,3 +126,35 @@ def test_bvp_invariants(th, v, sgn, model):
     assert phi[0] == pytest.approx(sgn, abs=1e-8) and phi[-1] == pytest.approx(0.0, abs=1e-8)
     assert np.sign(b.I) == sgn
     assert abs(b.I - float(moment(th, sgn * v, model, "quadrature").I)) <= 1e-8 * abs(b.I)
+
+
+def test_every_static_entry_refuses_a_voltage_past_the_cap_and_is_finite_at_it():
+    # near the overflow of A2 (4e306 V) the static charge never returned (and ignored SIGTERM);
+    # the cap is one comparison in the compiled drivers, so every entry says the same line
+    import ipmc_asym as ia
+    from ipmc_asym.base.settings import MAX_VOLTAGE
+    from ipmc_asym.cli import main
+
+    past = [5e306, -2 * MAX_VOLTAGE]
+    calls = [lambda v: ia.moment_integral(200e-6, v), lambda v: ia.moment(200e-6, [1.0, v]),
+             lambda v: ia.charge(200e-6, v), lambda v: ia.charge(200e-6, v, fidelity="leading"),
+             lambda v: ia.sweep({"voltage": [1.0, v]}, "constant", "quadrature")]
+    for call in calls:
+        for v in past:
+            with pytest.raises(ValueError, match=r"voltage: \|phi0\| up to"):
+                call(v)
+    assert main(["charge", "--voltage", "5e306"]) == 2
+    # at the cap, both signs: finite charge and moment (the guard's claim); inside the library the
+    # compiled drivers evaluate up to twice the cap (a central difference at the cap steps past it)
+    from ipmc_asym.integral.api import _moment
+    from ipmc_asym.model.params import NAFION_LI
+    from ipmc_asym.model.permittivity import get_model
+
+    for v in (MAX_VOLTAGE, -MAX_VOLTAGE):
+        for m in MODELS:
+            c = ia.charge(200e-6, v, m)
+            assert np.isfinite(float(c.sigma)) and np.isfinite(float(c.C_diff)), (v, m)
+            assert np.isfinite(float(ia.moment_integral(200e-6, v, m, "exact", on_invalid="nan"))), (v, m)
+            for f in FAST + ("exact",):
+                r = _moment(np.array([200e-6]), np.array([2 * v]), get_model(m), f, NAFION_LI)
+                assert np.all(np.isfinite(r.I)) and np.all(np.isfinite(r.error)), (v, m, f)
