@@ -50,6 +50,12 @@ MAX_VOLTAGE = 1e3
 #: the same cap under its former name (time-domain drives)
 MAX_DRIVE_VOLTAGE = MAX_VOLTAGE
 
+#: the frequencies (Hz) a spectrum accepts: a numerical guard, not a physical limit (IPMCs are driven
+#: at 0.01-100 Hz).  At 1e-300 Hz or 1e300 Hz the closed forms overflow; every output of the three
+#: models, both methods and beams, with and without the electrode line, is finite on this range
+#: (tests/dynamics/test_circuit.py)
+FREQUENCY_RANGE = (1e-9, 1e12)
+
 #: relative rounding floor of the error estimate of corrected / quadrature (the two terms are
 #: assembled with cancellations; measured <= 2.3e-12 against the BVP on 1 um - 10 mm x 0.1 mV - 20 V)
 ROUNDING_ERROR = 1e-11

@@ -12,7 +12,7 @@ import os
 import re
 import sys
 
-from ipmc_asym.base.settings import MIN_THICKNESS
+from ipmc_asym.base.settings import FREQUENCY_RANGE, MIN_THICKNESS
 from ipmc_asym.base.units import (
     fmt_length,
     parse_diffusion,
@@ -638,11 +638,15 @@ sheet_resistance_type = arg_type(_sheet_conv, "--sheet-resistance")
 
 
 def frequency_type(name):
-    """A frequency > 0 (Hz, ``1kHz``)."""
+    """A frequency within ``settings.FREQUENCY_RANGE`` (Hz, ``1kHz``)."""
     def conv(text):
         v = parse_quantity(name, text, {"Hz": 1.0, "kHz": 1e3, "mHz": 1e-3, "MHz": 1e6}, "frequency")
+        lo, hi = FREQUENCY_RANGE
         if v <= 0:
-            raise ValueError(f"{name} must be > 0 Hz (e.g. 0.1Hz, 1kHz); got {text!r}")
+            raise ValueError(f"must be > 0 Hz (e.g. 0.1Hz, 1kHz); got {text!r}")  # argparse names the option
+        if not lo <= v <= hi:
+            raise ValueError(f"must be within {lo:g}..{hi:g} Hz (a numerical guard: the closed forms are checked "
+                             f"finite there); got {text!r}")
         return v
 
     return arg_type(conv, name)

@@ -34,6 +34,7 @@ Small signal about ``phi0 = 0``: the exact linearised PNP impedance and moment t
 
 from __future__ import annotations
 
+import functools
 import math
 import time
 from dataclasses import dataclass, field
@@ -43,7 +44,7 @@ import numpy as np
 from ipmc_asym.base.ladder import climb, escalation_note, rungs_from
 from ipmc_asym.base.registry import check_choice
 from ipmc_asym.base.results import Panel, ResultMixin, ResultSpec
-from ipmc_asym.base.settings import VALIDATED_VOLTAGE
+from ipmc_asym.base.settings import FREQUENCY_RANGE, VALIDATED_VOLTAGE
 from ipmc_asym.beam.dynamics import (
     CLAMPED_OUTPUTS,
     DEFAULT_MODES,
@@ -86,7 +87,8 @@ from ipmc_asym.model.permittivity import Permittivity, get_model
 
 __all__ = ["DYNAMIC_NOTES", "StepResult", "FrequencyResult", "core_resistance", "time_constant",
            "waveform", "step_response", "frequency_response", "circuit_response", "quasi_static_mechanics",
-           "circuit_impedance_error", "circuit_band", "quasi_static_forward", "check_support", "check_electrode",
+           "circuit_impedance_error", "circuit_band", "check_finite_response", "check_frequencies", "quiet_numerics",
+           "quasi_static_forward", "check_support", "check_electrode",
            "support_notes"]
 
 #: stated in every dynamic output
@@ -872,6 +874,44 @@ def step_response(voltage=1.0, duration=None, *, strip: Strip | None = None, mod
                       sigma_error=sig_err, current_error=cur_err, w_error=w_err)
 
 
+def check_frequencies(f):
+    """``f`` (Hz) as a float array, each within :data:`~ipmc_asym.base.settings.FREQUENCY_RANGE`, else a
+    one-line ``ValueError`` (NaN and inf too)."""
+    f = np.asarray(f, dtype=float)
+    lo, hi = FREQUENCY_RANGE
+    inside = (f >= lo) & (f <= hi)  # NaN fails too
+    if not np.all(inside):
+        raise ValueError(f"frequencies must be finite and within {lo:g}..{hi:g} Hz (a numerical guard: the closed "
+                         f"forms are checked finite there); got {np.min(f):g}..{np.max(f):g} Hz")
+    return f
+
+
+def quiet_numerics(fn):
+    """``fn`` run with NumPy's floating-point warnings off: its outputs are checked finite at its end
+    (:func:`check_finite_response`), which says in one line what did not hold, where the warnings
+    would print lines of NumPy's internals before it."""
+    @functools.wraps(fn)
+    def quiet(*args, **kwargs):
+        with np.errstate(all="ignore"):
+            return fn(*args, **kwargs)
+
+    return quiet
+
+
+def check_finite_response(f, outputs: dict) -> None:
+    """A numerical check of a spectrum: one line naming the first output that is not a finite number
+    and its frequency (a frequency, ``D`` or ``R_s`` so extreme that the closed forms overflow, or an
+    undamped resonance hit exactly), so that no such number is printed."""
+    f = np.asarray(f, dtype=float).reshape(-1)
+    for name, a in outputs.items():
+        bad = ~np.isfinite(np.asarray(a)).reshape(-1)
+        if np.any(bad):
+            k = int(np.flatnonzero(bad)[0])
+            raise ValueError(f"f: {name} is not a finite number at {f[k % f.size]:.4g} Hz (an undamped resonance "
+                             "hit exactly, or a frequency, diffusion coefficient or sheet resistance beyond what the "
+                             "closed forms hold); move or narrow the frequencies, or check those inputs")
+
+
 def circuit_impedance_error(f, thickness, perm: Permittivity, material: Material):
     """Relative error of the circuit's impedance against the linearised PNP, per frequency.
 
@@ -1036,6 +1076,7 @@ class FrequencyResult(ResultMixin):
     check_voltage: bool = True
 
 
+@quiet_numerics
 def frequency_response(f, *, strip: Strip | None = None, model="constant", material: Material | None = None,
                        method="pnp-linear", beam="quasi-static", viscous_modulus=0.0, n_modes=DEFAULT_MODES,
                        voltage=0.0, support=None, electrode=None,
@@ -1090,9 +1131,7 @@ def frequency_response(f, *, strip: Strip | None = None, model="constant", mater
     perm = get_model(model)
     if perm.is_custom:
         raise ValueError("frequency_response needs an affine permittivity (constant, linear, affine)")
-    f = np.asarray(f, dtype=float)
-    if not np.all(np.isfinite(f)) or np.any(f <= 0):
-        raise ValueError("frequencies must be finite and > 0 Hz")
+    f = check_frequencies(f)
     bias = check_drive_voltage("voltage (DC bias)", voltage)
     support = check_support(support)
     el = check_electrode(electrode, s.length)
@@ -1180,6 +1219,7 @@ def frequency_response(f, *, strip: Strip | None = None, model="constant", mater
         notes.append(f"circuit: relative error of Z and H_w against the linearised PNP (the reference) in 'error', "
                      f"~(f/(2 f_d))/|1 + i omega tau| below the dielectric relaxation frequency f_d = {f_d:.4g} Hz, at most "
                      f"lambda/2 = {0.5 * lam:.3g} at any frequency")
+    check_finite_response(f, {"Z": Za, "H_w": Hw, "H_theta": Htheta, "H_F": HF, **Hcc})
     return FrequencyResult(f=f, Z=Za / area, Z_area=Za, H_w=Hw, w_amp=np.abs(Hw), w_phase=np.angle(Hw), tau=tau,
                            method=method, model=perm.name, notes=notes, H_w_profiles=Hprof, error=err, f_d=f_d,
                            error_max=(math.nan if err is None else 0.5 * lam if bias == 0.0

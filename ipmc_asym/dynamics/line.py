@@ -44,7 +44,15 @@ import numpy as np
 from ipmc_asym.base.registry import check_choice
 from ipmc_asym.base.results import Panel, ResultMixin, ResultSpec
 from ipmc_asym.beam.dynamics import DEFAULT_MODES, distributed_transfer
-from ipmc_asym.dynamics.circuit import BEAM_CHOICES, FrequencyResult, dynamic_notes, frequency_response, strip_beam
+from ipmc_asym.dynamics.circuit import (
+    BEAM_CHOICES,
+    FrequencyResult,
+    check_finite_response,
+    dynamic_notes,
+    frequency_response,
+    quiet_numerics,
+    strip_beam,
+)
 from ipmc_asym.model import groups
 from ipmc_asym.model.params import NAFION_LI, SHEET_RESISTANCE_SOURCE, Material, Strip, bending_stiffness, check_finite
 
@@ -317,6 +325,7 @@ def _line(u, strip: Strip, material: Material, Rs, beam, viscous_modulus, n_mode
     return Z, cf["w"], cf["theta"], cp["F"], HM, g, be
 
 
+@quiet_numerics
 def line_response(f, *, strip: Strip | None = None, model="constant", material: Material | None = None,
                   sheet_resistance=None, method="pnp-linear", x=None, beam="quasi-static", viscous_modulus=0.0,
                   n_modes=DEFAULT_MODES, voltage=0.0) -> LineResult:
@@ -386,6 +395,7 @@ def line_response(f, *, strip: Strip | None = None, model="constant", material: 
         if xs.size * g.size > MAX_PROFILE_POINTS:
             raise ValueError(f"x: {xs.size} positions x {g.size} frequencies exceed {MAX_PROFILE_POINTS} profile values")
         prof = voltage_profile(g[:, None], xs[None, :] / L)
+    check_finite_response(u.f, {"Z": Z, "H_w": Hw, "H_theta": Hth, "H_F": HF})
     notes = dynamic_notes(beam, viscous_modulus, m) + list(u.notes[len(dynamic_notes(material=m)):]) + [
         f"electrodes: sheet resistance R_s = {Rs:g} Ohm/sq each, in series along the length (r = 2 R_s/(2l)); "
         "the voltage decays along x as an RC line driven at the clamp; the moment follows the local voltage "

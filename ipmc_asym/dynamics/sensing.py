@@ -44,7 +44,7 @@ import numpy as np
 
 from ipmc_asym.base.registry import check_choice
 from ipmc_asym.base.results import Panel, ResultMixin, ResultSpec
-from ipmc_asym.dynamics.circuit import FREQ_METHODS, circuit_impedance_error, frequency_response
+from ipmc_asym.dynamics.circuit import FREQ_METHODS, check_frequencies, circuit_impedance_error, frequency_response
 from ipmc_asym.forward.sensing import DEFAULT_NU, SENSE_SUPPORTS, tip_curvature
 from ipmc_asym.integral.sensing import B_LIMIT, strain_parameter
 from ipmc_asym.model import groups
@@ -228,9 +228,7 @@ def sensing_response(f, strip: Strip | None = None, *, model="constant", materia
     w0 = check_finite("amplitude", amplitude, "a finite tip displacement in m, > 0")
     if w0 <= 0.0:
         raise ValueError(f"amplitude must be a finite tip displacement > 0 m; got {amplitude!r}")
-    f = np.asarray(f, dtype=float).reshape(-1)
-    if not np.all(np.isfinite(f)) or np.any(f <= 0):
-        raise ValueError("frequencies must be finite and > 0 Hz")
+    f = check_frequencies(f).reshape(-1)
     L, e = s.length, s.e
     # the amplitude's curvature at the clamp and its checks (the static sense's flags)
     k0 = float(tip_curvature(w0, L, support))

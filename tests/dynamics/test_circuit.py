@@ -174,3 +174,34 @@ def test_the_substep_refusal_states_the_longest_chunk_where_it_is(h_max):
     assert grid[idx[-1]] * tau == pytest.approx(0.99 * span)
     with pytest.raises(ValueError, match="use fewer time constants"):
         substep_grid(np.array([0.0, 1.01 * span]), tau, h_max, 2, ("the reduced model's", "use fewer time constants"))
+
+
+def test_the_frequency_range_ends_are_the_exact_theory_and_beyond_them_one_line():
+    # settings.FREQUENCY_RANGE: the closed forms hold at its ends (against the independent exact
+    # impedance above), every output finite for each model, method and beam, with the electrode line too;
+    # past them, and where an extreme D makes them overflow, one line (no NumPy warning before it)
+    import warnings
+
+    from ipmc_asym.base.settings import FREQUENCY_RANGE
+    from ipmc_asym.dynamics.line import line_response
+
+    f = np.array(FREQUENCY_RANGE)
+    s = Strip()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        for m in MODELS:
+            ref, _ = _exact_z_area(f, s, m)
+            r = frequency_response(f, strip=s, model=m)
+            assert np.allclose(r.Z_area, ref, rtol=1e-9, atol=0.0), m
+            for method in ("pnp-linear", "circuit"):
+                for beam in ("quasi-static", "dynamic"):
+                    for res in (frequency_response(f, model=m, method=method, beam=beam),
+                                line_response(f, model=m, method=method, beam=beam, sheet_resistance=2.5)):
+                        assert all(np.all(np.isfinite(x)) for x in (res.Z, res.H_w, res.H_theta, res.H_F)), (m, method)
+        for bad in ([0.5 * f[0]], [2.0 * f[1]], [np.nan]):
+            with pytest.raises(ValueError, match=r"^frequencies must be finite and within") as ei:
+                frequency_response(bad)
+            assert "\n" not in str(ei.value)
+        for D in (1e308, 1e-320):
+            with pytest.raises(ValueError, match=r"^f: Z is not a finite number at 1 Hz"):
+                frequency_response([1.0], material=NAFION_LI.with_(D=D))
