@@ -34,6 +34,12 @@ BVP_MAX_NODES_FIRST = 30_000
 #: same continuum equations) describes it; every command refuses at once (docs/design.md)
 MIN_THICKNESS = 100e-9
 
+#: largest length, TOTAL width and TOTAL thickness (m) of a strip: a numerical guard, not a physical
+#: limit (IPMC strips are centimetres long; a bare `--thickness 200`, 200 m, still runs with its
+#: plausibility warning).  At 1e308 m the charge Q = sigma 2l L and the bending stiffness overflow to
+#: inf; 1 km keeps every product finite
+MAX_DIMENSION = 1e3
+
 #: largest |voltage| (V) the toolkit is validated on (1e-4 - 20 V against the BVP).  The model
 #: has blocking electrodes and no electrode reactions, while water electrolyses above ~1.23 V
 #: (IPMCs are driven at a few volts): above this voltage every result carries a warning

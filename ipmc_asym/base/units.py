@@ -131,6 +131,10 @@ def _parse_value(name, text):
     return parse_pressure(name, text)
 
 
+#: most values of one sweep axis (800 MB of float64)
+MAX_AXIS_POINTS = 10**8
+
+
 def parse_vary_spec(spec: str):
     """``'length=1cm:4cm:16'`` -> ``(name, start, stop, n, log)`` without building the values
     (so that a huge ``n`` can be refused before any memory is used)."""
@@ -155,6 +159,9 @@ def parse_vary_spec(spec: str):
         raise ValueError(f"--vary {name}: N must be an integer >= 1 (e.g. 16 or 1e6); got {parts[2]!r}") from None
     if not math.isfinite(nf) or not nf.is_integer() or nf < 1:
         raise ValueError(f"--vary {name}: N must be an integer >= 1 (e.g. 16 or 1e6); got {parts[2]!r}")
+    if nf > MAX_AXIS_POINTS:  # each axis' values are held in memory (8 bytes each), whatever --max-rows says
+        raise ValueError(f"--vary {name}: N must be at most {MAX_AXIS_POINTS:g} (an axis' values are held in memory); "
+                         f"got {parts[2]!r}")
     if log and (a <= 0 or b <= 0):
         raise ValueError(f"--vary {name}: log spacing needs START, STOP > 0")
     if name != "voltage" and (a <= 0 or b <= 0):

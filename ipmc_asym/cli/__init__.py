@@ -189,6 +189,10 @@ def _run(argv, only, plugins, usage_error) -> int:
         msg = str(exc).splitlines()[0] if str(exc) else exc.__class__.__name__
         sys.stderr.write(f"ipmc-asym {command}: error: {msg}\n")
         return 2
+    except MemoryError as exc:  # sizes within their caps that this machine still cannot hold
+        why = str(exc).splitlines()[0] if str(exc) else "no detail"
+        sys.stderr.write(f"ipmc-asym {command}: error: out of memory ({why}); lower the sizes asked for\n")
+        return 2
     except RuntimeError as exc:  # a solver failure the library could not turn into a refusal
         sys.stderr.write(f"ipmc-asym {command}: error: {str(exc).splitlines()[0]}\n")
         return 2

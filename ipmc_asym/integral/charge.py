@@ -44,7 +44,7 @@ from ipmc_asym.base.units import parse_length, parse_voltage
 from ipmc_asym.integral.api import as_numbers, check_fidelity, check_min_thickness, paper_model_id, run_parallel
 from ipmc_asym.kernels.charge import GL_W, GL_X, closed_sweep, exact_sweep, near_sweep
 from ipmc_asym.model import groups
-from ipmc_asym.model.params import NAFION_LI, Material, Strip, check_positive, check_voltages
+from ipmc_asym.model.params import NAFION_LI, Material, Strip, check_dimension, check_voltages
 from ipmc_asym.model.permittivity import Permittivity, get_model
 
 __all__ = ["ChargeResult", "charge", "charge_escalated", "charge_inputs", "charge_at", "charge_scale", "capacitance_scale", "SUBNORMAL"]
@@ -132,8 +132,8 @@ def charge_inputs(thickness, voltage, model="constant", width=5.0e-3, length=0.0
     voltage, perm, width, length, material)``, thickness and voltage broadcast arrays."""
     perm = get_model(model)
     mat = NAFION_LI if material is None else material
-    w = check_positive("width (total, 2l)", width, "m")
-    L = check_positive("length", length, "m")
+    w = check_dimension("width (total, 2l)", width)
+    L = check_dimension("length", length)
     # numbers, arrays or the units people write ("200um", "1V"), as moment_integral takes them
     th = np.asarray(as_numbers("thickness (total, 2e)", thickness, parse_length), dtype=float)
     v = np.asarray(as_numbers("voltage", voltage, parse_voltage), dtype=float)

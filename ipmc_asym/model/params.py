@@ -29,7 +29,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ipmc_asym.base.settings import MAX_VOLTAGE, MIN_THICKNESS, STRAIN_LIMIT, VALIDATED_VOLTAGE
+from ipmc_asym.base.settings import MAX_DIMENSION, MAX_VOLTAGE, MIN_THICKNESS, STRAIN_LIMIT, VALIDATED_VOLTAGE
 from ipmc_asym.base.units import parse_length, parse_pressure, parse_voltage
 from ipmc_asym.model import material_data
 from ipmc_asym.model.electrode import NO_ELECTRODE, Electrode, composite_stiffness, electrode_from_spec
@@ -56,6 +56,7 @@ __all__ = [
     "check_positive",
     "check_finite",
     "check_min_thickness",
+    "check_dimension",
     "check_voltage_cap",
     "check_voltages",
     "make_groups",
@@ -125,6 +126,16 @@ def check_finite(name: str, value, allowed: str = "a finite number") -> float:
         raise ValueError(f"{name} must be {allowed}; got {value!r}") from None
     if not math.isfinite(v):
         raise ValueError(f"{name} must be {allowed}; got {value!r}")
+    return v
+
+
+def check_dimension(name: str, value) -> float:
+    """``value`` (m) as a float, finite, > 0 and at most :data:`ipmc_asym.base.settings.MAX_DIMENSION`,
+    else a one-line ``ValueError`` naming ``name``."""
+    v = check_positive(name, value, "m")
+    if v > MAX_DIMENSION:
+        raise ValueError(f"{name} must be at most {MAX_DIMENSION:g} m (a numerical guard: products such as the "
+                         f"charge 2l L sigma and the bending stiffness stay finite); got {value!r}")
     return v
 
 
@@ -473,9 +484,9 @@ class Strip:
                             ("voltage", parse_voltage)):
             if isinstance(getattr(self, name), str):
                 object.__setattr__(self, name, parse(name, getattr(self, name)))
-        check_positive("length", self.length, "m")
-        check_positive("width (total, 2l)", self.width, "m")
-        check_positive("thickness (total, 2e)", self.thickness, "m")
+        check_dimension("length", self.length)
+        check_dimension("width (total, 2l)", self.width)
+        check_dimension("thickness (total, 2e)", self.thickness)
         check_min_thickness(self.thickness)  # a Strip is checked once, here: its users trust it
         check_voltage_cap(check_finite("voltage", self.voltage, "a finite number of volts"))
 

@@ -24,3 +24,20 @@ def test_check_voltages_says_which_of_not_finite_and_past_the_cap():
         check_voltages(np.inf, "bias")  # inf is not finite, though also past the cap
     with pytest.raises(ValueError, match=r"bias: \|phi0\| up to"):
         check_voltages([1.0, -1.5 * MAX_VOLTAGE], "bias")
+
+
+def test_a_strip_refuses_a_dimension_past_the_cap_in_one_line_naming_it():
+    import ipmc_asym as ia
+    from ipmc_asym.base.settings import MAX_DIMENSION
+
+    for name, kw in (("length", {"length": 1e308}), ("width", {"width": 2 * MAX_DIMENSION}),
+                     ("thickness", {"thickness": 1e308})):
+        with pytest.raises(ValueError, match=rf"^{name}.* must be at most 1000 m") as ei:
+            Strip(**kw)
+        assert "\n" not in str(ei.value)
+    with pytest.raises(ValueError, match=r"^width \(total, 2l\) must be at most"):
+        ia.charge(200e-6, 1.0, width=1e308)  # Q = 2l L sigma was inf
+    # at the cap the products stay finite
+    Strip(length=MAX_DIMENSION, width=MAX_DIMENSION, thickness=MAX_DIMENSION)
+    c = ia.charge(200e-6, 1.0, width=MAX_DIMENSION, length=MAX_DIMENSION)
+    assert np.isfinite(float(c.Q)) and float(c.Q) > 0
