@@ -1097,7 +1097,7 @@ def frequency_response(f, *, strip: Strip | None = None, model="constant", mater
         (:func:`circuit_impedance_error`; at most ``lambda/2``).
     beam : {"quasi-static", "dynamic"}
         ``dynamic``: the strip's inertia and Kelvin-Voigt damping (resonances;
-        :func:`ipmc_asym.beam.dynamics.transfer`; the default of ``ipmc-asym freq``);
+        :func:`ipmc_asym.beam.dynamics.transfer`; asked for, as by ``ipmc-asym freq --beam dynamic``);
         ``quasi-static`` (default): the beam follows the moment.
     viscous_modulus : float
         ``eta_E`` (Pa s), default 0.
