@@ -216,7 +216,7 @@ def run(args):
                  if clamped else ""))
     pm = f" {'+-':>9s}" if stated else ""  # the stated errors beside their values
     print(f"{'t [s]':>11s} {'phi0 [V]':>9s} {'sigma [C/m^2]':>14s}{pm} {'J [A/m^2]':>11s}{pm} {'M_A [N m]':>11s} "
-          f"{'theta':>9s} {'w [mm]':>9s}{pm} {'F_block [mN]':>12s}")
+          f"{'th. [rad]':>9s} {'w [mm]':>9s}{pm} {'F_block [mN]':>12s}")
 
     def num(x, scale, spec):  # undefined or not stated: n/a, never a bare nan
         return f"{x * scale:{spec}}" if np.isfinite(x) else f"{'n/a':>{spec.split('.')[0]}s}"
@@ -232,6 +232,9 @@ def run(args):
               f"{num(r['theta'], 1.0, '9.4g')} {num(r['w'], 1e3, '9.4g')}{e['w_error']} {num(r['F_block'], 1e3, '12.4g')}")
     if clamped:
         print_clamped("t [s]", [r["t"] for r in shown], {c: [r[c] for r in shown] for c in CLAMPED_COLUMNS})
+    if len(shown) < args.points:  # the table is a sample of the rows computed
+        print(f"rows: {len(shown)} of the {args.points} output times shown, equally spaced; --out F.csv or --json "
+              "gives every row")
     for n in info["notes"]:
         print(f"note: {n}")
     return 0
