@@ -11,6 +11,7 @@ Matplotlib ``Figure`` (no pyplot state, no backend selected).
 
 from __future__ import annotations
 
+import textwrap
 from typing import NamedTuple
 
 import numpy as np
@@ -252,14 +253,17 @@ class ResultMixin:
                 x = arrays[panel.x]
             x = np.asarray(x).reshape(-1)
             cplx = any(arrays[y].dtype.kind == "c" for y in present)
-            for y in present:
+            for k, y in enumerate(present):
                 v = np.asarray(arrays[y])
                 v = (np.abs(v) if v.dtype.kind == "c" else v).astype(float).reshape(x.size, -1)
                 if panel.ylog:
                     v = np.abs(v)
-                ax.plot(x, v, marker="." if x.size < 30 else None, label=units_of(y)[1])
+                # a style per quantity: the lines of a panel told apart in grayscale too
+                ax.plot(x, v, linestyle=("-", "--", ":", "-.")[k % 4], marker="." if x.size < 30 else None,
+                        label=units_of(y)[1])
             ax.set_xlabel(label(panel.x))
-            ax.set_ylabel(label(present[0], magnitude=cplx) if present else "")
+            # wrapped: a long name on one line runs past a panel's height into its neighbours
+            ax.set_ylabel(textwrap.fill(label(present[0], magnitude=cplx), 32) if present else "")
             if panel.xlog:
                 ax.set_xscale("log")
             if panel.ylog:
