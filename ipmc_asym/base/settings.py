@@ -39,6 +39,9 @@ MIN_THICKNESS = 100e-9
 #: plausibility warning).  At 1e308 m the charge Q = sigma 2l L and the bending stiffness overflow to
 #: inf; 1 km keeps every product finite
 MAX_DIMENSION = 1e3
+#: smallest length and TOTAL width (m) of a strip, as a numerical guard (the thickness has its own floor,
+#: MIN_THICKNESS): a subnormal length divided the beam's formulas by zero
+MIN_DIMENSION = 1e-9
 
 #: largest |voltage| (V) the toolkit is validated on (1e-4 - 20 V against the BVP).  The model
 #: has blocking electrodes and no electrode reactions, while water electrolyses above ~1.23 V

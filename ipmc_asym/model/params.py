@@ -29,7 +29,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ipmc_asym.base.settings import MAX_DIMENSION, MAX_VOLTAGE, MIN_THICKNESS, STRAIN_LIMIT, VALIDATED_VOLTAGE
+from ipmc_asym.base.settings import MAX_DIMENSION, MAX_VOLTAGE, MIN_DIMENSION, MIN_THICKNESS, STRAIN_LIMIT, VALIDATED_VOLTAGE
 from ipmc_asym.base.units import parse_length, parse_pressure, parse_voltage
 from ipmc_asym.model import material_data
 from ipmc_asym.model.electrode import NO_ELECTRODE, Electrode, composite_stiffness, electrode_from_spec
@@ -129,13 +129,17 @@ def check_finite(name: str, value, allowed: str = "a finite number") -> float:
     return v
 
 
-def check_dimension(name: str, value) -> float:
-    """``value`` (m) as a float, finite, > 0 and at most :data:`ipmc_asym.base.settings.MAX_DIMENSION`,
-    else a one-line ``ValueError`` naming ``name``."""
+def check_dimension(name: str, value, floor: bool = True) -> float:
+    """``value`` (m) as a float, finite, within :data:`ipmc_asym.base.settings.MIN_DIMENSION` ..
+    :data:`ipmc_asym.base.settings.MAX_DIMENSION`, else a one-line ``ValueError`` naming ``name``
+    (``floor=False``: no MIN_DIMENSION, where a stricter floor of its own follows, the thickness's)."""
     v = check_positive(name, value, "m")
     if v > MAX_DIMENSION:
         raise ValueError(f"{name} must be at most {MAX_DIMENSION:g} m (a numerical guard: products such as the "
                          f"charge 2l L sigma and the bending stiffness stay finite); got {value!r}")
+    if floor and v < MIN_DIMENSION:
+        raise ValueError(f"{name} must be at least {MIN_DIMENSION:g} m (a numerical guard: the beam's formulas divide "
+                         f"by it); got {value!r}")
     return v
 
 
@@ -486,7 +490,7 @@ class Strip:
                 object.__setattr__(self, name, parse(name, getattr(self, name)))
         check_dimension("length", self.length)
         check_dimension("width (total, 2l)", self.width)
-        check_dimension("thickness (total, 2e)", self.thickness)
+        check_dimension("thickness (total, 2e)", self.thickness, floor=False)
         check_min_thickness(self.thickness)  # a Strip is checked once, here: its users trust it
         check_voltage_cap(check_finite("voltage", self.voltage, "a finite number of volts"))
 

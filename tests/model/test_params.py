@@ -41,3 +41,12 @@ def test_a_strip_refuses_a_dimension_past_the_cap_in_one_line_naming_it():
     Strip(length=MAX_DIMENSION, width=MAX_DIMENSION, thickness=MAX_DIMENSION)
     c = ia.charge(200e-6, 1.0, width=MAX_DIMENSION, length=MAX_DIMENSION)
     assert np.isfinite(float(c.Q)) and float(c.Q) > 0
+
+
+def test_a_strip_refuses_a_subnormal_length_or_width_by_name():
+    # a subnormal length divided the beam's formulas by zero ("float division by zero" from sense)
+    for name, kw in (("length", {"length": 1e-320}), ("width", {"width": 5e-324})):
+        with pytest.raises(ValueError, match=rf"^{name}.* must be at least 1e-09 m"):
+            Strip(**kw)
+    with pytest.raises(ValueError, match="MIN_THICKNESS"):  # the thickness keeps its own, stricter floor
+        Strip(thickness=1e-320)
