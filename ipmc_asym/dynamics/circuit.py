@@ -88,7 +88,7 @@ from ipmc_asym.model.permittivity import Permittivity, get_model
 __all__ = ["DYNAMIC_NOTES", "StepResult", "FrequencyResult", "core_resistance", "time_constant",
            "waveform", "step_response", "frequency_response", "circuit_response", "quasi_static_mechanics",
            "circuit_impedance_error", "circuit_band", "check_finite_response", "check_frequencies", "quiet_numerics",
-           "quasi_static_forward", "check_support", "check_electrode",
+           "layer_rates", "quasi_static_forward", "check_support", "check_electrode",
            "support_notes"]
 
 #: stated in every dynamic output
@@ -578,18 +578,26 @@ class CircuitStepper:
         """
         t = np.asarray(t, dtype=float)
         A = np.asarray(u, dtype=float) / self.VT
-        ps = self.fun(t) / self.VT
-        cx = np.empty(A.size)
-        cd_hat_many(np.ascontiguousarray(A).reshape(-1), self.rho, self.mid, GL_X, GL_W, cx)
-        cx = cx.reshape(A.shape)
-        sdot = (ps - A) / (2.0 * self.tau)
-        # dA/dt = (psi0 - A)/(2 s'(A)) per tau: the layers relax on 2 s'(A) tau; below the largest
-        # substep (5e-3 tau, substep_grid) that relaxation is not resolved -- the L-stable BDF2 settles
-        # A on psi0 within a substep and psi0 - A is the Newton residual -- so the rate is taken over
-        # the substep there (a saturated linear-model layer has s' ~ e^{-A}: 1e-34 at 2 V)
-        Adot = (ps - A) / (2.0 * np.maximum(cx, 2.5e-3) * self.tau)
+        # the largest substep is 5e-3 tau (substep_grid)
+        sdot, Adot = layer_rates(A, self.fun(t) / self.VT, self.rho, self.mid, self.tau, 5e-3)
         dphi = voltage_rate(self.fun, t, 1e-3 * self.tau)
         return self.S * sdot + self.Cg * (dphi - self.VT * Adot)
+
+
+def layer_rates(A, psi, rho, mid, tau, h_max):
+    """``(ds/dt, dA/dt)`` (1/s) of layers at ``A`` charging towards ``psi`` (both in R T/F, any shape):
+    the charging law ``ds/dt = (psi - A)/(2 tau)`` and ``dA/dt = (ds/dt)/s'(A)``, ``s'`` the layers'
+    differential capacitance (``model_id`` ``mid``, ``rho`` as the kernels).
+
+    The layers relax on ``2 s'(A) tau``; below the largest substep ``h_max`` (in tau) that relaxation
+    is not resolved -- the L-stable BDF2 settles ``A`` on ``psi`` within a substep and ``psi - A`` is
+    the Newton residual -- so the rate is taken over half the substep there (a saturated
+    linear-model layer has ``s' ~ e^{-A}``: 1e-34 at 2 V).
+    """
+    cx = np.empty(A.size)
+    cd_hat_many(np.ascontiguousarray(A).reshape(-1), rho, mid, GL_X, GL_W, cx)
+    sdot = (psi - A) / (2.0 * tau)
+    return sdot, (psi - A) / (2.0 * np.maximum(cx.reshape(A.shape), 0.5 * h_max) * tau)
 
 
 #: The most fixed substeps :func:`substep_grid` lays in one chunk (the grid and the stepper's

@@ -230,7 +230,7 @@ def drive_chunks(wave, duration, points, *, strip: Strip | None = None, model="c
         # the line's node moments drive the modes (both ladders: the coarse one for the error of w)
         ldyn = (LineBeamDynamics(s, m, viscous_modulus, n_modes, line.x),
                 LineBeamDynamics(s, m, viscous_modulus, n_modes, line.x_coarse))
-    stepper = line if line is not None else CircuitStepper(fun, s, perm, m)
+    stepper = CircuitStepper(fun, s, perm, m) if line is None else None
     lcols = LINE_COLUMNS if line is not None else ()
     if line is not None:
         # the forward model runs on every node of both ladders: keep its arrays at ~2e5 points a chunk

@@ -33,12 +33,12 @@ import numpy as np
 from scipy.linalg import solve_banded
 
 from ipmc_asym.beam.dynamics import _propagate, mode_shape, modes, moment_kernels, natural_frequencies
-from ipmc_asym.dynamics.circuit import drive_times, strip_beam, substep_grid
+from ipmc_asym.dynamics.circuit import drive_times, layer_rates, strip_beam, substep_grid
 from ipmc_asym.dynamics.electrode import charge_scale, core_resistance, time_constant
 from ipmc_asym.dynamics.waveforms import voltage_rate
 from ipmc_asym.integral.api import paper_model_id
 from ipmc_asym.kernels.charge import GL_W, GL_X
-from ipmc_asym.kernels.charge_time import cd_hat_many, integrate_line
+from ipmc_asym.kernels.charge_time import integrate_line
 from ipmc_asym.model import groups
 from ipmc_asym.model.params import Material, Strip, check_finite
 from ipmc_asym.model.permittivity import Permittivity
@@ -101,9 +101,8 @@ class LineStepper:
     uncharged) returns a dict of arrays over the output times: ``u`` and ``v`` (V, shape (n, N+1):
     layer and node voltages of the reported ``2 N``-segment line at its nodes :attr:`x`),
     ``sigma`` (C/m^2, shape (n, N+1): layers plus the bulk's displacement charge per node),
-    ``sigma_mean`` (C/m^2: the electrode's charge over its area), ``ub_mean`` (V: area mean of the
-    core voltage ``v - u``), ``u_w`` (V: the layer voltage weighted by ``2 (L - x)/L^2``, the
-    deflection's weight) and the Richardson estimates ``sigma_error``, ``u_w_error`` (same units,
+    ``sigma_mean`` (C/m^2: the electrode's charge over its area), ``u_w`` (V: the layer voltage
+    weighted by ``2 (L - x)/L^2``, the deflection's weight) and the Richardson estimates ``sigma_error``, ``u_w_error`` (same units,
     ``ERROR_FACTOR |y_2N - y_N|``) of the reported line's discretisation error; ``u_coarse`` and
     ``sigma_coarse``: the same of the ``N``-segment line (nodes :attr:`x_coarse`).
 
@@ -184,11 +183,11 @@ class LineStepper:
                 P[jump] = _node_voltages(lad, A[jump], ps_t[jump])
             u, v = self.VT * A, self.VT * P
             sig = self.S * s + self.Cg * (v - u)
-            out[name] = (u, v, sig, sig @ lad.w / L, (v - u) @ lad.w / L, u @ self._ww[id(lad)])
+            out[name] = (u, v, sig, sig @ lad.w / L, u @ self._ww[id(lad)])
         self.t_last = float(t[-1])
-        u, v, sig, sm, ub, uw = out["fine"]
-        _, _, _, sm2, _, uw2 = out["coarse"]
-        return {"u": u, "v": v, "sigma": sig, "sigma_mean": sm, "ub_mean": ub, "u_w": uw,
+        u, v, sig, sm, uw = out["fine"]
+        _, _, _, sm2, uw2 = out["coarse"]
+        return {"u": u, "v": v, "sigma": sig, "sigma_mean": sm, "u_w": uw,
                 "sigma_error": ERROR_FACTOR * np.abs(sm - sm2), "u_w_error": ERROR_FACTOR * np.abs(uw - uw2),
                 "u_coarse": out["coarse"][0], "sigma_coarse": sm2}
 
@@ -205,14 +204,7 @@ class LineStepper:
         """
         lad = self.fine
         A = np.asarray(u, dtype=float) / self.VT
-        P = np.asarray(v, dtype=float) / self.VT
-        cx = np.empty(A.size)
-        cd_hat_many(np.ascontiguousarray(A).reshape(-1), self.rho, self.mid, GL_X, GL_W, cx)
-        cx = cx.reshape(A.shape)
-        sdot = (P - A) / (2.0 * self.tau)
-        # below the largest substep the layers' relaxation on 2 s'(A) tau is not resolved (the BDF2
-        # settles A on psi within a substep, psi - A its Newton residual): the rate over half a substep
-        Adot = (P - A) / (2.0 * np.maximum(cx, 0.5 * self.h_max) * self.tau)
+        sdot, Adot = layer_rates(A, np.asarray(v, dtype=float) / self.VT, self.rho, self.mid, self.tau, self.h_max)
         dps = voltage_rate(self.fun, np.asarray(t, dtype=float), 1e-3 * self.tau) / self.VT
         Pdot = _node_voltages(lad, Adot, dps)
         Jn = self.S * sdot + self.Cg * self.VT * (Pdot - Adot)
