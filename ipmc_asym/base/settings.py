@@ -40,7 +40,7 @@ MIN_THICKNESS = 100e-9
 #: inf; 1 km keeps every product finite
 MAX_DIMENSION = 1e3
 #: smallest length and TOTAL width (m) of a strip, as a numerical guard (the thickness has its own floor,
-#: MIN_THICKNESS): a subnormal length divided the beam's formulas by zero
+#: MIN_THICKNESS): a subnormal length divides the beam's formulas by zero
 MIN_DIMENSION = 1e-9
 
 #: largest |voltage| (V) the toolkit is validated on (1e-4 - 20 V against the BVP).  The model
@@ -52,11 +52,11 @@ VALIDATED_VOLTAGE = 20.0
 #: integral, the charge and a sweep; a time-domain drive): a numerical guard, not a physical
 #: limit.  The charge kernels' closed forms lose finite values somewhere above ~1e100 V (measured:
 #: NaN charge at a 1e200 V step), and near the overflow of A2 = F |phi0|/(R T) (~4e306 V) the
-#: static charge did not return at all; 50x the validated range is far past any use and keeps
+#: static charge's kernels do not return at all; 50x the validated range is far past any use and keeps
 #: every output finite (tests/dynamics/test_waveforms.py, tests/integration/test_extremes.py); beyond
 #: VALIDATED_VOLTAGE results still carry the warning
 MAX_VOLTAGE = 1e3
-#: the same cap under its former name (time-domain drives)
+#: the same cap, as the time-domain drives name it
 MAX_DRIVE_VOLTAGE = MAX_VOLTAGE
 
 #: the frequencies (Hz) a spectrum accepts: a numerical guard, not a physical limit (IPMCs are driven

@@ -129,7 +129,7 @@ def test_bvp_invariants(th, v, sgn, model):
 
 
 def test_every_static_entry_refuses_a_voltage_past_the_cap_and_is_finite_at_it():
-    # near the overflow of A2 (4e306 V) the static charge never returned (and ignored SIGTERM);
+    # near the overflow of A2 (4e306 V) the static charge's kernels do not return (nor heed SIGTERM);
     # the cap is one comparison in the compiled drivers, so every entry says the same line
     import ipmc_asym as ia
     from ipmc_asym.base.settings import MAX_VOLTAGE

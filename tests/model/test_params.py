@@ -36,7 +36,7 @@ def test_a_strip_refuses_a_dimension_past_the_cap_in_one_line_naming_it():
             Strip(**kw)
         assert "\n" not in str(ei.value)
     with pytest.raises(ValueError, match=r"^width \(total, 2l\) must be at most"):
-        ia.charge(200e-6, 1.0, width=1e308)  # Q = 2l L sigma was inf
+        ia.charge(200e-6, 1.0, width=1e308)  # Q = 2l L sigma would be inf
     # at the cap the products stay finite
     Strip(length=MAX_DIMENSION, width=MAX_DIMENSION, thickness=MAX_DIMENSION)
     c = ia.charge(200e-6, 1.0, width=MAX_DIMENSION, length=MAX_DIMENSION)
@@ -44,7 +44,7 @@ def test_a_strip_refuses_a_dimension_past_the_cap_in_one_line_naming_it():
 
 
 def test_a_strip_refuses_a_subnormal_length_or_width_by_name():
-    # a subnormal length divided the beam's formulas by zero ("float division by zero" from sense)
+    # a subnormal length divides the beam's formulas by zero ("float division by zero" in sense)
     for name, kw in (("length", {"length": 1e-320}), ("width", {"width": 5e-324})):
         with pytest.raises(ValueError, match=rf"^{name}.* must be at least 1e-09 m"):
             Strip(**kw)
