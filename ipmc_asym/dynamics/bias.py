@@ -53,7 +53,7 @@ from ipmc_asym.kernels._generated_charge import (
     linear_static_induction,
 )
 from ipmc_asym.model import groups
-from ipmc_asym.model.params import NAFION_LI, Material, Strip, check_finite
+from ipmc_asym.model.params import NAFION_LI, Material, Strip, check_finite, check_frequencies
 from ipmc_asym.model.permittivity import Permittivity, get_model
 
 __all__ = ["BiasReference", "bias_reference", "BIAS_REFERENCE_CEILING"]
@@ -312,9 +312,7 @@ def bias_reference(f, voltage, strip: Strip | None = None, model="constant",
     if perm.is_custom:
         raise ValueError("bias_reference needs an affine permittivity (constant, linear, affine)")
     V = check_finite("voltage (DC bias)", voltage, "a finite number of volts")
-    f = np.atleast_1d(np.asarray(f, dtype=float))
-    if not np.all(np.isfinite(f)) or np.any(f <= 0):
-        raise ValueError("frequencies must be finite and > 0 Hz")
+    f = np.atleast_1d(check_frequencies(f))
     # the floor of the static solver (below it C - 1 ~ A2 is lost to rounding), with a margin so
     # that the floor itself is solved
     v_floor = (1.0 + 1e-9) * min_voltage(m)

@@ -44,7 +44,7 @@ import numpy as np
 from ipmc_asym.base.ladder import climb, escalation_note, rungs_from
 from ipmc_asym.base.registry import check_choice
 from ipmc_asym.base.results import Panel, ResultMixin, ResultSpec
-from ipmc_asym.base.settings import FREQUENCY_RANGE, VALIDATED_VOLTAGE
+from ipmc_asym.base.settings import VALIDATED_VOLTAGE
 from ipmc_asym.beam.dynamics import (
     CLAMPED_OUTPUTS,
     DEFAULT_MODES,
@@ -81,13 +81,15 @@ from ipmc_asym.model.params import (
     Strip,
     bending_stiffness,
     check_finite,
+    check_finite_response,
+    check_frequencies,
     check_positive,
 )
 from ipmc_asym.model.permittivity import Permittivity, get_model
 
 __all__ = ["DYNAMIC_NOTES", "StepResult", "FrequencyResult", "core_resistance", "time_constant",
            "waveform", "step_response", "frequency_response", "circuit_response", "quasi_static_mechanics",
-           "circuit_impedance_error", "circuit_band", "check_finite_response", "check_frequencies", "quiet_numerics",
+           "circuit_impedance_error", "circuit_band", "quiet_numerics",
            "layer_rates", "quasi_static_forward", "check_support", "check_electrode",
            "support_notes"]
 
@@ -882,21 +884,9 @@ def step_response(voltage=1.0, duration=None, *, strip: Strip | None = None, mod
                       sigma_error=sig_err, current_error=cur_err, w_error=w_err)
 
 
-def check_frequencies(f):
-    """``f`` (Hz) as a float array, each within :data:`~ipmc_asym.base.settings.FREQUENCY_RANGE`, else a
-    one-line ``ValueError`` (NaN and inf too)."""
-    f = np.asarray(f, dtype=float)
-    lo, hi = FREQUENCY_RANGE
-    inside = (f >= lo) & (f <= hi)  # NaN fails too
-    if not np.all(inside):
-        raise ValueError(f"frequencies must be finite and within {lo:g}..{hi:g} Hz (a numerical guard: the closed "
-                         f"forms are checked finite there); got {np.min(f):g}..{np.max(f):g} Hz")
-    return f
-
-
 def quiet_numerics(fn):
     """``fn`` run with NumPy's floating-point warnings off: its outputs are checked finite at its end
-    (:func:`check_finite_response`), which says in one line what did not hold, where the warnings
+    (:func:`~ipmc_asym.model.params.check_finite_response`), which says in one line what did not hold, where the warnings
     would print lines of NumPy's internals before it."""
     @functools.wraps(fn)
     def quiet(*args, **kwargs):
@@ -904,20 +894,6 @@ def quiet_numerics(fn):
             return fn(*args, **kwargs)
 
     return quiet
-
-
-def check_finite_response(f, outputs: dict) -> None:
-    """A numerical check of a spectrum: one line naming the first output that is not a finite number
-    and its frequency (a frequency, ``D`` or ``R_s`` so extreme that the closed forms overflow, or an
-    undamped resonance hit exactly), so that no such number is printed."""
-    f = np.asarray(f, dtype=float).reshape(-1)
-    for name, a in outputs.items():
-        bad = ~np.isfinite(np.asarray(a)).reshape(-1)
-        if np.any(bad):
-            k = int(np.flatnonzero(bad)[0])
-            raise ValueError(f"f: {name} is not a finite number at {f[k % f.size]:.4g} Hz (an undamped resonance "
-                             "hit exactly, or a frequency, diffusion coefficient or sheet resistance beyond what the "
-                             "closed forms hold); move or narrow the frequencies, or check those inputs")
 
 
 def circuit_impedance_error(f, thickness, perm: Permittivity, material: Material):

@@ -47,14 +47,21 @@ from ipmc_asym.beam.dynamics import DEFAULT_MODES, distributed_transfer
 from ipmc_asym.dynamics.circuit import (
     BEAM_CHOICES,
     FrequencyResult,
-    check_finite_response,
     dynamic_notes,
     frequency_response,
     quiet_numerics,
     strip_beam,
 )
 from ipmc_asym.model import groups
-from ipmc_asym.model.params import NAFION_LI, SHEET_RESISTANCE_SOURCE, Material, Strip, bending_stiffness, check_finite
+from ipmc_asym.model.params import (
+    NAFION_LI,
+    SHEET_RESISTANCE_SOURCE,
+    Material,
+    Strip,
+    bending_stiffness,
+    check_finite,
+    check_finite_response,
+)
 
 __all__ = ["LineResult", "line_response", "line_factors", "voltage_profile", "moment_modal_integral",
            "ProfileQuadrature", "MAX_PROFILE_POINTS"]

@@ -44,11 +44,11 @@ import numpy as np
 
 from ipmc_asym.base.registry import check_choice
 from ipmc_asym.base.results import Panel, ResultMixin, ResultSpec
-from ipmc_asym.dynamics.circuit import FREQ_METHODS, check_frequencies, circuit_impedance_error, frequency_response
+from ipmc_asym.dynamics.circuit import FREQ_METHODS, circuit_impedance_error, frequency_response
 from ipmc_asym.forward.sensing import DEFAULT_NU, SENSE_SUPPORTS, tip_curvature
 from ipmc_asym.integral.sensing import B_LIMIT, strain_parameter
 from ipmc_asym.model import groups
-from ipmc_asym.model.params import NAFION_LI, NOMINAL_STRIP, Material, Strip, check_finite
+from ipmc_asym.model.params import NAFION_LI, NOMINAL_STRIP, Material, Strip, check_finite, check_frequencies
 from ipmc_asym.model.permittivity import get_model
 
 __all__ = ["SensingResponse", "sensing_response", "voc_hat", "voc_hat_leading", "SENSING_LOADS",

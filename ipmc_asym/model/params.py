@@ -29,7 +29,15 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ipmc_asym.base.settings import MAX_DIMENSION, MAX_VOLTAGE, MIN_DIMENSION, MIN_THICKNESS, STRAIN_LIMIT, VALIDATED_VOLTAGE
+from ipmc_asym.base.settings import (
+    FREQUENCY_RANGE,
+    MAX_DIMENSION,
+    MAX_VOLTAGE,
+    MIN_DIMENSION,
+    MIN_THICKNESS,
+    STRAIN_LIMIT,
+    VALIDATED_VOLTAGE,
+)
 from ipmc_asym.base.units import parse_length, parse_pressure, parse_voltage
 from ipmc_asym.model import material_data
 from ipmc_asym.model.electrode import NO_ELECTRODE, Electrode, composite_stiffness, electrode_from_spec
@@ -59,6 +67,8 @@ __all__ = [
     "check_dimension",
     "check_voltage_cap",
     "check_voltages",
+    "check_frequencies",
+    "check_finite_response",
     "make_groups",
     "moment_scale",
     "debye_length",
@@ -160,6 +170,32 @@ def check_voltages(voltage, name: str = "voltage") -> None:
     if not np.all(np.isfinite(v)):
         raise ValueError(f"{name} must be finite (volts)")
     check_voltage_cap(v, name)
+
+
+def check_frequencies(f):
+    """``f`` (Hz) as a float array, each within :data:`~ipmc_asym.base.settings.FREQUENCY_RANGE`, else a
+    one-line ``ValueError`` (NaN and inf too)."""
+    f = np.asarray(f, dtype=float)
+    lo, hi = FREQUENCY_RANGE
+    inside = (f >= lo) & (f <= hi)  # NaN fails too
+    if not np.all(inside):
+        raise ValueError(f"frequencies must be finite and within {lo:g}..{hi:g} Hz (a numerical guard: the closed "
+                         f"forms are checked finite there); got {np.min(f):g}..{np.max(f):g} Hz")
+    return f
+
+
+def check_finite_response(f, outputs: dict) -> None:
+    """A numerical check of a spectrum: one line naming the first output that is not a finite number
+    and its frequency (a frequency, ``D`` or ``R_s`` so extreme that the closed forms overflow, or an
+    undamped resonance hit exactly), so that no such number is printed."""
+    f = np.asarray(f, dtype=float).reshape(-1)
+    for name, a in outputs.items():
+        bad = ~np.isfinite(np.asarray(a)).reshape(-1)
+        if np.any(bad):
+            k = int(np.flatnonzero(bad)[0])
+            raise ValueError(f"f: {name} is not a finite number at {f[k % f.size]:.4g} Hz (an undamped resonance "
+                             "hit exactly, or a frequency, diffusion coefficient or sheet resistance beyond what the "
+                             "closed forms hold); move or narrow the frequencies, or check those inputs")
 
 
 def check_min_thickness(thickness) -> None:
