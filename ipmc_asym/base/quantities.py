@@ -51,6 +51,8 @@ QUANTITIES = (
     Quantity("w_small", "m", "tip deflection w_p (small displacement)"),
     Quantity("x_tip", "m", "tip position along the clamp axis (large displacement)"),
     Quantity("y_tip", "m", "tip position across the clamp axis (large displacement)"),
+    Quantity("x_line", "m", "centre line of the free strip, along the clamp axis"),
+    Quantity("y_line", "m", "centre line of the free strip, across the clamp axis"),
     Quantity("F_block", "N", "blocking force F (large displacement)", scene_name="blocking_force"),
     Quantity("F_block_small", "N", "blocking force 3 M_A/(2 L) (small displacement)"),
     Quantity("B1", "1", "cathode concentration C(e)/C_moy"),

@@ -50,6 +50,8 @@ class ResultSpec(NamedTuple):
     panels : tuple of Panel   the figure, one axes per panel (vocabulary names)
     scalars : tuple of str   number fields shown in the summary and kept as dataset attributes
     names : dict   field -> vocabulary name where the two differ (``{"phi0": "voltage"}``)
+    labels : tuple of str   array fields that label the points (the inputs: ``thickness``,
+        ``voltage``): coordinates along ``dim`` in :meth:`ResultMixin.to_xarray`, not data
     """
 
     dim: str
@@ -58,6 +60,7 @@ class ResultSpec(NamedTuple):
     panels: tuple = ()
     scalars: tuple = ()
     names: dict = {}
+    labels: tuple = ()
 
 
 def units_of(name: str) -> tuple[str, str]:
@@ -120,7 +123,7 @@ class ResultMixin:
         """``(dim, coordinate values or None, {vocabulary name: array})`` of the result."""
         spec = self._result
         out = {}
-        for f in spec.fields:
+        for f in spec.labels + spec.fields:
             # "inputs.voltage": the key of a dict field
             head, _, key = f.partition(".")
             v = getattr(self, head, None)
@@ -197,7 +200,8 @@ class ResultMixin:
             data[name] = xr.Variable(dims, a, attrs={"units": unit, "long_name": long_name})
             if a.ndim and n is None:
                 n = a.shape[0]
-        coords = {}
+        # the inputs that label the points are coordinates, so that .sel and plots read them
+        coords = {name: data.pop(name) for name in self._result.labels if name in data}
         if n is not None:
             values = np.arange(n) if coord is None else coord
             unit, long_name = units_of(dim)

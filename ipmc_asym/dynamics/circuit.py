@@ -153,6 +153,9 @@ def dynamic_notes(beam="quasi-static", viscous_modulus=0.0, material: Material |
     if beam == "dynamic":
         notes[1] = INERTIA_NOTE + f"; viscous modulus {float(viscous_modulus):g} Pa s"
         notes.append(VISCOUS_MODULUS_SOURCE)
+    elif float(viscous_modulus) != 0.0:  # said, so that a damping asked for is not silently dropped
+        notes[1] += (f"; the viscous modulus {float(viscous_modulus):g} Pa s given is not used (it damps the "
+                     "dynamic beam's modes: beam 'dynamic')")
     if material is not None and material.electrode.present:
         notes.append("beam: " + beam_label(material.electrode))
     return notes

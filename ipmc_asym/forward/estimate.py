@@ -18,7 +18,9 @@ import time
 
 import numpy as np
 
+from ipmc_asym.base.quantities import BY_NAME as QUANTITY_NAMES
 from ipmc_asym.base.registry import check_choice
+from ipmc_asym.base.results import Panel, ResultMixin, ResultSpec
 from ipmc_asym.forward.escalation import Escalated, check_tol, moment_escalating
 from ipmc_asym.forward.model import CHECKS, FREE_STRIP_KEYS, MECHANICAL_KEYS, _forward, assumption_warnings
 from ipmc_asym.model.electrode import beam_label
@@ -37,7 +39,8 @@ from ipmc_asym.model.permittivity import MODELS
 from ipmc_asym.model.request import Request
 from ipmc_asym.model.spread import spread_of
 
-__all__ = ["evaluate", "estimate_rows", "estimate_report", "estimate_document", "model_spread", "spread_of",
+__all__ = ["evaluate", "EstimateRow", "StripLine", "arc", "estimate_rows",
+           "estimate_report", "estimate_document", "model_spread", "spread_of",
            "spread_variants", "SPREAD_KEYS",
            "RESULT_KEYS", "CHECKS", "moment_escalating", "Escalated",
            "check_tol", "FREE_STRIP_KEYS", "MECHANICAL_KEYS"]
@@ -54,7 +57,7 @@ def _f(x):
 
 def evaluate(strip: Strip, model="constant", fidelity="quadrature", material: Material = NAFION_LI,
              tol: float | None = None, *, escalate: bool = True, on_invalid: str = "raise",
-             pressure_term: bool = False) -> dict:
+             pressure_term: bool = False) -> EstimateRow:
     """One result row (SI units) for one strip and one permittivity model.
 
     Parameters
@@ -83,8 +86,9 @@ def evaluate(strip: Strip, model="constant", fidelity="quadrature", material: Ma
 
     Returns
     -------
-    dict
-        The keys of :data:`RESULT_KEYS` plus ``regime``, ``warnings``, ``x_tip``, ``y_tip``,
+    EstimateRow
+        A dict (the JSON row of ``ipmc-asym estimate --json``), with a summary, ``.plot()`` (the
+        bent strip) and ``.to_xarray()``; the keys of :data:`RESULT_KEYS` plus ``regime``, ``warnings``, ``x_tip``, ``y_tip``,
         ``debye_length`` (m), ``max_strain``, ``checks`` (each of :data:`CHECKS` -> bool),
         ``valid`` (all checks), ``flagged`` (the model assumptions that failed), ``withheld``
         (outputs set to ``None``: no valid rung, or the tip position past a full turn);
@@ -94,10 +98,67 @@ def evaluate(strip: Strip, model="constant", fidelity="quadrature", material: Ma
     req = Request(model, fidelity, tol, escalate, pressure_term)
     check_choice("on_invalid", on_invalid, ("raise", "nan"))
     material = as_material(material)
-    row = _evaluate(as_strip(strip), req, material, on_invalid)
+    strip = as_strip(strip)
+    row = _evaluate(strip, req, material, on_invalid)
     if pressure_term:
         _add_beta([row], material)
-    return row
+    return EstimateRow(row, length=strip.length)
+
+
+class EstimateRow(ResultMixin, dict):
+    """One row of :func:`evaluate`: the dict of the JSON row (its keys read as attributes too,
+    ``row.theta``), with a summary with units, ``.plot()`` and ``.to_xarray()`` (the numbers as
+    0-d variables).  ``length`` (m) is the strip's, for the figure."""
+
+    _result = ResultSpec("point", None, ())
+    _HEADLINE = ("model", "fidelity_used", "regime", "valid")
+
+    def __init__(self, row: dict, length: float):
+        super().__init__(row)
+        self.length = float(length)
+
+    def __getattr__(self, key):
+        try:
+            return self[key]
+        except KeyError:
+            raise AttributeError(key) from None
+
+    def _arrays(self):
+        out = {k: np.asarray(v) for k, v in self.items()
+               if k in QUANTITY_NAMES and isinstance(v, (bool, int, float)) and v is not None}
+        return "point", None, out
+
+    def plot(self, *, figsize=(6.4, 3.6)):
+        """The free strip's centre line (:class:`StripLine`: the arc of the tip rotation ``theta``
+        over the length, the quasi-static beam of uniform moment); a ``Figure``."""
+        th = self.get("theta")
+        if th is None or self.get("x_tip") is None:  # withheld: a line with nothing to plot
+            return StripLine(np.empty(0), np.empty(0), self._headline()).plot(figsize=figsize)
+        x, y = arc(th, self.length)
+        return StripLine(x, y, self._headline()).plot(figsize=figsize)
+
+
+class StripLine(ResultMixin):
+    """The centre line ``(x_line, y_line)`` (m) of a bent free strip, for :meth:`EstimateRow.plot`."""
+
+    _result = ResultSpec("x_line", "x_line", ("y_line",), (Panel("x_line", ("y_line",)),))
+
+    def __init__(self, x_line, y_line, headline: str):
+        self.x_line, self.y_line, self._title = x_line, y_line, headline
+
+    def _headline(self) -> str:
+        return self._title
+
+
+def arc(theta: float, length: float, points: int = 200):
+    """Centre line ``(x, y)`` (m, arrays of ``points``) of a strip clamped at the origin along x
+    and bent to the tip rotation ``theta`` (rad) at uniform curvature ``theta/length``; ``y`` has
+    the sign of ``theta`` (``theta < 0``: ``w < 0``, paper eq. 12)."""
+    s = np.linspace(0.0, length, points)
+    k = theta / length
+    if abs(k) * length < 1e-8:  # straight to within rounding: the series' first term
+        return s, 0.5 * k * s * s
+    return np.sin(k * s) / k, 2.0 * np.sin(0.5 * k * s) ** 2 / k  # 1 - cos without its cancellation
 
 
 def _evaluate(strip: Strip, req: Request, material: Material, on_invalid: str) -> dict:

@@ -102,6 +102,8 @@ class MomentResult(ResultMixin):
     A2 : ndarray
     valid : ndarray of bool   error estimate below ``VALIDITY_LIMIT`` and layers separate
         (``bvp``: the solve converged)
+    thickness, voltage : ndarray   the inputs (TOTAL thickness 2e, m; phi0, V) broadcast to the
+        result's shape (views, no copy): the coordinates of :meth:`to_xarray`
     fidelity : str
     model : str
     success : ndarray of bool   ``bvp``: solve_bvp converged at that point (True otherwise)
@@ -109,7 +111,8 @@ class MomentResult(ResultMixin):
     """
 
     _result = ResultSpec("point", None, ("I", "error", "B1", "core", "lam", "A2", "valid"),
-                         (Panel("point", ("I",)), Panel("point", ("error",), ylog=True)))
+                         (Panel("point", ("I",)), Panel("point", ("error",), ylog=True)),
+                         labels=("thickness", "voltage"))
 
     I: np.ndarray
     error: np.ndarray
@@ -122,6 +125,8 @@ class MomentResult(ResultMixin):
     model: str
     success: np.ndarray | None = None
     message: str = ""
+    thickness: np.ndarray | None = None
+    voltage: np.ndarray | None = None
 
 
 def _material(material, kw) -> Material:
@@ -669,7 +674,8 @@ def _moment(thickness, voltage, perm: Permittivity, fidelity: str, mat: Material
             check_voltages(voltage)
             raise ValueError("voltage must be finite (volts)")
         return MomentResult(I=I, error=err, B1=B1, core=core, lam=lam, A2=A2, valid=valid,
-                            fidelity=fidelity, model=perm.name, success=np.ones(I.shape, bool))
+                            fidelity=fidelity, model=perm.name, success=np.ones(I.shape, bool),
+                            **_inputs(thickness, voltage, I.shape))
     lam, A2, A3, rho, sign = _groups_arrays(thickness, voltage, gperm, mat, floor=not floor_checked)
     shape = lam.shape
     I = np.empty(shape)
@@ -679,7 +685,14 @@ def _moment(thickness, voltage, perm: Permittivity, fidelity: str, mat: Material
     success, message = _bvp_loop(thickness, voltage, perm, mat, I, err, B1, core, progress)
     valid = (err < validity_limit(fidelity)) & ((core > 0) | _FIDELITY_SPECS[fidelity].any_thickness) & success
     return MomentResult(I=I, error=err, B1=B1, core=core, lam=lam, A2=A2, valid=valid,
-                        fidelity=fidelity, model=perm.name, success=success, message=message)
+                        fidelity=fidelity, model=perm.name, success=success, message=message,
+                        **_inputs(thickness, voltage, shape))
+
+
+def _inputs(thickness, voltage, shape) -> dict:
+    """The inputs broadcast to the result's shape, as read-only views."""
+    return {"thickness": np.broadcast_to(np.asarray(thickness, dtype=float), shape),
+            "voltage": np.broadcast_to(np.asarray(voltage, dtype=float), shape)}
 
 
 def paper_model_id(perm: Permittivity) -> int:

@@ -44,7 +44,7 @@ from ipmc_asym.base.units import parse_length, parse_voltage
 from ipmc_asym.integral.api import as_numbers, check_fidelity, check_min_thickness, paper_model_id, run_parallel
 from ipmc_asym.kernels.charge import GL_W, GL_X, closed_sweep, exact_sweep, near_sweep
 from ipmc_asym.model import groups
-from ipmc_asym.model.params import NAFION_LI, Material, Strip, check_dimension, check_voltages
+from ipmc_asym.model.params import NAFION_LI, NOMINAL_STRIP, Material, Strip, check_dimension, check_voltages
 from ipmc_asym.model.permittivity import Permittivity, get_model
 
 __all__ = ["ChargeResult", "charge", "charge_escalated", "charge_inputs", "charge_at", "charge_scale", "capacitance_scale", "SUBNORMAL"]
@@ -101,21 +101,24 @@ def capacitance_scale(perm: Permittivity, material: Material) -> float:
     return charge_scale(perm, material) * groups.inverse_thermal_voltage(material)
 
 
-def charge(thickness, voltage, model="constant", fidelity="corrected", *, width=5.0e-3, length=0.02,
+def charge(thickness, voltage=None, model="constant", fidelity="corrected", *, width=None, length=None,
            material: Material | None = None) -> ChargeResult:
     """Electrode charge ``sigma``, ``Q``, differential capacitance and apparent permittivity.
 
     Parameters
     ----------
-    thickness : float or array_like
-        TOTAL thickness ``2e`` (m), > 0.
+    thickness : float, array_like or Strip
+        TOTAL thickness ``2e`` (m), > 0; or a :class:`~ipmc_asym.model.params.Strip`, whose
+        thickness, voltage, width and length serve where the arguments below are not given.
     voltage : float or array_like
-        ``phi0`` (V), any sign (``sigma`` is odd, ``C_diff`` even); broadcast with ``thickness``.
+        ``phi0`` (V), any sign (``sigma`` is odd, ``C_diff`` even); broadcast with ``thickness``;
+        needed unless a Strip is given.
     model : {"constant", "linear", "affine"}, Permittivity or callable
         A callable ``eps(C)`` needs ``fidelity="bvp"``.
     fidelity : {"leading", "corrected", "quadrature", "exact", "bvp"}
-    width, length : float
-        TOTAL width ``2l`` and length ``L`` (m), for ``Q = sigma 2l L``.
+    width, length : float, optional
+        TOTAL width ``2l`` and length ``L`` (m), for ``Q = sigma 2l L``; default the Strip's, else
+        those of the default ``Strip()`` (5 mm, 20 mm).
     material : Material, optional (default ``nafion-li``)
 
     Returns
@@ -124,7 +127,20 @@ def charge(thickness, voltage, model="constant", fidelity="corrected", *, width=
         Arrays of the broadcast shape (0-d for scalar inputs), SI.
     """
     check_fidelity(fidelity)
+    thickness, voltage, width, length = _from_strip(thickness, voltage, width, length)
     return charge_at(*charge_inputs(thickness, voltage, model, width, length, material), fidelity)
+
+
+def _from_strip(thickness, voltage, width, length):
+    """``charge``'s geometry from a Strip where one is passed (a Strip is checked when built),
+    else the arguments with the default Strip's width and length."""
+    s = thickness if isinstance(thickness, Strip) else NOMINAL_STRIP
+    if isinstance(thickness, Strip):
+        thickness = s.thickness
+        voltage = s.voltage if voltage is None else voltage
+    elif voltage is None:
+        raise ValueError("voltage: needed (V) unless the first argument is a Strip")
+    return (thickness, voltage, s.width if width is None else width, s.length if length is None else length)
 
 
 def charge_inputs(thickness, voltage, model="constant", width=5.0e-3, length=0.02, material: Material | None = None):

@@ -37,12 +37,14 @@ def doubling_panels(integrand):
 
     ``integrand(u, sgn, par, wt)`` returns ``wt f(u)``, the node's weight applied by the
     integrand (where it enters the rounding is the integrand's); ``sgn`` and ``par`` are passed
-    on (``y = sgn u``).  Returns the jitted ``panels(T, sgn, par, X, Wt)`` (``T > 0``; ``X``,
+    on (``y = sgn u``).  Returns the jitted ``panels(T, sgn, par, X, Wt)`` (``T > 0``; NaN for a ``T`` not finite; ``X``,
     ``Wt`` the nodes and weights on [-1, 1]).
     """
 
     @jit
     def panels(T, sgn, par, X, Wt):
+        if not T < math.inf:  # NaN would never meet the end test below (b >= T), inf gives junk
+            return math.nan
         total = 0.0
         a = 0.0
         b = min(0.5, T)

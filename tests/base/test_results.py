@@ -154,6 +154,23 @@ def test_dataset_values_of_the_study_results():
     assert float(dd["length"].values[0]) == d.optimum["inputs"]["length"]
 
 
+def test_moment_points_are_labelled_by_their_inputs():
+    """The inputs are coordinates: a point picked by thickness and voltage holds the moment that a
+    call at that point alone gives (a different evaluation, one point)."""
+    th = np.array([[100e-6], [300e-6]])
+    v = np.array([-1.0, 0.5, 2.0])
+    ds = ia.moment(th, v).to_xarray()
+    assert set(ds.coords) >= {"thickness", "voltage"} and "thickness" not in ds.data_vars
+    assert ds["thickness"].attrs["units"] == "m" and ds["voltage"].attrs["units"] == "V"
+    assert ds["thickness"].shape == ds["I"].shape == (2, 3)
+    i, j = 1, 0
+    one = ia.moment(float(ds["thickness"].values[i, j]), float(ds["voltage"].values[i, j]))
+    assert (float(ds["thickness"].values[i, j]), float(ds["voltage"].values[i, j])) == (300e-6, -1.0)
+    assert float(ds["I"].values[i, j]) == pytest.approx(float(one.I), rel=1e-13)
+    flat = ia.moment(np.array([100e-6, 200e-6]), 1.0).to_xarray().swap_dims(point="thickness")
+    assert float(flat["I"].sel(thickness=200e-6)) == pytest.approx(float(ia.moment(200e-6, 1.0).I), rel=1e-13)
+
+
 def test_tabular_results_as_dataframes():
     s = _built("StepResult")
     df = s.to_dataframe()

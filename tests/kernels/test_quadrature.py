@@ -1,6 +1,9 @@
 """The doubling-panel quadrature shared by the layer integrals, against closed forms."""
 
+import ast
 import math
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -38,3 +41,15 @@ def test_doubling_panels_against_closed_forms(T, sgn):
         return
     ref = sgn * math.expm1(sgn * a * T) / a  # int_0^T e^{sgn a u} du
     assert _panels_exp(T, sgn, a, _X, _W) == pytest.approx(ref, rel=1e-13)
+
+
+def test_doubling_panels_end_on_a_limit_that_is_not_finite():
+    """A NaN upper limit never met the loop's end test (the charge at A2 ~ 1e308 spun forever,
+    deaf to SIGTERM): NaN out, at once, for NaN and inf; in a child process so that a regression
+    fails here instead of hanging the suite."""
+    code = ("import math; from ipmc_asym.kernels.charge import _chat_panels; "
+            "from ipmc_asym.kernels.quadrature import _X, _W; "
+            "print([_chat_panels(t, 1.0, 0.5, _X, _W) for t in (2.0, math.inf, math.nan)])")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    finite, inf, nan = ast.literal_eval(out.stdout.strip().replace("nan", "None"))
+    assert finite > 0 and inf is None and nan is None
