@@ -205,3 +205,14 @@ def test_the_frequency_range_ends_are_the_exact_theory_and_beyond_them_one_line(
         for D in (1e308, 1e-320):
             with pytest.raises(ValueError, match=r"^f: Z is not a finite number at 1 Hz"):
                 frequency_response([1.0], material=NAFION_LI.with_(D=D))
+
+
+def test_a_viscous_modulus_the_quasi_static_beam_does_not_use_is_said():
+    f = np.array([1.0, 10.0])
+    r0 = frequency_response(f, method="circuit")
+    r1 = frequency_response(f, method="circuit", viscous_modulus=1e4)
+    np.testing.assert_array_equal(r1.H_w, r0.H_w)  # indeed unused
+    said = [n for n in r1.notes if "viscous modulus 10000 Pa s given is not used" in n]
+    assert len(said) == 1 and not any("not used" in n for n in r0.notes)
+    rd = frequency_response(f, method="circuit", beam="dynamic", viscous_modulus=1e4)
+    assert not any("not used" in n for n in rd.notes)
