@@ -31,7 +31,7 @@ from ipmc_asym.forward.sensing import DEFAULT_NU, SENSE_SUPPORTS
 from ipmc_asym.io.fileio import FIGURE_FORMATS
 from ipmc_asym.model.electrode import beam_label
 from ipmc_asym.parallel.executors import check_scheduler
-from ipmc_asym.studies.calibrate import FREE_ALIASES, FREE_PARAMETERS, MAX_DATA_ROWS, CalibrationData, parse_free
+from ipmc_asym.studies.calibrate import FREE_ALIASES, FREE_PARAMETERS, MAX_DATA_ROWS, CalibrationData, free_warnings, parse_free
 from ipmc_asym.studies.calibrate_dynamic import TIME_FIDELITIES, fit, read_file
 
 #: data files of one fit (each read into memory, at most --max-rows rows)
@@ -111,7 +111,10 @@ def register(sub):
 def run(args) -> int:
     # every option checked before any work (the fit of a long file takes seconds to minutes);
     # --plot with every output (add_output_option)
-    parse_free(args.free)
+    # said before the run (a fit searching where no strip is can be long), and not again after it
+    early = free_warnings(parse_free(args.free))
+    for w in early:
+        sys.stderr.write(f"fit: warning: {w}\n")
     if args.scheduler is not None:
         check_scheduler(args.scheduler)
     if len(args.data) > MAX_FILES:
@@ -180,7 +183,7 @@ def run(args) -> int:
         if args.plot:
             print(f"figure: {args.plot}")
     sys.stdout.flush()  # the stdout lines before the stderr ones (never interleaved mid-line)
-    for w in res.warnings:
+    for w in (w for w in res.warnings if w not in early):
         sys.stderr.write(f"fit: warning: {w}\n")
     sys.stderr.write(f"fit: {res.message}\n")
     return 0

@@ -74,6 +74,7 @@ from ipmc_asym.parallel.executors import run_chunks
 
 __all__ = [
     "FREE_PARAMETERS",
+    "free_warnings",
     "MEASURED",
     "CalibrationData",
     "CalibrationResult",
@@ -354,6 +355,21 @@ def parse_free(spec) -> dict:
         out[k] = (lo, hi)
     if not out:
         raise ValueError("--free needs at least one of " + ", ".join(FREE_PARAMETERS))
+    return out
+
+
+def free_warnings(bounds: dict) -> list:
+    """One line per free parameter whose bounds (``{name: (lo, hi)}``, SI, of :func:`parse_free`) lie
+    wholly outside its plausible range (:data:`ipmc_asym.model.limits.PLAUSIBLE`): a bare number is
+    SI (``modulus=1:2`` is 1-2 Pa), and such a fit searches where no strip is (it runs, as asked)."""
+    out = []
+    for k, (lo, hi) in bounds.items():
+        par = PARAMETERS[k]
+        pl = par.plausible
+        if pl is None or (hi >= pl[0] and lo <= pl[1]):
+            continue
+        out.append(f"--free {k} {lo:g}:{hi:g} {par.unit} lies wholly outside the plausible {pl[0]:g}-{pl[1]:g} "
+                   f"{par.unit} (a bare number is SI, {par.unit}); fitted as given")
     return out
 
 
@@ -696,10 +712,12 @@ def fit(data: CalibrationData, free, model="constant", material: Material = NAFI
 
     bar = _bar(None, "fit", enabled=progress, unit="eval")
     try:
-        return _fit(data, bounds, names, p, n, lo, hi, x0, ladder, starts, model, material, fidelity, scheduler,
-                    bar, stats)
+        res = _fit(data, bounds, names, p, n, lo, hi, x0, ladder, starts, model, material, fidelity, scheduler,
+                   bar, stats)
     finally:
         bar.close()
+    res.warnings[:0] = free_warnings(bounds)
+    return res
 
 
 def _fit(data, bounds, names, p, n, lo, hi, x0, ladder, starts, model, material, fidelity, scheduler, bar,

@@ -108,6 +108,7 @@ from ipmc_asym.studies.calibrate import (
     check_count,
     check_stiffness_free,
     check_visible,
+    free_warnings,
     multistart_starts,
     parse_free,
     predict,
@@ -989,11 +990,13 @@ def fit_dynamic(datasets, free, model="constant", material: Material = NAFION_LI
     starts = multistart_starts(x0, lo, hi, multistart, seed)
     bar = _bar(None, "fit", enabled=progress, unit="eval")
     try:
-        return _fit_joint(parts, names, bounds, lo, hi, starts, s_ladder, t_ladder, has_static, has_time, has_sigma,
-                          n, model, material, strip, beam, viscous_modulus, scheduler, bar, stats, fidelity,
-                          time_fidelity)
+        res = _fit_joint(parts, names, bounds, lo, hi, starts, s_ladder, t_ladder, has_static, has_time, has_sigma,
+                         n, model, material, strip, beam, viscous_modulus, scheduler, bar, stats, fidelity,
+                         time_fidelity)
     finally:
         bar.close()
+    res.warnings[:0] = free_warnings(bounds)
+    return res
 
 
 def fit(data, free, model="constant", material: Material = NAFION_LI, fidelity: str | None = None,

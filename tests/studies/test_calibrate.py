@@ -313,3 +313,17 @@ def test_free_bounds_with_units_and_aliases():
     assert b["c_moy"] == pytest.approx((1e3, 3e3))
     with pytest.raises(ValueError, match="unknown unit"):
         parse_free("D=1e-11furlong:1e-9")
+
+
+def test_free_bounds_wholly_outside_the_plausible_range_are_said():
+    from ipmc_asym.model.limits import PLAUSIBLE
+    from ipmc_asym.studies.calibrate import free_warnings, parse_free
+
+    (line,) = free_warnings(parse_free("modulus=1:2"))  # Pa: a bare number is SI
+    assert line.startswith("--free modulus 1:2 Pa") and f"{PLAUSIBLE['E'][0]:g}" in line
+    (line,) = free_warnings(parse_free("diffusion=1e-20:1e-19,modulus=50MPa:500MPa"))
+    assert line.startswith("--free diffusion")
+    # touching the range is enough: the fit may end inside it
+    lo = PLAUSIBLE["E"][1]
+    assert free_warnings(parse_free(f"modulus={lo:g}:{10 * lo:g}")) == []
+    assert free_warnings(parse_free("modulus,c_moy")) == []  # the default bounds
