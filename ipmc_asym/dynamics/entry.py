@@ -41,7 +41,7 @@ from ipmc_asym.forward.model import CHECKS
 from ipmc_asym.model.params import NAFION_LI, Material, Strip, check_finite
 
 __all__ = ["DEFAULT_BEAM", "TIME_PATHS", "ERROR_COLUMNS", "AUTO_TOL", "AUTO_WORK", "WORK_PER_SECOND", "Drive",
-           "TimeResponse", "stated_tol", "time_path", "time_response", "spectrum"]
+           "TimeResponse", "stated_tol", "time_path", "time_response", "spectrum", "sampling_note"]
 
 #: solvers of a time response: ``memory`` (step_response: circuit or PNP, optional tolerance, the dynamic
 #: beam on a refined grid), ``stream`` (the circuit stepped on the output grid, chunk by chunk, memory
@@ -274,6 +274,23 @@ def time_path(*, fidelity="circuit", tol=None, beam=DEFAULT_BEAM, sheet_resistan
     return "memory"
 
 
+def sampling_note(drive: Drive, duration, points: int):
+    """A note where the output rows are spaced wider than half a period of the drive's fastest
+    component (its ``max_frequency``): each row is the state at its time (the substeps resolve the
+    drive, :func:`~ipmc_asym.dynamics.circuit.drive_substep`), but the rows do not trace the
+    oscillation between them; None otherwise."""
+    f = float(getattr(drive.function, "max_frequency", 0.0) or 0.0)
+    if duration is None or f <= 0.0 or points < 2:
+        return None
+    dt = float(duration) / (points - 1)
+    if dt <= 0.5 / f:
+        return None
+    need = int(min(2.0 * f * float(duration), 1e18)) + 2
+    return (f"output rows every {dt:.3g} s sample the drive's {f:.4g} Hz component below twice a period "
+            f"({1.0 / (dt * f):.3g} rows a period): each row is the state at its time, but the rows do not "
+            f"trace the oscillation between them (at least {need:.3g} points would)")
+
+
 def time_response(strip: Strip | None = None, drive=None, *, duration=None, points: int = 1000, model="constant",
                   material: Material | None = None, fidelity="circuit", tol: float | None = None,
                   beam=DEFAULT_BEAM, viscous_modulus=0.0, sheet_resistance=0.0, line_segments=DEFAULT_SEGMENTS,
@@ -363,9 +380,10 @@ def time_response(strip: Strip | None = None, drive=None, *, duration=None, poin
         # the header of the stepped paths, with the run's own notes (what it states and what it leaves out)
         info = dict(drive_info(s, model, m, beam, viscous_modulus), notes=list(r.notes), fidelity=r.fidelity,
                     tol=tol if tol is not None else r.extra.get("tol"), valid_from=r.extra.get("valid_from"))
-        if why is not None:
-            r.notes.append(why)
-            info["notes"].append(why)
+        for n in (why, sampling_note(d, duration, points)):
+            if n is not None:
+                r.notes.append(n)
+                info["notes"].append(n)
         return TimeResponse(path, d, duration, info=info, result=r)
     # the stepped paths: the uniform strip streams with the quasi-static beam unless the output grid
     # carries the modes (time_path); the line and the supports with either beam
@@ -376,6 +394,8 @@ def time_response(strip: Strip | None = None, drive=None, *, duration=None, poin
     if why is not None:
         info["notes"].append(why)
     dur = float(duration) if duration is not None else DEFAULT_SPAN * info["tau"]
+    if (n := sampling_note(d, dur, points)) is not None:
+        info["notes"].append(n)
     kw = dict(strip=s, model=model, material=m, beam=beam, viscous_modulus=vm, n_modes=n_modes, **line, **where)
     if duration is None and d.kind == "step":  # the in-memory step's default window (circuit.default_times)
         grid = default_times(info["tau"], points)

@@ -33,7 +33,7 @@ import numpy as np
 from scipy.linalg import solve_banded
 
 from ipmc_asym.beam.dynamics import _propagate, mode_shape, modes, moment_kernels, natural_frequencies
-from ipmc_asym.dynamics.circuit import drive_times, layer_rates, strip_beam, substep_grid
+from ipmc_asym.dynamics.circuit import SUBSTEP_ADVICE, drive_substep, drive_times, layer_rates, strip_beam, substep_grid
 from ipmc_asym.dynamics.electrode import charge_scale, core_resistance, time_constant
 from ipmc_asym.dynamics.waveforms import voltage_rate
 from ipmc_asym.integral.api import paper_model_id
@@ -133,6 +133,7 @@ class LineStepper:
         Cd0 = 0.5 * charge_scale(perm, material) / self.VT
         self.t_line = 2.0 * Rs * strip.length**2 * Cd0 / self.tau
         self.h_max = 5e-3 * min(1.0, max(self.t_line, 0.05))
+        self.h_sub = drive_substep(phi0_fun, self.tau, self.h_max)
         self.substeps = int(substeps)
         self.rho = perm.eps0 / perm.eps_moy
         self.mid = paper_model_id(perm)
@@ -163,8 +164,7 @@ class LineStepper:
         if t[0] != self.t_last:
             raise ValueError("each chunk must start at the last time of the previous one (0 at the start)")
         tau = self.tau
-        tt, idx = substep_grid(t, tau, self.h_max, self.substeps,
-                               ("the line's", "use fewer time constants or fewer points a chunk"))
+        tt, idx = substep_grid(t, tau, self.h_sub, self.substeps, ("the line's", SUBSTEP_ADVICE + " or fewer points a chunk"))
         ps = self.fun(drive_times(t, tt, idx, tau)) / self.VT
         out = {}
         L = self.strip.length

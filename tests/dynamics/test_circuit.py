@@ -216,3 +216,40 @@ def test_a_viscous_modulus_the_quasi_static_beam_does_not_use_is_said():
     assert len(said) == 1 and not any("not used" in n for n in r0.notes)
     rd = frequency_response(f, method="circuit", beam="dynamic", viscous_modulus=1e4)
     assert not any("not used" in n for n in rd.notes)
+
+
+@pytest.mark.parametrize("stream", [False, True])
+def test_a_drive_faster_than_the_output_grid_is_resolved(stream):
+    """The substeps follow the waveform's fastest component, not only tau/200: an 11-row grid
+    over ten periods of a 1 kHz sine gives the rows a 10001-row grid gives at the same times (a
+    different discretisation); before, its middle row had the wrong sign (0.18 against -0.022)."""
+    import ipmc_asym as ia
+
+    said = {}
+
+    def rows(points):
+        r = ia.time_response(Strip(), ia.Drive("sine:1V@1010Hz"), duration=0.01, points=points, tol=None,
+                             stream=stream)
+        said[points] = [n for n in r.info["notes"] if n.startswith("output rows every")]
+        if stream:
+            return np.concatenate([np.asarray(c["sigma"]) for c in r.iter_chunks()])
+        assert [n for n in r.result.notes if n.startswith("output rows every")] == said[points]
+        return np.asarray(r.result.sigma)
+
+    fine, coarse = rows(10001), rows(11)
+    # the rows' spacing said where it is wider than half a period (0.1 rows a period here)
+    assert said[10001] == [] and len(said[11]) == 1 and "1010 Hz" in said[11][0]
+    scale = np.max(np.abs(fine))
+    np.testing.assert_allclose(coarse, fine[::1000], rtol=0, atol=2e-4 * scale)
+
+
+def test_drive_substep_follows_the_fastest_component():
+    from ipmc_asym.dynamics.circuit import STEPS_PER_PERIOD, drive_substep
+    from ipmc_asym.dynamics.waveforms import parse_waveform
+
+    tau = 0.03
+    assert drive_substep(parse_waveform("step:1V"), tau, 5e-3) == 5e-3
+    assert drive_substep(parse_waveform("sine:1V@1Hz"), tau, 5e-3) == 5e-3
+    w = parse_waveform("step:1V+square:0.1V@5kHz")
+    assert drive_substep(w, tau, 5e-3) == pytest.approx(1.0 / (STEPS_PER_PERIOD * 5e3 * tau), rel=1e-15)
+    assert drive_substep(lambda t: 0.0 * t, tau, 5e-3) == 5e-3  # a bare callable states no frequency
