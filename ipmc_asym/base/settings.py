@@ -65,6 +65,25 @@ MAX_DRIVE_VOLTAGE = MAX_VOLTAGE
 #: (tests/dynamics/test_circuit.py)
 FREQUENCY_RANGE = (1e-9, 1e12)
 
+#: the cation diffusion coefficients D (m^2/s) a material accepts: a numerical guard, not a physical
+#: limit (the plausible range, model.limits.PLAUSIBLE["D"], only warns).  Every dynamic time scales as
+#: 1/D: at 1e308 the time constant underflows to 0 and at 1e-320 it overflows to inf; from one end to
+#: the other of this range the time constant of every accepted strip stays a normal double, and step,
+#: drive and freq return finite rows at both ends (tests/model/test_params.py)
+DIFFUSION_RANGE = (1e-30, 1e10)
+
+#: the mean cation concentrations C_moy (mol/m^3) a material accepts: a numerical guard, not a physical
+#: limit (the plausible range, model.limits.PLAUSIBLE["c_moy"], only warns).  The Debye length goes as
+#: C_moy^-1/2: at 1e-320 every rung fails (the BVP's Jacobian is singular); at both ends of this range
+#: estimate, charge, step and freq return on strips from MIN_THICKNESS to MAX_DIMENSION thick
+#: (tests/model/test_params.py)
+C_MOY_RANGE = (1e-3, 1e8)
+
+#: shortest time span (s) a waveform's ramp time or period and a drive's duration may have: the period
+#: of the highest frequency a spectrum accepts (FREQUENCY_RANGE), a numerical guard.  A subnormal ramp
+#: time (1e-320 s) makes the ramp's slope V/TR overflow
+MIN_TIME = 1.0 / FREQUENCY_RANGE[1]
+
 #: relative rounding floor of the error estimate of corrected / quadrature (the two terms are
 #: assembled with cancellations; measured <= 2.3e-12 against the BVP on 1 um - 10 mm x 0.1 mV - 20 V)
 ROUNDING_ERROR = 1e-11
@@ -97,6 +116,29 @@ MAX_ROWS = 10**7
 #: fresh one each chunk (2^18 rows, 80 MB: ~30 ms of faults a chunk); a 10^6-row CSV sweep
 #: went from 2.2-2.5 s to 1.9 s (measured, this machine)
 CHUNK_ROWS = 2**16
+
+#: hard ceilings of the settable caps (``--max-rows``, ``--max-samples``, ...): a cap raised past its
+#: ceiling is refused in one line, so that no setting of a cap lets memory or time run away.
+#: sweep rows: streamed in CHUNK_ROWS chunks (memory bounded), ~1.9 s per 1e6 rows to CSV (measured,
+#: above): 1e9 rows are ~30 min and a ~300 GB file
+MAX_ROWS_CEILING = 10**9
+#: fit data rows: held in memory and read by every evaluation of the fit; a row is a few numbers, so
+#: the 64 MiB input cap (base.inputs) holds about this many: 10 times the default cap
+MAX_DATA_ROWS_CEILING = 10**6
+#: uq model runs: streamed chunk by chunk (memory does not grow), ~1e6 runs/s at leading in one
+#: process: 1e9 runs are ~17 min, 10 times the default cap
+MAX_SAMPLES_CEILING = 10**9
+#: uq runs kept for --out and --plot, ~100 B each in memory: 2e7 are ~2 GB, 10 times the default cap
+MAX_STORE_SAMPLES_CEILING = 2 * 10**7
+#: fit's extra starts, each a full least-squares solve (seconds on a time series): 1e4 are hours,
+#: 10 times the default cap
+MAX_MULTISTART_CEILING = 10**4
+#: figure resolution: a page-wide figure (17 cm x ~15 cm) is ~1 GB of RGBA pixels at 2400 dpi (the
+#: resolution of image-setters), 4 times the default cap
+MAX_DPI_CEILING = 2400
+#: output points of step and freq: held in memory with every column (~100-200 B a point with the
+#: beam's outputs): 1e6 points are ~0.2 GB, 10 times the default cap
+MAX_POINTS_CEILING = 10**6
 
 #: beam regimes outside the model (fits leave these points out)
 OUTSIDE_REGIMES = ("past-quarter-turn", "multi-turn")

@@ -28,14 +28,14 @@ from ipmc_asym.io.fileio import check_output_path
 from ipmc_asym.model.electrode import METALS
 from ipmc_asym.model.limits import material_warnings, range_warning, value_warning
 from ipmc_asym.model.materials import bibliography, material_comments
-from ipmc_asym.model.params import Strip, check_min_thickness, material_from_spec, set_thickness
+from ipmc_asym.model.params import Strip, check_diffusion, check_min_thickness, material_from_spec, set_thickness
 
 __all__ = ["UsageError", "Parser", "add_strip_options", "add_material_options", "print_citations", "material_comments",
            "scene_with_material",
            "material_from_args", "strip_from_args", "strip_and_material",
            "arg_type", "count_type", "join_negative_values", "fmt_num", "c_moy_label", "length_type", "pressure_type",
            "voltage_type", "tol_type", "time_tol_type",
-           "first_run_notice", "spread_count", "diffusion_type", "sidecar_path", "add_size_option", "check_size_caps",
+           "first_run_notice", "spread_count", "diffusion_type", "sidecar_path", "add_size_option", "check_size_caps", "cap_type",
            "add_output_option", "check_outputs",
            "seed_type", "model_help", "viscous_modulus_type", "duration_type", "waveform_type", "sheet_resistance_type",
            "frequency_type", "add_beam_options", "SOLVER_ALIASES", "add_solver_option", "add_line_options",
@@ -155,6 +155,7 @@ def pressure_type(name):
 
 
 def _plausible_diffusion(text, v):
+    check_diffusion(v, "--diffusion")  # the refusal before the plausibility warning: one line
     line = range_warning("D", v, "--diffusion")
     if line:
         warn(line)
@@ -205,23 +206,35 @@ def _time_tol(text):
 time_tol_type = arg_type(_time_tol, "tol")
 
 
-def count_type(name, minimum=1):
-    """An integer >= ``minimum``, also written ``1e6`` or ``10**6``-style ``1_000_000``."""
+def count_type(name, minimum=1, maximum=None, why=""):
+    """An integer >= ``minimum`` (and <= ``maximum``, where given, for the reason ``why``), also
+    written ``1e6`` or ``10**6``-style ``1_000_000``."""
+    if maximum is None:
+        allowed = f"an integer >= {minimum} (e.g. 1000000 or 1e6)"
+    else:
+        allowed = f"an integer from {minimum} to {maximum:g}" + (f" ({why})" if why else "")
 
     def conv(text):
         try:
             v = float(str(text).replace("_", ""))
         except ValueError:
-            raise ValueError(f"{name} must be an integer >= {minimum} (e.g. 1000000 or 1e6); got {text!r}") from None
-        if not v.is_integer() or v < minimum:
-            raise ValueError(f"{name} must be an integer >= {minimum} (e.g. 1000000 or 1e6); got {text!r}")
+            raise ValueError(f"{name} must be {allowed}; got {text!r}") from None
+        if not v.is_integer() or v < minimum or (maximum is not None and v > maximum):
+            raise ValueError(f"{name} must be {allowed}; got {text!r}")
         return int(v)
 
     return arg_type(conv, name)
 
 
-def add_size_option(p, flag, *, default, maximum, minimum=1, help="", cap_flag=None, metavar=None):
-    """A size-like option ``flag`` with its documented cap ``--max-<name>`` (settable, like sweep's ``--max-rows``).
+def cap_type(flag, ceiling):
+    """The type of a settable cap ``--max-<name>``: an integer from 1 to its hard ``ceiling``
+    (a ``settings.MAX_*_CEILING``)."""
+    return count_type(flag, 1, ceiling, "the ceiling of this cap: memory and time stay bounded")
+
+
+def add_size_option(p, flag, *, default, maximum, ceiling, minimum=1, help="", cap_flag=None, metavar=None):
+    """A size-like option ``flag`` with its documented cap ``--max-<name>`` (settable, like sweep's ``--max-rows``,
+    up to its hard ``ceiling``, a ``settings.MAX_*_CEILING``).
 
     The cap is checked by :func:`check_size_caps` before any work (``main`` calls it), so a
     size that would exhaust memory or time is refused in one line, exit 2.
@@ -230,8 +243,9 @@ def add_size_option(p, flag, *, default, maximum, minimum=1, help="", cap_flag=N
     kw = {"metavar": metavar} if metavar else {}
     p.add_argument(flag, type=count_type(flag, minimum), default=default,
                    help=f"{help} (default {default:g}; at most {cap_flag}, default {maximum:g})".replace("%", "%%"), **kw)
-    p.add_argument(cap_flag, type=count_type(cap_flag), default=maximum,
-                   help=f"refuse {flag} above this (default {maximum:g}: memory and time stay bounded)")
+    p.add_argument(cap_flag, type=cap_type(cap_flag, ceiling), default=maximum,
+                   help=f"refuse {flag} above this (default {maximum:g}, at most {ceiling:g}: memory and time stay "
+                        "bounded)")
     caps = p.get_default("_size_caps") or ()
     p.set_defaults(_size_caps=tuple(caps) + ((flag, cap_flag),))
 
@@ -606,10 +620,12 @@ def viscous_modulus_type(name="--viscous-modulus"):
 
 
 def _duration(text):
+    from ipmc_asym.dynamics.waveforms import check_time_span  # deferred: start-up
+
     v = parse_time("--duration", text)
     if v <= 0:
         raise ValueError(f"--duration must be > 0 (e.g. 0.5s, 200ms); got {text!r}")
-    return v
+    return check_time_span("--duration", v)
 
 
 #: ``--duration``: an end time > 0 (s, ``200ms``)

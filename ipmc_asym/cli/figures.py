@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import sys
 
+from ipmc_asym.base.settings import MAX_DPI_CEILING
 from ipmc_asym.cli import SUMMARIES, load_plugin
 from ipmc_asym.cli.common import add_output_option, add_size_option, new_dir_removed_on_failure
 from ipmc_asym.io.fileio import check_output_path, make_output_dir
@@ -20,7 +21,8 @@ def register(sub):
     add_output_option(p, "--out", kind="dir", required=True, metavar="DIR",
                    help="output directory (required: no default that would depend on the working directory; "
                         "only its last level is created)")
-    add_size_option(p, "--dpi", default=110, maximum=MAX_DPI, minimum=10, help="resolution in dots per inch (>= 10)")
+    add_size_option(p, "--dpi", default=110, maximum=MAX_DPI, ceiling=MAX_DPI_CEILING, minimum=10,
+                    help="resolution in dots per inch (>= 10)")
     p.add_argument("--format", default="pdf", choices=("pdf", "svg", "png"),
                    help="file format (default pdf: vector, one column 8.5 cm or a page 17 cm wide, fonts >= 7 pt)")
     p.add_argument("--quick", action="store_true", help="fewer points (for tests)")

@@ -7,13 +7,14 @@ import sys
 
 from ipmc_asym.base.jsonio import dumps
 from ipmc_asym.base.registry import fidelity_names, model_names
+from ipmc_asym.base.settings import MAX_DATA_ROWS_CEILING, MAX_MULTISTART_CEILING
 from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import (
     add_output_option,
     add_size_option,
     add_solver_option,
     add_strip_options,
-    count_type,
+    cap_type,
     diffusion_type,
     first_run_notice,
     fmt_num,
@@ -95,9 +96,9 @@ def register(sub):
     add_solver_option(p, "fit", dest="time_fidelity", default=None, choices=TIME_FIDELITIES,
                       help="force the time series' rung (default: circuit, escalated to pnp where its error is too "
                            "large; its error is checked either way)")
-    add_size_option(p, "--multistart", default=0, maximum=MAX_MULTISTART, minimum=0, metavar="N",
+    add_size_option(p, "--multistart", default=0, maximum=MAX_MULTISTART, ceiling=MAX_MULTISTART_CEILING, minimum=0, metavar="N",
                     help="N extra starts, log-uniform in the bounds; the best is kept")
-    p.add_argument("--max-rows", type=count_type("--max-rows"), default=MAX_DATA_ROWS,
+    p.add_argument("--max-rows", type=cap_type("--max-rows", MAX_DATA_ROWS_CEILING), default=MAX_DATA_ROWS,
                    help=f"refuse a DATA.csv of more data rows than this (default {MAX_DATA_ROWS:.0e})")
     p.add_argument("--seed", type=seed_type, default=0, help="seed of the multistart starts (integer >= 0, default 0)")
     p.add_argument("--scheduler", default=None, metavar="local|tcp://HOST:PORT",

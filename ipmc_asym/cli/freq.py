@@ -7,6 +7,7 @@ import numpy as np
 
 from ipmc_asym.base.jsonio import dumps
 from ipmc_asym.base.registry import model_names
+from ipmc_asym.base.settings import MAX_POINTS_CEILING
 from ipmc_asym.base.units import fmt_length, parse_length
 from ipmc_asym.beam.dynamics import CLAMPED_OUTPUTS
 from ipmc_asym.cli import SUMMARIES
@@ -52,7 +53,7 @@ def register(sub):
     add_strip_options(p, voltage=False, mechanics=False)
     p.add_argument("--from", dest="f1", type=frequency_type("--from"), required=True, help="first frequency (e.g. 0.01Hz)")
     p.add_argument("--to", dest="f2", type=frequency_type("--to"), required=True, help="last frequency (e.g. 1kHz)")
-    add_size_option(p, "--points", default=50, maximum=MAX_POINTS, minimum=2, help="log-spaced points")
+    add_size_option(p, "--points", default=50, maximum=MAX_POINTS, ceiling=MAX_POINTS_CEILING, minimum=2, help="log-spaced points")
     p.add_argument("--model", default="constant", choices=list(model_names()), help=model_help("constant"))
     add_solver_option(p, "freq", dest="method", default=None, choices=FREQ_METHODS,
                       help="pnp-linear (exact linearised PNP, closed form; the default at 0 V) or circuit "

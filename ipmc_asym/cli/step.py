@@ -11,6 +11,7 @@ import numpy as np
 
 from ipmc_asym.base.jsonio import dumps
 from ipmc_asym.base.registry import model_names
+from ipmc_asym.base.settings import MAX_POINTS_CEILING
 from ipmc_asym.base.units import fmt_length
 from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import (
@@ -163,7 +164,7 @@ def register(sub):
                         f"default auto: {AUTO_TOL:g} where the error can be stated (at most 10001 output times, no "
                         "--sheet-resistance: the electrode line states its own), 1e-6 for pnp; none: the bare circuit, "
                         "no error stated (~100 times faster)")
-    add_size_option(p, "--points", default=1000, maximum=MAX_POINTS, minimum=2,
+    add_size_option(p, "--points", default=1000, maximum=MAX_POINTS, ceiling=MAX_POINTS_CEILING, minimum=2,
                     help=f"output times (with --fidelity pnp at most {MAX_POINTS_PNP:.0e} unless --max-points is given)")
     p.add_argument("--waveform", type=waveform_type, default=None,
                    help="instead of the step of --voltage: a SPEC such as 'sine:1V@10Hz' or 'step:1V+square:0.1V@5Hz' "

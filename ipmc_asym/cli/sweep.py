@@ -13,13 +13,13 @@ import numpy as np
 from ipmc_asym.base.jsonio import dumps
 from ipmc_asym.base.progress import progress
 from ipmc_asym.base.registry import fidelity_names, model_choices, model_names
-from ipmc_asym.base.settings import MAX_ROWS
+from ipmc_asym.base.settings import MAX_ROWS, MAX_ROWS_CEILING
 from ipmc_asym.base.units import parse_vary_spec, vary_values
 from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import (
     add_output_option,
     add_strip_options,
-    count_type,
+    cap_type,
     first_run_notice,
     model_help,
     strip_and_material,
@@ -61,7 +61,7 @@ def register(sub):
     p.add_argument("--tol", type=tol_type, default=None,
                    help="relative accuracy required of I, and tolerance of the 'small' beam regime "
                         "(e.g. 1e-3 or 0.1%%; default 1%%)")
-    p.add_argument("--max-rows", type=count_type("--max-rows"), default=MAX_ROWS,
+    p.add_argument("--max-rows", type=cap_type("--max-rows", MAX_ROWS_CEILING), default=MAX_ROWS,
                    help=f"refuse a sweep of more rows than this (default {MAX_ROWS:.0e}, settings.MAX_ROWS)")
     add_output_option(p, "--out", formats=OUT_FORMATS, default=None,
                    help="output file, written in chunks and atomically; the format follows the extension: .csv "

@@ -6,6 +6,7 @@ import sys
 
 from ipmc_asym.base.jsonio import dumps
 from ipmc_asym.base.registry import compiled_fidelities
+from ipmc_asym.base.settings import MAX_SAMPLES_CEILING, MAX_STORE_SAMPLES_CEILING
 from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import (
     add_electrode_options,
@@ -40,10 +41,10 @@ def register(sub):
                        description="Sample a scene's [uncertain] table (normal, lognormal, uniform, triangular), "
                                    "report quantiles 2.5/50/97.5 %, mean, sd and Sobol' first/total indices.")
     p.add_argument("scene", metavar="SCENE.toml", help="scene with an [uncertain] table (examples/uq_nominal.toml)")
-    add_size_option(p, "--samples", default=10**5, maximum=MAX_SAMPLES, minimum=MIN_SAMPLES,
+    add_size_option(p, "--samples", default=10**5, maximum=MAX_SAMPLES, ceiling=MAX_SAMPLES_CEILING, minimum=MIN_SAMPLES,
                     help=f"model runs wanted (>= {MIN_SAMPLES}; rounded up to N(D+2), N a power of two; streamed: "
                          "memory does not grow with it, the cap bounds the time)")
-    add_size_option(p, "--store-samples", default=STORE_SAMPLES, maximum=MAX_STORE_SAMPLES, minimum=0,
+    add_size_option(p, "--store-samples", default=STORE_SAMPLES, maximum=MAX_STORE_SAMPLES, ceiling=MAX_STORE_SAMPLES_CEILING, minimum=0,
                     help="runs kept per sample for --out and --plot: the first whole Saltelli groups of the design "
                          "(the statistics use every run)")
     p.add_argument("--fidelity", default=None, choices=list(compiled_fidelities()),

@@ -636,10 +636,13 @@ def substep_grid(t, tau, h_max, substeps, too_long):
     time in the grid.  ``too_long`` = (whose substeps, what to do) for the refusal where the grid
     would pass :data:`MAX_SUBSTEPS`; the refusal states the longest chunk in tau and in seconds.
     """
-    dt = np.diff(t) / tau
-    # counted in floating point first: a duration of 1e30 s would overflow the integer count
-    kf = np.maximum(np.ceil(dt / h_max), np.where(dt <= 0.5 * h_max, 1, substeps))
-    if not np.all(np.isfinite(kf)) or kf.sum() > MAX_SUBSTEPS:
+    # counted in floating point first: a duration of 1e30 s would overflow the integer count, and
+    # one of 1e308 s overflows the float count to inf, which the refusal below names
+    with np.errstate(over="ignore", invalid="ignore"):
+        dt = np.diff(t) / tau
+        kf = np.maximum(np.ceil(dt / h_max), np.where(dt <= 0.5 * h_max, 1, substeps))
+        total = kf.sum()
+    if not np.all(np.isfinite(kf)) or total > MAX_SUBSTEPS:
         span = MAX_SUBSTEPS * h_max
         whose, advice = too_long
         raise ValueError(f"duration is too long for {whose} fixed substeps (at most {MAX_SUBSTEPS:.0e} of at most "

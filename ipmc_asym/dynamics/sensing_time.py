@@ -58,7 +58,7 @@ from ipmc_asym.dynamics.sensing import (
     voc_hat_leading,
 )
 from ipmc_asym.dynamics.waveforms import Waveform, parse_waveform
-from ipmc_asym.forward.sensing import DEFAULT_NU, tip_curvature
+from ipmc_asym.forward.sensing import DEFAULT_NU, MAX_TIP_DISPLACEMENT, tip_curvature
 from ipmc_asym.integral.sensing import B_LIMIT, sense_hat, strain_parameter
 from ipmc_asym.kernels.lti import lti_foh
 from ipmc_asym.model import groups
@@ -158,7 +158,8 @@ def _knots(wave: Waveform, duration, points):
         sub = max(1, math.ceil(h_out / h_need))
     n = (points - 1) * sub
     if n > MAX_SENSE_STEPS:
-        raise ValueError(f"waveform: the interpolation of the tip displacement to {INTERP_TOL:g} needs {n:.3g} steps "
+        said = f"{n:.3g}" if n < 10**300 else "over 1e300"  # an integer count past the floats (a duration of 1e308 s)
+        raise ValueError(f"waveform: the interpolation of the tip displacement to {INTERP_TOL:g} needs {said} steps "
                          f"over the duration (at most {MAX_SENSE_STEPS:g}): shorten the duration or lower the frequency")
     tj, _ = wave.jumps(0.0, duration)
     if tj.size > MAX_SENSE_STEPS:
@@ -238,6 +239,9 @@ def sensing_transient(waveform, duration, points: int = 2001, strip: Strip | Non
     L, e = s.length, s.e
     # the largest bend the drive reaches: the static sense's refusal (a face losing all its water)
     _, peak = _second_derivative_scale(wave)
+    if peak > MAX_TIP_DISPLACEMENT:  # the static sense's guard: kappa = 3 w/L^2 would overflow
+        raise ValueError(f"waveform: a peak tip displacement of {peak:.3g} m; up to {MAX_TIP_DISPLACEMENT:g} m allowed "
+                         "(a numerical guard)")
     k_peak = float(tip_curvature(peak, L, support))
     if abs(float(strain_parameter(k_peak, s.thickness, nu, m))) >= B_LIMIT:
         raise ValueError(f"waveform: a peak tip displacement of {peak:.3g} m gives (1 - 2 nu) |kappa0| e/phi4 >= 1 "

@@ -30,10 +30,11 @@ import re
 import numpy as np
 
 from ipmc_asym.base.inputs import read_input_text
+from ipmc_asym.base.settings import FREQUENCY_RANGE, MIN_TIME
 from ipmc_asym.base.units import parse_length, parse_quantity, parse_time, parse_voltage
 from ipmc_asym.model.params import check_finite, check_voltage_cap
 
-__all__ = ["Waveform", "parse_waveform", "WAVEFORM_KINDS", "MAX_CSV_ROWS", "voltage_rate"]
+__all__ = ["Waveform", "parse_waveform", "WAVEFORM_KINDS", "MAX_CSV_ROWS", "voltage_rate", "check_time_span"]
 
 WAVEFORM_KINDS = ("dc", "step", "ramp", "sine", "square", "triangle", "csv")
 
@@ -45,6 +46,20 @@ def _freq(name, text):
     v = parse_quantity(name, text, {"Hz": 1.0, "kHz": 1e3, "mHz": 1e-3, "MHz": 1e6}, "frequency")
     if not v > 0:
         raise ValueError(f"{name} must be > 0 Hz; got {text!r}")
+    lo, hi = FREQUENCY_RANGE  # its period a normal float, at least MIN_TIME
+    if not lo <= v <= hi:
+        raise ValueError(f"the frequency must be within {lo:g}..{hi:g} Hz (settings.FREQUENCY_RANGE, a numerical "
+                         f"guard); got {text.strip()!r}")
+    return v
+
+
+def check_time_span(name, value) -> float:
+    """``value`` (s) a finite time of at least :data:`~ipmc_asym.base.settings.MIN_TIME` (a ramp time, a
+    duration), else a one-line ``ValueError`` naming ``name``."""
+    v = check_finite(name, value, "a finite time in seconds")
+    if not v >= MIN_TIME:
+        raise ValueError(f"{name} must be at least {MIN_TIME:g} s (settings.MIN_TIME, a numerical guard: the period "
+                         f"of the highest frequency settings.FREQUENCY_RANGE accepts); got {value!r}")
     return v
 
 
@@ -227,9 +242,7 @@ def parse_waveform(spec, quantity="voltage") -> Waveform:
                 tr, _, t0 = rest.partition("@")
                 if not tr:
                     raise ValueError("ramp needs V/TR, e.g. ramp:1V/0.1s")
-                trv = parse_time(name, tr)
-                if not trv > 0:
-                    raise ValueError("the ramp time TR must be > 0 s")
+                trv = check_time_span("the ramp time TR", parse_time(name, tr))
                 terms.append((kind, {"V": parse_value(name, a), "tr": trv, "t0": parse_time(name, t0) if t0 else 0.0}))
             else:
                 a, _, rest = arg.partition("@")

@@ -29,14 +29,15 @@ import numpy as np
 from ipmc_asym.base.ladder import first_shown
 from ipmc_asym.base.registry import check_choice
 from ipmc_asym.base.results import Panel, ResultMixin, ResultSpec
-from ipmc_asym.base.settings import VALIDITY_LIMIT
+from ipmc_asym.base.settings import MAX_DIMENSION, MIN_DIMENSION, VALIDITY_LIMIT
 from ipmc_asym.integral.charge import _subnormal_rounding
 from ipmc_asym.integral.sensing import B_LIMIT, charge_scale_sensing, debye_length, sense_hat, strain_parameter
 from ipmc_asym.model import groups
 from ipmc_asym.model.params import NAFION_LI, NOMINAL_STRIP, Material, Strip
 from ipmc_asym.model.request import Request
 
-__all__ = ["SenseResult", "sense", "SENSE_SUPPORTS", "SENSE_LOADS", "DEFAULT_NU", "tip_curvature"]
+__all__ = ["SenseResult", "sense", "SENSE_SUPPORTS", "SENSE_LOADS", "DEFAULT_NU", "tip_curvature", "MAX_CURVATURE",
+           "MAX_TIP_DISPLACEMENT"]
 
 #: support cases of an imposed tip displacement
 SENSE_SUPPORTS = ("free", "tip-force")
@@ -116,12 +117,24 @@ class SenseResult(ResultMixin):
         return self.Q if self.load == "short" else self.V_oc
 
 
-def _check_array(name, value, unit):
+#: largest |curvature| (1/m) and |tip displacement| (m) sense takes: a numerical guard.  A bend radius
+#: below the smallest dimension of a strip (settings.MIN_DIMENSION) or a tip moved further than the
+#: largest (settings.MAX_DIMENSION) is no bend of an accepted strip; within both, the tip displacement,
+#: the curvature and the strain parameter of every accepted strip stay finite (no overflow of kappa L^2)
+MAX_CURVATURE = round(1.0 / MIN_DIMENSION)
+MAX_TIP_DISPLACEMENT = MAX_DIMENSION
+
+
+def _check_array(name, value, unit, cap):
     a = np.atleast_1d(np.asarray(value, dtype=float))
     if a.ndim != 1:
         raise ValueError(f"{name} must be a number or a 1-D list of numbers ({unit})")
     if not np.all(np.isfinite(a)):
         raise ValueError(f"{name} must be finite ({unit})")
+    big = float(np.max(np.abs(a), initial=0.0))
+    if big > cap:
+        raise ValueError(f"{name}: |value| up to {cap:g} {unit} allowed (a numerical guard: a bend radius of at least "
+                         f"{MIN_DIMENSION:g} m and a tip displacement of at most {MAX_DIMENSION:g} m); got {big:.3g} {unit}")
     return a
 
 
@@ -160,10 +173,10 @@ def sense(strip: Strip | None = None, curvature=None, tip_displacement=None, sup
         raise ValueError("model: sensing needs one of the paper's permittivity models (constant, linear, affine)")
     L = strip.length
     if curvature is not None:
-        kap = _check_array("curvature", curvature, "1/m")
+        kap = _check_array("curvature", curvature, "1/m", MAX_CURVATURE)
         w = kap * L**2 / (2.0 if support == "free" else 3.0)
     else:
-        w = _check_array("tip_displacement", tip_displacement, "m")
+        w = _check_array("tip_displacement", tip_displacement, "m", MAX_TIP_DISPLACEMENT)
         kap = tip_curvature(w, L, support)
     b0 = strain_parameter(kap, strip.thickness, nu, mat)
     if np.any(np.abs(b0) >= B_LIMIT):

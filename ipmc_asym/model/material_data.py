@@ -43,7 +43,7 @@ from ipmc_asym.base.inputs import read_input_text
 from ipmc_asym.base.units import parse_quantity
 from ipmc_asym.model.electrode import METALS, NO_ELECTRODE, Electrode, electrode_from_spec
 
-__all__ = ["Parameter", "MaterialSet", "PARAMETERS", "MATERIAL_FIELDS", "set_names", "load_set", "read_set",
+__all__ = ["Parameter", "MaterialSet", "PARAMETERS", "MATERIAL_FIELDS", "SCHEMA_VERSIONS", "set_names", "load_set", "read_set",
            "parse_set"]
 
 _F = 96487.0  # the paper's Faraday constant (section 4), used for IEC -> Z3
@@ -71,6 +71,8 @@ PARAMETERS = {
 MATERIAL_FIELDS = ("Z3", "rho3", "phi4", "rho2", "E", "T", "F", "R", "D")
 #: a set must give these (or IEC for Z3); the others fall back to the library default
 _REQUIRED = ("rho3", "phi4", "E")
+#: the versions of this file format the reader knows (``schema = 1``; a file without it is read as 1)
+SCHEMA_VERSIONS = (1,)
 _TOP = {"schema", "name", "title", "membrane", "cation", "c_moy", "description", "sources", "parameters",
         "permittivity", "electrode"}
 #: keys of the optional ``[electrode]`` table: the metal layers of the set's strips (the metal's
@@ -243,6 +245,11 @@ def parse_set(data: dict, origin: str = "built-in", defaults: dict | None = None
     for k in data:
         if k not in _TOP:
             raise ValueError(f"material file {origin}: unknown key {k!r}; allowed: {', '.join(sorted(_TOP))}")
+    schema = data.get("schema", SCHEMA_VERSIONS[0])
+    # a later format may mean other things by the same keys: read only the versions known here
+    if isinstance(schema, bool) or not isinstance(schema, int) or schema not in SCHEMA_VERSIONS:
+        raise ValueError(f"material file {origin}: schema = {schema!r} is not supported; supported: "
+                         f"{', '.join(map(str, SCHEMA_VERSIONS))}")
     name = data.get("name")
     if not isinstance(name, str) or not name.strip():
         raise ValueError(f"material file {origin}: name must be a non-empty string")

@@ -30,6 +30,8 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ipmc_asym.base.settings import (
+    C_MOY_RANGE,
+    DIFFUSION_RANGE,
     FREQUENCY_RANGE,
     MAX_DIMENSION,
     MAX_VOLTAGE,
@@ -65,6 +67,9 @@ __all__ = [
     "check_finite",
     "check_min_thickness",
     "check_dimension",
+    "check_within",
+    "check_diffusion",
+    "check_c_moy",
     "check_voltage_cap",
     "check_voltages",
     "check_frequencies",
@@ -222,6 +227,28 @@ def check_positive(name: str, value, unit: str = "") -> float:
     return v
 
 
+def check_within(name: str, value, bounds, unit: str, why: str) -> float:
+    """``value`` as a float within ``bounds`` = (low, high), else a one-line ``ValueError`` naming
+    ``name``, the range with its ``unit`` and ``why`` it holds."""
+    lo, hi = bounds
+    allowed = f"a finite number within {lo:g}..{hi:g} {unit} ({why})"
+    v = check_finite(name, value, allowed)
+    if not lo <= v <= hi:
+        raise ValueError(f"{name} must be {allowed}; got {value!r}")
+    return v
+
+
+def check_diffusion(value, name: str = "cation diffusion coefficient D") -> float:
+    """``value`` (m^2/s) within :data:`ipmc_asym.base.settings.DIFFUSION_RANGE`, else one line naming ``name``."""
+    return check_within(name, value, DIFFUSION_RANGE, "m^2/s", "a numerical guard: every dynamic time scales as 1/D")
+
+
+def check_c_moy(value, name: str = "c_moy") -> float:
+    """``value`` (mol/m^3) within :data:`ipmc_asym.base.settings.C_MOY_RANGE`, else one line naming ``name``."""
+    return check_within(name, value, C_MOY_RANGE, "mol/m^3",
+                        "a numerical guard: the Debye length goes as C_moy^-1/2")
+
+
 @dataclass(frozen=True)
 class Material:
     """Ionic polymer data (SI).  ``c_moy`` is ``"paper"``, ``"formula"`` or a number (mol/m^3).
@@ -292,7 +319,7 @@ class Material:
         check_positive("temperature T", self.T, "K")
         check_positive("Faraday constant F", self.F, "C/mol")
         check_positive("gas constant R", self.R, "J/(mol K)")
-        check_positive("cation diffusion coefficient D", self.D, "m^2/s")
+        check_diffusion(self.D)
         sl = check_finite("strain_limit", self.strain_limit, "in the open interval (0, 1)")
         if not 0.0 < sl < 1.0:
             raise ValueError(f"strain_limit must be in the open interval (0, 1), e.g. 0.01; got {self.strain_limit!r}")
@@ -308,7 +335,9 @@ class Material:
                     f"c_moy must be 'paper', 'formula' or a number > 0 mol/m^3; got {self.c_moy!r}"
                 )
         else:
-            check_positive("c_moy", self.c_moy, "mol/m^3")
+            check_c_moy(self.c_moy)
+        if self.c_moy == "formula":  # eq. (17) from phi4, rho3 and Z3, each accepted on its own
+            check_c_moy(self.C_moy_formula, "C_moy (formula, eq. (17) from phi4, rho3 and Z3)")
 
     @property
     def C_moy_formula(self) -> float:
@@ -460,6 +489,8 @@ def material_from_spec(spec=None, labels=None) -> Material:
                 raise ValueError(bad) from None
         if not isinstance(v, str) and not (math.isfinite(v) and v > 0):
             raise ValueError(bad)
+        if not isinstance(v, str):
+            check_c_moy(v, name("c_moy"))
         if v == "paper" and base.name not in _PAPER_SETS:  # 3082 is the paper's Nafion Li+ value
             raise ValueError(f"{name('c_moy')} = paper is the C_moy the paper states for its Nafion Li+; the material "
                              f"{base.name} takes formula (eq. (17) from its own data) or a number in mol/m^3")

@@ -68,7 +68,7 @@ from ipmc_asym.base.units import (
 )
 from ipmc_asym.beam.statics import blocking_force_ratio
 from ipmc_asym.model.parameters import ALIASES, PARAMETERS, parse_value, with_values
-from ipmc_asym.model.params import NAFION_LI, Material, Strip
+from ipmc_asym.model.params import NAFION_LI, Material, Strip, check_c_moy, check_diffusion
 from ipmc_asym.model.permittivity import Permittivity, get_model
 from ipmc_asym.parallel.executors import run_chunks
 
@@ -375,7 +375,14 @@ def free_warnings(bounds: dict) -> list:
 
 def _bound(k, x):
     """A bound of ``--free k`` in SI (a bare number or a value with one of the parameter's units)."""
-    return parse_value(k, x, k if k == "modulus" else f"--free {k}")
+    where = k if k == "modulus" else f"--free {k}"
+    v = parse_value(k, x, where)
+    # a bound past the material's own range would be refused in the middle of the fit
+    if k == "diffusion":
+        check_diffusion(v, where)
+    elif k == "c_moy":
+        check_c_moy(v, where)
+    return v
 
 
 # ---- forward model ---------------------------------------------------------------------------

@@ -55,7 +55,7 @@ from ipmc_asym.base.settings import DEFAULT_SCENE_TOL, MAX_ROWS
 from ipmc_asym.base.units import parse_length, parse_voltage
 from ipmc_asym.forward.escalation import check_tol
 from ipmc_asym.model.limits import material_warnings, range_warning, value_warning
-from ipmc_asym.model.params import NOMINAL_STRIP, Material, Strip, material_from_spec
+from ipmc_asym.model.params import NOMINAL_STRIP, Material, Strip, check_dimension, check_voltage_cap, material_from_spec
 
 __all__ = ["Scene", "OUTPUTS", "AXES", "load_scene", "parse_scene", "read_scene"]
 
@@ -157,14 +157,15 @@ def _num_or_str(key, v):
 
 
 def _length(key, v):
-    x = parse_length(key, _num_or_str(key, v))
-    if x <= 0:
-        raise ValueError(f"{key} must be > 0 m; got {v!r}")
-    return x
+    # the strip's own caps, at the scene's edge (the thickness keeps its stricter floor, checked with the grid)
+    return check_dimension(key, parse_length(key, _num_or_str(key, v)), floor="thickness" not in key)
 
 
 def _voltage(key, v):
-    return parse_voltage(key, _num_or_str(key, v))
+    # capped here, at the scene's edge: the rungs would each overflow F|phi0|/(R T) before refusing it
+    x = parse_voltage(key, _num_or_str(key, v))
+    check_voltage_cap(x, key)
+    return x
 
 
 def _values(key, spec, axis):

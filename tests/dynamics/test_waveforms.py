@@ -90,3 +90,22 @@ def test_voltage_rate_of_a_plain_callable_is_one_sided_at_a_jump():
     # a parsed waveform: the regular part of its own derivative (its jumps left out)
     w = parse_waveform("sine:1V@2Hz+square:0.5V@1Hz")
     assert voltage_rate(w, t, 1e-5) == pytest.approx(2.0 * math.pi * 2.0 * np.cos(2.0 * math.pi * 2.0 * t))
+
+
+def test_a_ramp_time_or_period_past_the_numerical_guard_is_refused_naming_the_term():
+    from ipmc_asym.base.settings import FREQUENCY_RANGE, MIN_TIME
+
+    for spec, what in (("ramp:1V/1e-320s", "the ramp time TR must be at least 1e-12 s"),
+                       ("ramp:1V/5e-324s", "the ramp time TR must be at least"),
+                       ("ramp:1V/1e-13s", "the ramp time TR must be at least"),
+                       ("sine:1V@1e300Hz", "the frequency must be within 1e-09..1e+12 Hz"),
+                       ("square:1V@1e-320Hz", "the frequency must be within"),
+                       ("dc:0.1V+triangle:1V@2e12Hz", "the frequency must be within")):
+        with pytest.raises(ValueError) as ei:
+            parse_waveform(spec)
+        msg = str(ei.value)
+        assert msg.startswith("waveform term '") and what in msg and "\n" not in msg, msg
+    # the ends themselves are taken, and give finite values and slopes
+    w = parse_waveform(f"ramp:1V/{MIN_TIME}s+sine:0.1V@{FREQUENCY_RANGE[1]}Hz+sine:0.1V@{FREQUENCY_RANGE[0]}Hz")
+    t = np.linspace(0.0, 10 * MIN_TIME, 11)
+    assert np.all(np.isfinite(w(t))) and np.all(np.isfinite(w.derivative(t)))

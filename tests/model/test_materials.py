@@ -179,3 +179,18 @@ def test_a_material_file_has_the_input_cap_of_every_input_file(tmp_path):
     (tmp_path / "d.toml").mkdir()
     with pytest.raises(ValueError, match="is a directory"):
         material_data.read_set(tmp_path / "d.toml")
+
+
+def test_a_material_file_of_an_unknown_schema_is_refused_listing_the_supported_ones(tmp_path):
+    text = (ROOT / "ipmc_asym" / "materials" / "nafion-117-h.toml").read_text(encoding="utf-8")
+    assert "\nschema = 1\n" in text
+    for bad in ("99", "0", "1.0", "true", '"1"'):
+        p = tmp_path / "m.toml"
+        p.write_text(text.replace("\nschema = 1\n", f"\nschema = {bad}\n"), encoding="utf-8")
+        with pytest.raises(ValueError, match=r"schema = .* is not supported; supported: 1$") as ei:
+            Material.from_file(p)
+        assert "\n" not in str(ei.value)
+    p.write_text(text, encoding="utf-8")
+    assert Material.from_file(p).E > 0
+    p.write_text(text.replace("\nschema = 1\n", "\n"), encoding="utf-8")  # no schema: read as 1
+    assert Material.from_file(p).E > 0

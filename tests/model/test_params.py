@@ -50,3 +50,56 @@ def test_a_strip_refuses_a_subnormal_length_or_width_by_name():
             Strip(**kw)
     with pytest.raises(ValueError, match="MIN_THICKNESS"):  # the thickness keeps its own, stricter floor
         Strip(thickness=1e-320)
+
+
+def test_a_material_refuses_a_diffusion_coefficient_outside_its_range_in_one_line():
+    from ipmc_asym.base.settings import DIFFUSION_RANGE
+    from ipmc_asym.model.params import NAFION_LI
+
+    for bad in (1e308, 1e-320, 0.5 * DIFFUSION_RANGE[0], 2.0 * DIFFUSION_RANGE[1]):
+        with pytest.raises(ValueError, match=r"^cation diffusion coefficient D must be a finite number within "
+                                             r"1e-30\.\.1e\+10 m\^2/s") as ei:
+            NAFION_LI.with_(D=bad)
+        assert "\n" not in str(ei.value)
+
+
+def test_a_material_refuses_a_mean_concentration_outside_its_range_in_one_line():
+    from ipmc_asym.base.settings import C_MOY_RANGE
+    from ipmc_asym.model.params import NAFION_LI, material_from_spec
+
+    for bad in (1e-320, 0.5 * C_MOY_RANGE[0], 2.0 * C_MOY_RANGE[1]):
+        with pytest.raises(ValueError, match=r"^c_moy must be a finite number within 0\.001\.\.1e\+08 mol/m\^3"):
+            NAFION_LI.with_(c_moy=bad)
+        with pytest.raises(ValueError, match=r"^--c-moy must be a finite number within"):
+            material_from_spec({"c_moy": bad}, {"c_moy": "--c-moy"})
+    # eq. (17) from data each accepted on its own
+    with pytest.raises(ValueError, match=r"^C_moy \(formula, eq\. \(17\) from phi4, rho3 and Z3\) must be"):
+        NAFION_LI.with_(c_moy="formula", rho3=1e-300)
+
+
+@pytest.mark.parametrize("end", [0, 1])
+def test_the_ends_of_the_diffusion_range_give_finite_dynamics(end):
+    from ipmc_asym.base.settings import DIFFUSION_RANGE
+    from ipmc_asym.dynamics.circuit import frequency_response, step_response
+    from ipmc_asym.model.params import NAFION_LI
+
+    m = NAFION_LI.with_(D=DIFFUSION_RANGE[end])
+    for th in (200e-9, 200e-6, 1.0):
+        s = Strip(thickness=th)
+        r = step_response(1.0, strip=s, material=m, points=5)
+        assert np.all(np.isfinite(r.t)) and np.all(np.isfinite(r.sigma)) and np.all(np.isfinite(r.current_density))
+        f = frequency_response([1e-9, 1.0, 1e12], strip=s, material=m)
+        assert np.all(np.isfinite(f.Z)) and np.all(np.isfinite(f.H_w))
+
+
+@pytest.mark.parametrize("end", [0, 1])
+def test_the_ends_of_the_concentration_range_give_answers(end):
+    import ipmc_asym as ia
+    from ipmc_asym.base.settings import C_MOY_RANGE
+    from ipmc_asym.model.params import NAFION_LI
+
+    m = NAFION_LI.with_(c_moy=C_MOY_RANGE[end])
+    for th in (200e-9, 200e-6, 1.0):
+        c = ia.charge(th, 1.0, material=m)
+        assert np.isfinite(float(c.Q)) and float(c.Q) > 0
+        assert np.isfinite(float(ia.moment(th, 1.0, material=m).I))

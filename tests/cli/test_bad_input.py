@@ -1,0 +1,101 @@
+"""Bad input on the command line: one line naming the option and what it allows, exit 2, and no
+NumPy warning printed before it (the commands run with NumPy's default floating-point warnings)."""
+
+from __future__ import annotations
+
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+from references import REPO
+
+from ipmc_asym.cli import main
+
+EXAMPLES = Path(REPO) / "examples"
+
+
+def _refused(capsys, argv):
+    """The one line of a refusal (exit 2), with no RuntimeWarning raised on the way."""
+    with np.errstate(all="warn", under="ignore"), warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            rc = main(argv)
+        except SystemExit as exc:  # argparse's own refusals (one line, status 2)
+            rc = exc.code
+    err = capsys.readouterr().err
+    numeric = [str(w.message) for w in caught if issubclass(w.category, RuntimeWarning)]
+    assert not numeric, numeric
+    lines = [ln for ln in err.splitlines() if ln.strip() and not ln.startswith("ipmc-asym: warning:")]
+    assert rc == 2 and len(lines) == 1, err
+    assert "Warning" not in err and "Traceback" not in err
+    return lines[0]
+
+
+@pytest.mark.parametrize("argv, named", [
+    (["step", "--diffusion", "1e308"], "--diffusion must be a finite number within 1e-30..1e+10 m^2/s"),
+    (["step", "--diffusion", "1e-320"], "--diffusion must be a finite number within 1e-30..1e+10 m^2/s"),
+    (["estimate", "--c-moy", "1e-320"], "--c-moy must be a finite number within 0.001..1e+08 mol/m^3"),
+    (["charge", "--c-moy", "1e12"], "--c-moy must be a finite number within 0.001..1e+08 mol/m^3"),
+])
+def test_a_diffusion_coefficient_or_concentration_out_of_range_names_the_option(capsys, argv, named):
+    assert named in _refused(capsys, argv)
+
+
+def test_the_ends_of_the_diffusion_range_run(capsys):
+    for d in ("1e-30", "1e10"):
+        assert main(["step", "--diffusion", d, "--points", "3", "--tol", "none", "--json"]) == 0
+    capsys.readouterr()
+
+
+@pytest.mark.parametrize("argv, named", [
+    (["step", "--duration", "1e308"], "duration is too long for the reduced model's fixed substeps"),
+    (["sense", "--curvature", "1e308"], "curvature: |value| up to 1e+09 1/m allowed"),
+    (["sense", "--tip-displacement", "1e308"], "tip_displacement: |value| up to 1000 m allowed"),
+    (["sense", "--curvature", "1e308", "--nu", "0.5", "--length", "10m"], "curvature: |value| up to"),
+    (["sense", "--waveform", "step:1e308m", "--duration", "1s", "--nu", "0.5"], "waveform: a peak tip displacement"),
+    (["sense", "--waveform", "sine:1mm@1Hz", "--duration", "1e308"], "needs over 1e300 steps"),
+])
+def test_a_refusal_comes_without_numpy_warnings_before_it(capsys, argv, named):
+    assert named in _refused(capsys, argv)
+
+
+@pytest.mark.parametrize("line, named", [('voltage = "1e308V"', "voltage: |phi0| up to 1000 V allowed"),
+                                         ('voltages = ["1V", "2kV"]', "voltages[1]: |phi0| up to 1000 V"),
+                                         ('voltage = "1V"\n[strip]\nthickness = "1e308m"',
+                                          "strip.thickness must be at most 1000 m")])
+def test_a_scene_past_a_cap_is_refused_by_its_key_before_any_rung_runs(tmp_path, capsys, line, named):
+    p = tmp_path / "s.toml"
+    p.write_text(f'name = "x"\nmodel = "constant"\n{line}\n', encoding="utf-8")
+    assert named in _refused(capsys, ["scene", str(p)])
+
+
+@pytest.mark.parametrize("argv, flag, ceiling", [
+    (["sweep", "--vary", "length=1cm:2cm:3", "--max-rows", "1e12"], "--max-rows", "1e+09"),
+    (["fit", str(EXAMPLES / "dynamic_step.csv"), "--free", "diffusion", "--max-rows", "1e12"], "--max-rows", "1e+06"),
+    (["uq", str(EXAMPLES / "uq_nominal.toml"), "--max-samples", "1e300"], "--max-samples", "1e+09"),
+    (["uq", str(EXAMPLES / "uq_nominal.toml"), "--max-store-samples", "1e12"], "--max-store-samples", "2e+07"),
+    (["fit", str(EXAMPLES / "dynamic_step.csv"), "--free", "diffusion", "--max-multistart", "1e9"],
+     "--max-multistart", "10000"),
+    (["figures", "--out", "{tmp}/figs", "--max-dpi", "1e9"], "--max-dpi", "2400"),
+    (["step", "--max-points", "1e9"], "--max-points", "1e+06"),
+    (["freq", "--from", "1Hz", "--to", "2Hz", "--max-points", "1e9"], "--max-points", "1e+06"),
+])
+def test_a_settable_cap_has_a_ceiling(tmp_path, capsys, argv, flag, ceiling):
+    line = _refused(capsys, [a.replace("{tmp}", str(tmp_path)) for a in argv])
+    assert f"{flag} must be an integer from 1 to {ceiling} (the ceiling of this cap" in line, line
+
+
+def test_a_ramp_time_below_the_floor_is_refused_naming_the_term(capsys):
+    line = _refused(capsys, ["drive", "--waveform", "ramp:1V/1e-320s", "--duration", "1s"])
+    assert "waveform term 'ramp:1V/1e-320s': the ramp time TR must be at least 1e-12 s" in line, line
+    line = _refused(capsys, ["step", "--duration", "1e-320"])
+    assert "--duration must be at least 1e-12 s" in line, line
+
+
+def test_a_material_file_of_an_unknown_schema_is_refused(tmp_path, capsys):
+    text = (Path(REPO) / "ipmc_asym" / "materials" / "nafion-117-h.toml").read_text(encoding="utf-8")
+    p = tmp_path / "m.toml"
+    p.write_text(text.replace("\nschema = 1\n", "\nschema = 99\n"), encoding="utf-8")
+    for argv in (["materials", str(p)], ["estimate", "--material", str(p)]):
+        assert "schema = 99 is not supported; supported: 1" in _refused(capsys, argv)
