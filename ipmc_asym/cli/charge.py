@@ -6,7 +6,15 @@ from ipmc_asym.base.jsonio import dumps
 from ipmc_asym.base.registry import fidelity_names, model_choices
 from ipmc_asym.base.units import fmt_length
 from ipmc_asym.cli import SUMMARIES
-from ipmc_asym.cli.common import add_strip_options, first_run_notice, spread_count, strip_and_material, warn
+from ipmc_asym.cli.common import (
+    add_document_out,
+    add_strip_options,
+    first_run_notice,
+    spread_count,
+    strip_and_material,
+    warn,
+    write_document,
+)
 from ipmc_asym.forward.charge import charge_report
 
 
@@ -18,6 +26,7 @@ def register(sub):
                    help="rung of the fidelity ladder to start from (default corrected); a rung not valid for "
                         "this strip is escalated to the next valid one (said per row)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
+    add_document_out(p, "model")
 
 
 def run(args):
@@ -27,6 +36,11 @@ def run(args):
     doc = charge_report(strip, material, args.model, args.fidelity)
     for w in doc["warnings"]:
         warn(w)
+    if args.out is not None:
+        echo = {"thickness_total": strip.thickness, "half_thickness_e": strip.e, "voltage": strip.voltage,
+                "length": strip.length, "width_total": strip.width}
+        write_document(args.out, doc, [dict(echo, **r) for r in doc["results"]],
+                       {k: v for k, v in doc.items() if k != "results"})
     if args.json:
         print(dumps(doc, indent=2))
         return 0
@@ -52,4 +66,6 @@ def run(args):
         print(f"  {k:8s} {d['min']:.4g} .. {d['max']:.4g}{ratio}   numerical rel.err <= {d['numerical_error']:.1e}"
               + spread_count(d))
     print("  note: " + spread["note"])
+    if args.out is not None:
+        print(f"wrote {args.out}")
     return 0

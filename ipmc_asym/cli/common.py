@@ -7,11 +7,15 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import csv
 import math
 import os
 import re
 import sys
 
+import numpy as np
+
+from ipmc_asym.base.jsonio import dumps
 from ipmc_asym.base.settings import FREQUENCY_RANGE, MIN_THICKNESS
 from ipmc_asym.base.units import (
     fmt_length,
@@ -24,7 +28,7 @@ from ipmc_asym.base.units import (
     parse_time,
     parse_voltage,
 )
-from ipmc_asym.io.fileio import check_output_path
+from ipmc_asym.io.fileio import atomic_write, check_output_path, output_format
 from ipmc_asym.model.electrode import METALS
 from ipmc_asym.model.limits import material_warnings, range_warning, value_warning
 from ipmc_asym.model.materials import bibliography, material_comments
@@ -35,7 +39,8 @@ __all__ = ["UsageError", "Parser", "add_strip_options", "add_material_options", 
            "material_from_args", "strip_from_args", "strip_and_material",
            "arg_type", "count_type", "join_negative_values", "fmt_num", "c_moy_label", "length_type", "pressure_type",
            "voltage_type", "tol_type", "time_tol_type",
-           "first_run_notice", "spread_count", "diffusion_type", "sidecar_path", "add_size_option", "check_size_caps", "cap_type",
+           "first_run_notice", "spread_count", "diffusion_type", "sidecar_path", "DOCUMENT_FORMATS", "add_document_out",
+           "write_document", "column_rows", "add_size_option", "check_size_caps", "cap_type",
            "add_output_option", "check_outputs",
            "seed_type", "model_help", "viscous_modulus_type", "duration_type", "waveform_type", "sheet_resistance_type",
            "frequency_type", "add_beam_options", "SOLVER_ALIASES", "add_solver_option", "add_line_options",
@@ -278,6 +283,69 @@ def add_output_option(p, flag="--out", *, formats=None, kind="file", sidecar=Fal
     p.set_defaults(_outputs=tuple(outs) + ((flag, kind, tuple(formats) if formats else None),))
     if sidecar:
         p.set_defaults(_sidecars=tuple(p.get_default("_sidecars") or ()) + (flag,))
+
+
+# ---- --out of a one-document command (estimate, charge, freq) ----------------------------------------
+
+#: formats of a one-document ``--out``
+DOCUMENT_FORMATS = (".json", ".csv")
+
+
+def add_document_out(p, rows: str):
+    """``--out F.json|F.csv`` on the parser ``p``; ``rows`` says what one CSV row is."""
+    add_output_option(p, "--out", formats=DOCUMENT_FORMATS, sidecar=True, default=None, metavar="F.json|F.csv",
+                      help=f"also write the result to a file (atomically): .json the --json document; .csv one row "
+                           f"per {rows} (SI units, the header the column names), the rest of the document in "
+                           "F.csv.json")
+
+
+def write_document(path, doc: dict, rows: list, meta: dict) -> None:
+    """Write ``doc`` (the ``--json`` document) to ``path`` (.json), or ``rows`` (dicts: one CSV row
+    each, nested checks flattened to ``check_<name>``, lists joined by ``"; "``) with ``meta`` in
+    the sidecar ``path.json`` (.csv)."""
+    if output_format(path, DOCUMENT_FORMATS) == ".json":
+        with atomic_write(path) as fh:
+            fh.write(dumps(doc, indent=2) + "\n")
+        return
+    flat = [_flat(r) for r in rows]
+    cols = list(dict.fromkeys(k for r in flat for k in r))
+    with atomic_write(path) as fh:
+        wr = csv.writer(fh)
+        wr.writerow(cols)
+        for r in flat:
+            wr.writerow([_cell(r.get(k)) for k in cols])
+    with atomic_write(sidecar_path(path)) as fh:
+        fh.write(dumps(meta, indent=2) + "\n")
+
+
+def column_rows(cols: dict) -> list:
+    """Rows (dicts of Python numbers) of the equal-length columns ``cols`` (arrays)."""
+    arrs = {k: np.asarray(v).reshape(-1) for k, v in cols.items()}
+    n = min((a.size for a in arrs.values()), default=0)
+    return [{k: a[i].item() for k, a in arrs.items()} for i in range(n)]
+
+
+def _flat(row: dict) -> dict:
+    out = {}
+    for k, v in row.items():
+        if isinstance(v, dict):
+            out.update({f"check_{c}" if k == "checks" else f"{k}_{c}": x for c, x in v.items()})
+        else:
+            out[k] = v
+    return out
+
+
+def _cell(v) -> str:
+    # a number as the shortest text that reads back to the same double; None (withheld) empty
+    if v is None:
+        return ""
+    if isinstance(v, bool):
+        return str(v)
+    if isinstance(v, float):
+        return repr(float(v))  # a NumPy scalar's repr names its type
+    if isinstance(v, (list, tuple)):
+        return "; ".join(str(x) for x in v)
+    return str(v)
 
 
 def check_outputs(args):

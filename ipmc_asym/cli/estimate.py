@@ -7,6 +7,7 @@ from ipmc_asym.base.registry import fidelity_names, model_choices
 from ipmc_asym.base.units import fmt_length
 from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import (
+    add_document_out,
     add_strip_options,
     c_moy_label,
     first_run_notice,
@@ -14,6 +15,7 @@ from ipmc_asym.cli.common import (
     spread_count,
     strip_and_material,
     tol_type,
+    write_document,
 )
 from ipmc_asym.forward.estimate import SPREAD_NOTE, estimate_document
 from ipmc_asym.integral.api import interpret_small
@@ -36,6 +38,7 @@ def register(sub):
                    help="keep the pressure term of the Nernst-Planck law (paper eq. 5, dropped by the paper): "
                         "I from the exact or bvp rung, beta = (v1 - M1 v2/M2) C_moy from the material")
     p.add_argument("--json", action="store_true", help="print one JSON object {inputs, results}")
+    add_document_out(p, "model")
     p.add_argument("--compiled", action="store_true",
                    help="run the compiled kernels even for these few points (loads them from Numba's cache, "
                         "compiling them on the first run after install: use it to warm the cache); by default "
@@ -67,6 +70,9 @@ def run(args):
     for r in rows:
         if r["I"] is None:  # no rung valid: refuse the whole command, one line
             raise ValueError(r["warnings"][-1])
+    if args.out is not None:
+        write_document(args.out, doc, [dict(_echo(inputs), **r) for r in rows],
+                       {k: v for k, v in doc.items() if k != "results"})
     if args.json:
         print(dumps(doc, indent=2))
         return 0
@@ -104,7 +110,14 @@ def run(args):
             held = ", ".join(r["withheld"]) or "none"
             print(f"not valid [{r['model']}]: failed check(s) {failed} (model assumptions: numbers kept, flagged); "
                   f"withheld (n/a): {held}")
+    if args.out is not None:
+        print(f"wrote {args.out}")
     return 0
+
+
+def _echo(inputs) -> dict:
+    # the strip in every CSV row: which thickness is meant said by the column's name
+    return {k: inputs[k] for k in ("thickness_total", "half_thickness_e", "voltage", "length", "width_total")}
 
 
 def _print_spread(spread):

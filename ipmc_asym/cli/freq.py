@@ -15,12 +15,14 @@ from ipmc_asym.cli.common import (
     CLAMPED_UNITS,
     _positive,
     add_beam_options,
+    add_document_out,
     add_output_option,
     add_size_option,
     add_solver_option,
     add_strip_options,
     add_support_options,
     arg_type,
+    column_rows,
     diffusion_type,
     first_run_notice,
     fmt_num,
@@ -34,6 +36,7 @@ from ipmc_asym.cli.common import (
     support_from_args,
     voltage_type,
     warn,
+    write_document,
 )
 from ipmc_asym.dynamics.circuit import FREQ_METHODS
 from ipmc_asym.dynamics.entry import spectrum
@@ -79,6 +82,7 @@ def register(sub):
     p.add_argument("--amplitude", type=_positive("--amplitude", parse_length, "1mm"), default=None,
                    help="--mode sensing: peak tip displacement of the load columns (default 1mm)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
+    add_document_out(p, "frequency")
     add_output_option(p, "--export", formats=(".json",), metavar="F.json", default=None,
                    help="write reduced-order models of V -> w and V -> charge over [--from, --to] (poles, residues, "
                         "state space, stated error; see ipmc_asym.transfer_function)")
@@ -172,6 +176,8 @@ def run(args):
             fh.write(dumps(doc, indent=1))
         head["export"] = {"path": str(args.export), **{o: t.message for o, t in fits.items()}}
         bad = [o for o, t in fits.items() if not t.success]
+    if args.out is not None:
+        write_document(args.out, dict(head, **cols), column_rows(cols), head)
     if args.json:
         out = dict(head)
         out.update(cols)
@@ -208,6 +214,8 @@ def run(args):
         print(f"wrote {args.export}")
         if bad:
             print(f"warning: the fit of {', '.join(bad)} misses --export-tol {args.export_tol:g} (its error is stated)")
+    if args.out is not None:
+        print(f"wrote {args.out}")
     return 0
 
 
@@ -273,6 +281,8 @@ def _run_sensing(args):
             "load": load if isinstance(load, str) else "resistive", "load_resistance": None if not resistive else load,
             "tau": r.tau, "f_stream": r.f_stream, "f_d": r.f_d, "diffusion_coefficient": material.D,
             "units": units, "notes": r.notes, "warnings": warnings}
+    if args.out is not None:
+        write_document(args.out, dict(head, **cols), column_rows(cols), head)
     if args.json:
         out = dict(head)
         out.update(cols)
@@ -299,4 +309,6 @@ def _run_sensing(args):
              if resistive else "") + "; 1-way = estimate of the neglected pressure feedback")
     for n in head["notes"]:
         print(f"note: {n}")
+    if args.out is not None:
+        print(f"wrote {args.out}")
     return 0

@@ -63,3 +63,45 @@ def test_drive_sidecar_written_after_the_csv(tmp_path, capsys, monkeypatch):
     monkeypatch.setattr(drive_cmd, "_csv_rows", real)
     assert main(DRIVE + ["--out", str(out)]) == 0
     assert sorted(os.listdir(tmp_path)) == ["d.csv", "d.csv.json"]
+
+
+@pytest.mark.parametrize("command", [["estimate"], ["charge"], ["freq", "--from", "1Hz", "--to", "10Hz", "--points", "4"]])
+def test_one_document_out_is_the_json_document_or_its_rows(tmp_path, capsys, command):
+    """``--out F.json`` holds what ``--json`` prints; ``--out F.csv`` its rows (one per model or
+    frequency, the strip's total thickness named), the rest in ``F.csv.json``."""
+    import csv
+    import json
+
+    def timeless(doc):  # each run's own CPU time aside
+        for r in doc.get("results", ()):
+            r.pop("seconds", None)
+        return doc
+
+    assert main(command + ["--json"]) == 0
+    printed = timeless(json.loads(capsys.readouterr().out))
+    assert main(command + ["--out", str(tmp_path / "r.json")]) == 0
+    assert capsys.readouterr().out.rstrip().endswith(f"wrote {tmp_path / 'r.json'}")
+    assert timeless(json.loads((tmp_path / "r.json").read_text())) == printed
+    assert main(command + ["--out", str(tmp_path / "r.csv"), "--json"]) == 0
+    assert timeless(json.loads(capsys.readouterr().out)) == printed  # stdout stays one JSON document
+    with open(tmp_path / "r.csv", newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    meta = json.loads((tmp_path / "r.csv.json").read_text())
+    if command[0] == "freq":
+        assert [float(r["f"]) for r in rows] == printed["f"]
+        assert [float(r["Z_phase"]) for r in rows] == printed["Z_phase"]
+        assert meta["thickness_total"] == printed["thickness_total"] and "f" not in meta
+    else:
+        assert [r["model"] for r in rows] == [r["model"] for r in printed["results"]]
+        key = "I" if command[0] == "estimate" else "sigma"
+        assert [float(r[key]) for r in rows] == [r[key] for r in printed["results"]]
+        assert {float(r["thickness_total"]) for r in rows} == {2.0e-4} and "results" not in meta
+
+
+@pytest.mark.parametrize("command", ["estimate", "charge", "freq"])
+def test_one_document_out_format_refused_before_the_work(tmp_path, capsys, command):
+    argv = [command] + (["--from", "1Hz", "--to", "10Hz"] if command == "freq" else [])
+    rc = main(argv + ["--out", str(tmp_path / "r.xlsx")])
+    err = capsys.readouterr().err
+    assert rc == 2 and "allowed: .json, .csv" in err and err.count("\n") == 1, err
+    assert os.listdir(tmp_path) == []
