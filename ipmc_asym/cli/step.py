@@ -25,10 +25,12 @@ from ipmc_asym.cli.common import (
     duration_type,
     first_run_notice,
     fmt_num,
+    given,
     model_help,
     sidecar_path,
     strip_and_material,
     time_tol_type,
+    warn,
     waveform_type,
 )
 from ipmc_asym.dynamics.circuit import STEP_FIDELITIES
@@ -183,6 +185,8 @@ def run(args):
         raise ValueError(f"--points {args.points:g} with --fidelity pnp is above {MAX_POINTS_PNP:g} (the pnp solver keeps "
                          f"every output time's profiles: ~10 kB each); lower --points or set --max-points")
     strip, material, _ = strip_and_material(args)
+    if args.waveform is not None and given(args, "voltage"):  # said, not silently dropped
+        warn(f"--voltage {args.voltage:g} V is not used: --waveform sets the voltage (its amplitudes are in the SPEC)")
     models = list(model_names()) if args.model == "all" else [args.model]
     stream = bool(args.out) and not args.json
     # what --tol auto means here (the library's rule, dynamics.entry.stated_tol; time_response applies

@@ -122,3 +122,15 @@ def test_step_pnp_json_states_its_default_tolerance_and_errors(capsys):
     assert np.all(np.abs(sig - ref.sigma) <= err + ref.sigma_error)
     assert np.all(np.abs(J - ref.current_density) <= jerr + ref.current_error)
     assert np.all(err <= 1e-6 * np.max(np.abs(sig)))
+
+
+@pytest.mark.parametrize("extra, said", [
+    (["--waveform", "sine:1V@10Hz", "--voltage", "3V"], 1),
+    (["--waveform", "sine:1V@10Hz", "--voltage", "1V"], 1),  # given, though equal to the default
+    (["--waveform", "sine:1V@10Hz"], 0),
+    (["--voltage", "3V"], 0),
+])
+def test_a_voltage_the_waveform_overrides_is_said(capsys, extra, said):
+    assert main(["step", "--duration", "0.01", "--points", "3", "--tol", "none", *extra]) == 0
+    err = capsys.readouterr().err
+    assert err.count("--voltage") == said and err.count("is not used: --waveform sets the voltage") == said
