@@ -47,6 +47,10 @@ MIN_DIMENSION = 1e-9
 #: has blocking electrodes and no electrode reactions, while water electrolyses above ~1.23 V
 #: (IPMCs are driven at a few volts): above this voltage every result carries a warning
 VALIDATED_VOLTAGE = 20.0
+#: the decomposition potential of water (V; the standard value at 25 C is 1.229 V): above it a real
+#: electrode may electrolyse the solvent, which the model (blocking electrodes) leaves out; said in a
+#: note beside the numbers, not a flag (IPMCs are driven at a few volts, as the paper's strips)
+ELECTROLYSIS_VOLTAGE = 1.23
 
 #: largest |phi0| (V) any command or library entry accepts (a Strip, the voltages of the moment
 #: integral, the charge and a sweep; a time-domain drive): a numerical guard, not a physical

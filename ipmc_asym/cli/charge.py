@@ -56,7 +56,8 @@ def run(args):
               + ("" if r["valid"] else "  not valid (see warning)"))
     if any(r["escalated"] for r in rows):
         print("* escalated: the requested fidelity is not valid here; the first valid rung was used")
-    print("note: " + doc["notes"][0])
+    for n in doc["notes"]:
+        print("note: " + n)
     print(f"model-form spread over {len(spread['variants'])} variants ({'; '.join(spread['over'])}):")
     for k, d in spread["quantities"].items():
         if d["min"] is None:

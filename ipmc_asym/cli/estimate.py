@@ -102,6 +102,8 @@ def run(args):
     if any(r["escalated"] for r in rows):
         print("* escalated: the requested fidelity is not valid here; the first valid rung was used")
     _print_spread(spread)
+    for n in doc["notes"]:
+        print(f"note: {n}")
     for r in rows:
         for w in r["warnings"]:
             print(f"warning [{r['model']}]: {w}")

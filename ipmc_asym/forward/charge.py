@@ -9,8 +9,9 @@ from __future__ import annotations
 
 from ipmc_asym.base.settings import VALIDITY_LIMIT
 from ipmc_asym.forward.estimate import SPREAD_NOTE, model_list, spread_variants
-from ipmc_asym.forward.model import voltage_reason
+from ipmc_asym.forward.model import model_notes, voltage_reason
 from ipmc_asym.integral.charge import charge_escalated
+from ipmc_asym.model import groups
 from ipmc_asym.model.params import NAFION_LI, Material, Strip
 from ipmc_asym.model.permittivity import MODELS
 from ipmc_asym.model.spread import spread_of
@@ -102,4 +103,5 @@ def charge_report(strip: Strip, material: Material = NAFION_LI, model: str = "al
               "note": SPREAD_NOTE}
     inputs = {"length": strip.length, "width_total": strip.width, "thickness_total": strip.thickness,
               "half_thickness_e": strip.e, "voltage": strip.voltage, "c_moy": material.C_moy}
-    return {"inputs": inputs, "results": rows, "notes": [CHARGE_NOTE], "warnings": warnings, "model_spread": spread}
+    notes = [CHARGE_NOTE] + model_notes(strip.voltage, groups.A2(strip.voltage, material), [r["model"] for r in rows])
+    return {"inputs": inputs, "results": rows, "notes": notes, "warnings": warnings, "model_spread": spread}

@@ -22,7 +22,8 @@ from ipmc_asym.base.quantities import BY_NAME as QUANTITY_NAMES
 from ipmc_asym.base.registry import check_choice
 from ipmc_asym.base.results import Panel, ResultMixin, ResultSpec
 from ipmc_asym.forward.escalation import Escalated, check_tol, moment_escalating
-from ipmc_asym.forward.model import CHECKS, FREE_STRIP_KEYS, MECHANICAL_KEYS, _forward, assumption_warnings
+from ipmc_asym.forward.model import CHECKS, FREE_STRIP_KEYS, MECHANICAL_KEYS, _forward, assumption_warnings, model_notes
+from ipmc_asym.model import groups
 from ipmc_asym.model.electrode import beam_label
 from ipmc_asym.model.groups import pressure_beta
 from ipmc_asym.model.params import (
@@ -253,7 +254,7 @@ def estimate_report(strip: Strip, models, fidelity="quadrature", material: Mater
 def estimate_document(strip: Strip, material: Material = NAFION_LI, model: str = "all", fidelity="quadrature",
                       tol=None, *, escalate: bool = True, on_invalid: str = "nan", pressure_term: bool = False,
                       thickness_note: str = "") -> dict:
-    """All of ``ipmc-asym estimate --json``: ``{"inputs", "results", "model_spread"}``.
+    """All of ``ipmc-asym estimate --json``: ``{"inputs", "results", "model_spread", "notes"}``.
 
     ``inputs`` echoes the strip, the material and the beam (with ``thickness_source`` =
     ``thickness_note`` where one is given: the material set's typical thickness stood in for
@@ -285,7 +286,8 @@ def estimate_document(strip: Strip, material: Material = NAFION_LI, model: str =
     }
     if thickness_note:
         inputs["thickness_source"] = thickness_note
-    return {"inputs": inputs, "results": rows, "model_spread": spread}
+    notes = model_notes(strip.voltage, groups.A2(strip.voltage, material), [r["model"] for r in rows])
+    return {"inputs": inputs, "results": rows, "model_spread": spread, "notes": notes}
 
 
 def _rows(strip: Strip, material: Material, reqs: list, on_invalid: str, spread: bool) -> tuple:

@@ -34,7 +34,14 @@ from ipmc_asym.base.ladder import climb, first_shown, rungs_from
 from ipmc_asym.base.registry import FIDELITIES as _FIDELITY_SPECS
 from ipmc_asym.base.registry import compiled_fidelities
 from ipmc_asym.base.results import Panel, ResultMixin, ResultSpec
-from ipmc_asym.base.settings import OUTSIDE_REGIMES, STRAIN_LIMIT, STRAIN_LIMIT_SOURCE, VALIDATED_VOLTAGE, VALIDITY_LIMIT
+from ipmc_asym.base.settings import (
+    ELECTROLYSIS_VOLTAGE,
+    OUTSIDE_REGIMES,
+    STRAIN_LIMIT,
+    STRAIN_LIMIT_SOURCE,
+    VALIDATED_VOLTAGE,
+    VALIDITY_LIMIT,
+)
 from ipmc_asym.beam.statics import REGIMES, blocking_force_ratio, solve_beam
 from ipmc_asym.forward.escalation import (
     Climb,
@@ -57,7 +64,29 @@ __all__ = ["forward", "ForwardResult", "CHECKS", "NUMERICAL_CHECKS", "ASSUMPTION
            "FREE_STRIP_KEYS", "MECHANICAL_KEYS", "TIP_POSITION_KEYS", "WITHHOLD", "SAMPLING_FIDELITIES",
            "ASSUMPTION_LIMITS", "distinct_pairs", "strain_reason", "regime_reason", "voltage_reason", "blocked_reason",
            "flag_mask", "assumption_warnings",
-           "blocked_rotation"]
+           "blocked_rotation", "model_notes", "LINEAR_SATURATION_A2"]
+
+#: A2 = F|phi0|/(R T) from which the linear model's cathode layer is saturated: its concentration at
+#: the face is within 1e-3 of 2 C_moy (B1 = 1.9991 at A2 = 7.74 on the nominal strip) and M_A within
+#: 0.2 % of its limit, so neither the moment nor the charge grows with the voltage any more
+LINEAR_SATURATION_A2 = 8.0
+
+
+def model_notes(voltage, A2, models) -> list:
+    """Notes on what the model does or leaves out at this voltage (V; ``A2`` its group), for the
+    permittivity ``models`` shown: said beside the numbers, nothing flagged (the numbers are the
+    model's).  The linear model's saturation (paper section 6.3) and water's electrolysis."""
+    notes = []
+    if "linear" in models and float(A2) >= LINEAR_SATURATION_A2:
+        notes.append(f"linear model (eps proportional to C): from A2 = F|phi0|/(R T) ~ {LINEAR_SATURATION_A2:g} "
+                     f"(here {float(A2):.3g}) its cathode layer is saturated, C = 2 C_moy at the face: its moment and "
+                     "charge no longer grow with the voltage (C_diff -> 0), the paper's section 6.3, which "
+                     "`ipmc-asym validate` checks")
+    if abs(float(voltage)) > ELECTROLYSIS_VOLTAGE:
+        notes.append(f"|phi0| = {abs(float(voltage)):g} V is above water's decomposition potential (~"
+                     f"{ELECTROLYSIS_VOLTAGE:g} V): real electrodes may electrolyse the solvent there, which this "
+                     "blocking-electrode model leaves out; the numbers are the model's")
+    return notes
 
 #: numerical validity: the rung's error bound on ``I`` and separate layers (escalation fixes
 #: them; where no rung holds, the outputs are withheld)

@@ -46,3 +46,27 @@ def test_row_is_the_json_dict_with_a_face():
     (line,) = ax.lines
     x, y = line.get_data()
     assert (x[0], y[0]) == (0.0, 0.0) and y[-1] == pytest.approx(r["y_tip"], rel=1e-12)
+
+
+def test_model_notes_say_what_the_numbers_show():
+    """The linear model's saturation note is true where it is said (an independent evaluation:
+    M_A at twice the voltage within 0.2 %), and the electrolysis note appears above 1.23 V only."""
+    from ipmc_asym.forward.estimate import estimate_document
+    from ipmc_asym.forward.model import LINEAR_SATURATION_A2
+    from ipmc_asym.model import groups
+
+    v_sat = LINEAR_SATURATION_A2 / float(groups.A2(1.0, ia.NAFION_LI))  # volts where A2 reaches the threshold
+    for v in (v_sat * 1.01, 1.0, 3.0):
+        doc = estimate_document(ia.Strip(voltage=v), ia.NAFION_LI, "linear", "quadrature", None)
+        assert sum("saturated" in n for n in doc["notes"]) == 1
+        m1 = doc["results"][0]["M_A"]
+        m2 = ia.evaluate(ia.Strip(voltage=2 * v), "linear")["M_A"]
+        assert abs(m2 / m1 - 1.0) < 2e-3
+        assert any("decomposition potential" in n for n in doc["notes"]) == (v > 1.23)
+    for th in (1e-6, 2e-3):  # thin and thick strips saturate from the same A2
+        m1, m2 = (ia.evaluate(ia.Strip(thickness=th, voltage=k * v_sat * 1.01), "linear")["M_A"] for k in (1, 2))
+        assert abs(m2 / m1 - 1.0) < 2e-3
+    below = estimate_document(ia.Strip(voltage=0.5 * v_sat), ia.NAFION_LI, "all", "quadrature", None)
+    assert below["notes"] == []
+    # not said for the models that do not saturate
+    assert estimate_document(ia.Strip(voltage=1.0), ia.NAFION_LI, "constant", "quadrature", None)["notes"] == []

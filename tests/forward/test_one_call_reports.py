@@ -28,7 +28,7 @@ def test_estimate_json_is_the_document(capsys):
     printed = json.loads(capsys.readouterr().out)
     doc = json.loads(dumps(estimate_document(Strip(thickness=200e-6), NAFION_LI, "all", "corrected")))
     assert _without_seconds(printed) == _without_seconds(doc)
-    assert list(doc) == ["inputs", "results", "model_spread"]
+    assert list(doc) == ["inputs", "results", "model_spread", "notes"]
 
 
 def test_estimate_document_rows_are_estimate_report_rows():
