@@ -92,7 +92,7 @@ def _fmt(v) -> str:
 
 def _range(a: np.ndarray) -> str:
     if a.dtype.kind == "b":
-        return f"{int(a.sum())} of {a.size} true"
+        return str(bool(a)) if a.ndim == 0 else f"{int(a.sum())} of {a.size} true"
     if a.dtype.kind not in "fciu":
         vals = list(dict.fromkeys(str(v) for v in a.reshape(-1)))
         return ", ".join(vals[:4]) + (", ..." if len(vals) > 4 else "")
@@ -134,6 +134,15 @@ class ResultMixin:
         coord = None if spec.coord is None else np.asarray(getattr(self, spec.coord))
         return spec.dim, coord, out
 
+    def _varying_label(self, arrays: dict, n: int):
+        """``(name, values)`` of the first label (an input, :attr:`ResultSpec.labels`) that is 1-D
+        of ``n`` values and not constant, or None."""
+        for name in self._result.labels:
+            v = arrays.get(name)
+            if v is not None and v.ndim == 1 and v.size == n and n > 1 and np.ptp(v) > 0:
+                return name, v
+        return None
+
     def _panels(self, arrays: dict) -> tuple:
         """The panels of :meth:`plot` (the spec's; a result whose outputs vary overrides it)."""
         return self._result.panels
@@ -166,7 +175,9 @@ class ResultMixin:
                 continue
             unit = units_of(name)[0]
             shape = "x".join(str(n) for n in a.shape) or "scalar"
-            lines.append(f"  {name:<24} {shape:>8}  {_range(a)}" + (f" [{unit}]" if unit else ""))
+            extent = BY_NAME[name].extent  # which thickness or width is meant: total, never the half
+            shown = f"{name} ({extent})" if extent else name
+            lines.append(f"  {shown:<24} {shape:>8}  {_range(a)}" + (f" [{unit}]" if unit else ""))
         for name, v in self._scalars().items():
             unit = units_of(name)[0]
             lines.append(f"  {name:<24} = {_fmt(v)}" + (f" {unit}" if unit not in ("", "1") else ""))
@@ -238,7 +249,7 @@ class ResultMixin:
         axes = fig.subplots(len(panels), 1, squeeze=False)[:, 0]
         for ax, panel in zip(axes, panels):
             self._draw(ax, panel, dim, coord, arrays)
-        fig.suptitle(self._headline(), fontsize="small")
+        fig.suptitle(textwrap.fill(self._headline(), 80), fontsize="small")  # a long headline kept in the figure
         return fig
 
     def _draw(self, ax, panel: Panel, dim, coord, arrays) -> None:
@@ -250,26 +261,34 @@ class ResultMixin:
             ax.set_xlabel(label(present[0]) if present else "")
             ax.set_ylabel(label("count"))
         else:
+            xname = panel.x
             if panel.x == dim:
                 first = np.atleast_1d(arrays[present[0]] if present else next(iter(arrays.values())))
                 x = np.arange(first.shape[0]) if coord is None else coord
+                if coord is None:  # numbered points: against the input that varies along them, if one does
+                    xname, x = self._varying_label(arrays, first.shape[0]) or (xname, x)
             else:
                 x = arrays[panel.x]
             x = np.asarray(x).reshape(-1)
+            # points in the order of an input along them (a line through unsorted points zigzags)
+            order = np.argsort(x, kind="stable") if xname != panel.x else slice(None)
+            x = x[order]
             cplx = any(arrays[y].dtype.kind == "c" for y in present)
             for k, y in enumerate(present):
                 v = np.asarray(arrays[y])
-                v = (np.abs(v) if v.dtype.kind == "c" else v).astype(float).reshape(x.size, -1)
+                v = (np.abs(v) if v.dtype.kind == "c" else v).astype(float).reshape(x.size, -1)[order]
                 if panel.ylog:
                     v = np.abs(v)
                 # a style per quantity: the lines of a panel told apart in grayscale too
                 ax.plot(x, v, linestyle=("-", "--", ":", "-.")[k % 4], marker="." if x.size < 30 else None,
                         label=units_of(y)[1])
-            ax.set_xlabel(label(panel.x))
+            ax.set_xlabel(label(xname))
             # wrapped: a long name on one line runs past a panel's height into its neighbours
-            ax.set_ylabel(textwrap.fill(label(present[0], magnitude=cplx), 32) if present else "")
-            if panel.xlog:
-                ax.set_xscale("log")
+            # an equation ("z = -e") kept on one line: its spaces made non-breaking
+            ax.set_ylabel(textwrap.fill(label(present[0], magnitude=cplx).replace(" = ", "\u00a0=\u00a0"), 32)
+                          if present else "")
+            if panel.xlog or (xname != panel.x and x.size > 2 and x[0] > 0 and x[-1] / x[0] > 100):
+                ax.set_xscale("log")  # an input spanning decades (thickness 10 um .. 1 mm)
             if panel.ylog:
                 ax.set_yscale("log")
         if len(present) > 1:

@@ -103,20 +103,24 @@ def evaluate(strip: Strip, model="constant", fidelity="quadrature", material: Ma
     row = _evaluate(strip, req, material, on_invalid)
     if pressure_term:
         _add_beta([row], material)
-    return EstimateRow(row, length=strip.length)
+    return EstimateRow(row, strip)
 
 
 class EstimateRow(ResultMixin, dict):
     """One row of :func:`evaluate`: the dict of the JSON row (its keys read as attributes too,
     ``row.theta``), with a summary with units, ``.plot()`` and ``.to_xarray()`` (the numbers as
-    0-d variables).  ``length`` (m) is the strip's, for the figure."""
+    0-d variables).  ``strip`` is the one evaluated: its length, total width and thickness and
+    voltage lead the summary and the dataset (not keys of the row, whose JSON is as before)."""
 
     _result = ResultSpec("point", None, ())
     _HEADLINE = ("model", "fidelity_used", "regime", "valid")
+    #: the strip's inputs shown with the row (vocabulary names)
+    _INPUTS = ("length", "width", "thickness", "voltage")
 
-    def __init__(self, row: dict, length: float):
+    def __init__(self, row: dict, strip: Strip):
         super().__init__(row)
-        self.length = float(length)
+        self.strip = strip
+        self.length = float(strip.length)
 
     def __getattr__(self, key):
         try:
@@ -125,9 +129,15 @@ class EstimateRow(ResultMixin, dict):
             raise AttributeError(key) from None
 
     def _arrays(self):
-        out = {k: np.asarray(v) for k, v in self.items()
-               if k in QUANTITY_NAMES and isinstance(v, (bool, int, float)) and v is not None}
+        out = {k: np.asarray(float(getattr(self.strip, k))) for k in self._INPUTS}
+        out.update({k: np.asarray(v) for k, v in self.items()
+                    if k in QUANTITY_NAMES and isinstance(v, (bool, int, float)) and v is not None})
         return "point", None, out
+
+    def _headline(self) -> str:
+        s = self.strip
+        return (super()._headline() + f" of L = {s.length * 1e3:.4g} mm, 2l = {s.width * 1e3:.4g} mm, "
+                f"2e = {s.thickness * 1e6:.4g} um, phi0 = {s.voltage:g} V")
 
     def plot(self, *, figsize=(6.4, 3.6)):
         """The free strip's centre line (:class:`StripLine`: the arc of the tip rotation ``theta``
@@ -136,7 +146,9 @@ class EstimateRow(ResultMixin, dict):
         if th is None or self.get("x_tip") is None:  # withheld: a line with nothing to plot
             return StripLine(np.empty(0), np.empty(0), self._headline()).plot(figsize=figsize)
         x, y = arc(th, self.length)
-        return StripLine(x, y, self._headline()).plot(figsize=figsize)
+        fig = StripLine(x, y, self._headline()).plot(figsize=figsize)
+        fig.axes[0].set_aspect("equal", adjustable="datalim")  # an arc drawn as an arc
+        return fig
 
 
 class StripLine(ResultMixin):

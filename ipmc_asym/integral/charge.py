@@ -72,10 +72,12 @@ class ChargeResult(ResultMixin):
     fidelity, model : str
     check_voltage : ndarray of bool  ``|phi0| <= settings.VALIDATED_VOLTAGE`` (the range validated against
                       the BVP; beyond it the numbers are kept and flagged, as the forward model's)
+    thickness, voltage : ndarray  the inputs (TOTAL 2e, m; phi0, V) broadcast: the points' coordinates
     """
 
     _result = ResultSpec("point", None, ("sigma", "Q", "C_diff", "eps_app", "error", "error_C_diff", "core", "valid"),
-                         (Panel("point", ("sigma",)), Panel("point", ("C_diff",))), names={"error": "error_sigma"})
+                         (Panel("point", ("sigma",)), Panel("point", ("C_diff",))), names={"error": "error_sigma"},
+                         labels=("thickness", "voltage"))
 
     sigma: np.ndarray
     Q: np.ndarray
@@ -88,6 +90,8 @@ class ChargeResult(ResultMixin):
     fidelity: str
     model: str
     check_voltage: np.ndarray | None = None
+    thickness: np.ndarray | None = None
+    voltage: np.ndarray | None = None
 
 
 def charge_scale(perm: Permittivity, material: Material) -> float:
@@ -209,7 +213,7 @@ def charge_at(th, v, perm: Permittivity, w: float, L: float, mat: Material, fide
     valid = accurate(err, errc) & volt_ok
     return ChargeResult(sigma=sig, Q=sig * w * L, C_diff=cdv, eps_app=cdv * th, error=err,
                         error_C_diff=errc, core=core, valid=valid, fidelity=fidelity, model=perm.name,
-                        check_voltage=volt_ok)
+                        check_voltage=volt_ok, thickness=th, voltage=v)
 
 
 def accurate(err, errc):

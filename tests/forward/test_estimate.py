@@ -41,6 +41,11 @@ def test_row_is_the_json_dict_with_a_face():
     assert "EstimateRow(model=linear" in text and "[N m]" in text and len(text.splitlines()) < 40
     ds = r.to_xarray()
     assert float(ds["M_A"]) == r["M_A"] and ds["M_A"].attrs["units"] == "N m"
+    # the strip evaluated travels with the row (not as keys: the JSON row is as before)
+    s = ia.Strip()
+    assert [float(ds[k]) for k in ("length", "width", "thickness", "voltage")] == [s.length, s.width, s.thickness,
+                                                                                  s.voltage]
+    assert "thickness" not in r and "thickness (total 2e)" in text and "2e = 200 um" in text
     ax = r.plot().axes[0]
     assert "[m]" in ax.get_xlabel() and "[m]" in ax.get_ylabel()
     (line,) = ax.lines
