@@ -52,9 +52,10 @@ def parse_quantity(name: str, text, units: dict, unit_name: str, case_sensitive:
         s = str(text)
         m = _NUM.match(s)
         if not m:
+            # a finite number and a unit, shown with the first units it takes (1V, 1mV, ...)
             raise ValueError(
-                f"{name}: cannot read {text!r} as a {unit_name} (examples: "
-                f"{', '.join(list(units)[:4])}; a bare number is SI)"
+                f"{name}: cannot read {text!r} as a {unit_name}: a finite number with one of the units "
+                f"{', '.join(list(units)[:4])}, ... (e.g. 1{next(iter(units))}), or a bare number in SI"
             )
         v = float(m.group(1))
         u = m.group(2)

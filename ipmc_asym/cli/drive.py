@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import argparse
 import os
 import sys
 
@@ -19,6 +20,7 @@ from ipmc_asym.cli.common import (  # noqa: F401  (CLAMPED_UNITS, viscous_modulu
     add_solver_option,
     add_strip_options,
     add_support_options,
+    arg_type,
     count_type,
     diffusion_type,
     duration_type,
@@ -56,9 +58,18 @@ from ipmc_asym.io.textfmt import format_table
 MAX_JSON_POINTS = 1_000_000
 
 
+def _voltage_in_waveform(text):
+    raise ValueError(f"drive takes its voltage in --waveform (e.g. --waveform step:{text.strip()} or "
+                     f"sine:{text.strip()}@1Hz); --voltage is step's and estimate's")
+
+
 def register(sub):
     p = sub.add_parser("drive", help=SUMMARIES["drive"])
     add_strip_options(p, voltage=False)
+    # not an option of drive: the voltage is the waveform's; said, where argparse would say only
+    # "unrecognized arguments"
+    p.add_argument("--voltage", dest="voltage_refused", type=arg_type(_voltage_in_waveform, "--voltage"), default=None,
+                   help=argparse.SUPPRESS)
     p.add_argument("--waveform", type=waveform_type, required=True,
                    help="SPEC: terms joined by '+': dc:V, step:V[@T0], ramp:V/TR[@T0], sine:V@F[,PHASE_deg], "
                         "square:V@F, triangle:V@F, csv:FILE (t, V); e.g. 'dc:0.2V+sine:0.5V@10Hz'")

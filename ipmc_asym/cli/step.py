@@ -137,7 +137,7 @@ def _line_in_memory(args, strip, material, resps) -> int:
               f"beam {args.beam}, electrode sheet resistance {args.sheet_resistance:g} Ohm/sq "
               f"({info['line_segments']} segments): tau = {info['tau']:.4g} s")
         idx = np.unique(np.linspace(0, r["t"].size - 1, min(r["t"].size, 11)).astype(int))
-        print(f"{'t [s]':>11s} {'sigma [C/m^2]':>14s} {'+-':>9s} {'J [A/m^2]':>11s} {'M_A [N m]':>11s} {'theta':>9s} "
+        print(f"{'t [s]':>11s} {'sigma [C/m^2]':>14s} {'+-':>9s} {'J [A/m^2]':>11s} {'M_A [N m]':>11s} {'th. [rad]':>9s} "
               f"{'w [mm]':>9s} {'+-':>9s} valid")
         for i in idx:
             print(f"{fmt_num(r['t'][i], '11.4g')} {fmt_num(r['sigma'][i], '14.6g')} {fmt_num(r['sigma_error'][i], '9.2g')} "
@@ -288,7 +288,7 @@ def run(args):
             idx = np.unique(np.linspace(0, r.t.size - 1, min(r.t.size, 11)).astype(int))
             if "w_error" in columns:  # the stated errors beside their values
                 print(f"{'t [s]':>11s} {'sigma [C/m^2]':>14s} {'+-':>9s} {'J [A/m^2]':>11s} {'+-':>9s} "
-                      f"{'M_A [N m]':>11s} {'theta':>9s} {'w [mm]':>9s} {'+-':>9s} valid")
+                      f"{'M_A [N m]':>11s} {'th. [rad]':>9s} {'w [mm]':>9s} {'+-':>9s} valid")
                 for i in idx:
                     print(f"{fmt_num(r.t[i], '11.4g')} {fmt_num(r.sigma[i], '14.6g')} "
                           f"{fmt_num(r.sigma_error[i], '9.2g')} {_num(r.current_density[i], 1.0):>11s} "
@@ -296,7 +296,7 @@ def run(args):
                           f"{_num(r.theta[i], 1.0):>9s} {_num(r.w[i], 1e3):>9s} {_num(r.w_error[i], 1e3):>9s} "
                           f"{'yes' if r.valid[i] else 'no'}")
                 continue
-            print(f"{'t [s]':>11s} {'sigma [C/m^2]':>14s} {'J [A/m^2]':>11s} {'M_A [N m]':>11s} {'theta':>9s} "
+            print(f"{'t [s]':>11s} {'sigma [C/m^2]':>14s} {'J [A/m^2]':>11s} {'M_A [N m]':>11s} {'th. [rad]':>9s} "
                   f"{'w [mm]':>9s} valid")
             for i in idx:
                 print(f"{fmt_num(r.t[i], '11.4g')} {fmt_num(r.sigma[i], '14.6g')} {fmt_num(r.current_density[i], '11.4g')} "

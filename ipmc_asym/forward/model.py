@@ -141,7 +141,12 @@ def _strain_source(limit) -> str:
 
 def strain_reason(strain, limit=STRAIN_LIMIT) -> str:
     """One line: the strain assumption fails (``strain`` = ``e|kappa|``, ``limit`` = ``Material.strain_limit``)."""
-    return (f"strain at the faces e|kappa| = {float(strain):.3g} > strain limit {float(limit):g} "
+    shown = f"{float(strain):.3g}"
+    for digits in range(4, 18):  # enough digits that the value shown is not the limit's own text
+        if float(shown) > float(limit):
+            break
+        shown = f"{float(strain):.{digits}g}"
+    return (f"strain at the faces e|kappa| = {shown} > strain limit {float(limit):g} "
             f"({_strain_source(limit)}): outside the small-strain beam model; mechanical outputs kept, "
             "flagged check_strain = false")
 

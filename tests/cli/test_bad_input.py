@@ -99,3 +99,12 @@ def test_a_material_file_of_an_unknown_schema_is_refused(tmp_path, capsys):
     p.write_text(text.replace("\nschema = 1\n", "\nschema = 99\n"), encoding="utf-8")
     for argv in (["materials", str(p)], ["estimate", "--material", str(p)]):
         assert "schema = 99 is not supported; supported: 1" in _refused(capsys, argv)
+
+
+@pytest.mark.parametrize("argv, said", [
+    (["drive", "--voltage", "1.5V"], "drive takes its voltage in --waveform (e.g. --waveform step:1.5V"),
+    (["estimate", "--voltage", "nan"], "cannot read 'nan' as a voltage: a finite number with one of the units"),
+    (["estimate", "--thickness", "abc"], "cannot read 'abc' as a length: a finite number with one of the units"),
+])
+def test_a_refusal_says_what_to_write_instead(capsys, argv, said):
+    assert said in _refused(capsys, argv)

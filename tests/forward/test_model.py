@@ -255,3 +255,14 @@ def test_step_uq_figures_and_estimate_agree_on_every_points_checks():
             ev = evaluate(s.with_(voltage=float(r.layer_voltage[j])), "constant")["checks"]
             ev["voltage"] = ev["voltage"] and abs(r.phi0[j]) <= 20.0
             assert {c: bool(r.checks[c][j]) for c in CHECKS} == ev, (i, j)
+
+
+@pytest.mark.parametrize("strain", [0.0100004, 0.01000000000000001, 0.0116, 0.5])
+def test_a_strain_just_past_its_limit_reads_past_it(strain):
+    """The strain the warning shows is above the limit it names (0.0100004 read '0.01 > 0.01')."""
+    import re
+
+    from ipmc_asym.forward.model import strain_reason
+
+    shown = re.search(r"e\|kappa\| = (\S+) > strain limit (\S+) ", strain_reason(strain, 0.01))
+    assert float(shown.group(1)) > float(shown.group(2)) == 0.01
