@@ -453,9 +453,10 @@ def given(args, dest: str) -> bool:
 def add_strip_options(p, *, voltage=True, mechanics=True):
     """The strip/material options shared by several commands (SI or with units); ``mechanics``:
     the command reports beam outputs (``--strain-limit``)."""
-    p.add_argument("--length", type=length_type("length"), default=0.02, help="strip length L (default 2cm)")
-    p.add_argument("--width", type=length_type("width"), default=5e-3, help="TOTAL width 2l (default 5mm)")
-    p.add_argument("--thickness", type=length_type("thickness"), default=None,
+    p.add_argument("--length", type=length_type("length"), default=0.02, action=_Given,
+                   help="strip length L (default 2cm)")
+    p.add_argument("--width", type=length_type("width"), default=5e-3, action=_Given, help="TOTAL width 2l (default 5mm)")
+    p.add_argument("--thickness", type=length_type("thickness"), default=None, action=_Given,
                    help="TOTAL membrane thickness 2e (default: the material set's typical thickness, e.g. 183um for "
                         "nafion-117-h, said in the output; 200um for nafion-li)")
     if voltage:

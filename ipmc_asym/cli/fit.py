@@ -18,6 +18,7 @@ from ipmc_asym.cli.common import (
     diffusion_type,
     first_run_notice,
     fmt_num,
+    given,
     load_type,
     model_help,
     nu_type,
@@ -25,6 +26,7 @@ from ipmc_asym.cli.common import (
     sheet_resistance_type,
     strip_and_material,
     viscous_modulus_type,
+    warn,
     waveform_type,
 )
 from ipmc_asym.dynamics.circuit import BEAM_CHOICES
@@ -127,6 +129,11 @@ def run(args) -> int:
     support = args.support  # None: the sensing entries' one default (tip-force)
     files = [read_file(d, strip, waveform=args.waveform, load=load, support=support, max_rows=args.max_rows)
              for d in args.data]
+    for d in files:  # a strip option the file's own column overrides: said, not silently dropped
+        for k in getattr(d, "file_columns", ()):
+            if given(args, k):
+                flag = "--" + k
+                warn(f"{flag} is not used for {d.source}: its {k} column gives each row's {k}")
     first_run_notice("fit")
     static_only = len(files) == 1 and isinstance(files[0], CalibrationData)
     if static_only:

@@ -167,12 +167,15 @@ class CalibrationData(MeasuredColumns):
     sigma : dict
         name -> array (n_rows,) of one standard deviation, or None (relative weights).
     source : str
+    file_columns : tuple of str
+        The geometry columns the file gave (the others took ``base``'s value).
     """
 
     geometry: dict
     measured: dict
     sigma: dict
     source: str = "data"
+    file_columns: tuple = ()
 
     @property
     def n_rows(self) -> int:
@@ -317,7 +320,8 @@ def read_data(path, base: Strip | None = None, max_rows: int | None = MAX_DATA_R
     sigma = {m: cols.get(f"sigma_{m}") for m in meas}
     if any(s is None for s in sigma.values()) and any(s is not None for s in sigma.values()):
         raise ValueError(f"{name}: give sigma_ columns for every measured column or for none")
-    return CalibrationData(geometry, measured, sigma, source=name)
+    return CalibrationData(geometry, measured, sigma, source=name,
+                           file_columns=tuple(k for k in GEOMETRY if k in header))
 
 
 def parse_free(spec) -> dict:

@@ -174,3 +174,13 @@ def test_fit_spectrum_and_static_files_together(data_csv, tmp_path, capsys):
                  "--plot", str(png)]) == 0
     assert png.stat().st_size > 10_000
     assert main(["fit", data_csv, "--free", "modulus", "--waveform", "step:1V"]) == 2
+
+
+def test_a_strip_option_the_file_overrides_is_said(capsys):
+    """fit_synthetic.csv has a length column: --length is not used for it (said), --width is."""
+    base = ["fit", os.path.join(ROOT, "examples", "fit_synthetic.csv"), "--free", "modulus", "--no-progress", "--json"]
+    assert main(base + ["--length", "3cm", "--width", "4mm"]) == 0
+    err = capsys.readouterr().err
+    assert "--length is not used for fit_synthetic.csv: its length column" in err and "--width is not used" not in err
+    assert main(base) == 0
+    assert "is not used" not in capsys.readouterr().err
