@@ -22,6 +22,7 @@ from ipmc_asym.cli.common import (
     fmt_num,
     load_type,
     nu_type,
+    sidecar_path,
     strip_and_material,
     tol_type,
     warn,
@@ -99,7 +100,7 @@ def register(sub):
     p.add_argument("--pressure-term", action="store_true",
                    help="keep the pressure term of the Nernst-Planck law (eq. (5)); linear order only")
     p.add_argument("--json", action="store_true", help="print one JSON object")
-    add_output_option(p, "--out", formats=(".csv", ".nc"), default=None, metavar="F.csv|F.nc",
+    add_output_option(p, "--out", formats=(".csv", ".nc"), sidecar=True, default=None, metavar="F.csv|F.nc",
                       help="write the rows (one per model) to a CSV or NetCDF file (written atomically)")
 
 
@@ -153,6 +154,7 @@ def _run_time(args, strip, material):
               "waveform": args.waveform.spec, "duration": args.duration, "points": args.points}
     if args.out:
         _write_time(args.out, results)
+        _sidecar(args.out, inputs, notes, warnings)
     summary = {m: {"error": r.error, "error_circuit": r.error_circuit, "error_emf": r.error_emf,
                    "error_interp": r.error_interp, "error_linear": r.error_linear,
                    "error_settled": r.error_settled, "tau": r.tau, "f_stream": r.f_stream, "f_top": r.f_top,
@@ -182,6 +184,8 @@ def _run_time(args, strip, material):
                   + ("" if r.valid[i] else "  not valid (see warning)"))
     for n in notes:
         print("note: " + n)
+    if args.out:
+        print(f"wrote {args.out}" + (f" and {sidecar_path(args.out)}" if _csv(args.out) else ""))
     return 0
 
 
@@ -241,6 +245,7 @@ def run(args):
               "support": args.support, "load": args.load, "nu": args.nu, "c_moy": material.C_moy}
     if args.out:
         _write(args.out, results, rows)
+        _sidecar(args.out, inputs, notes, warnings)
     if args.json:
         print(dumps({"inputs": inputs, "results": rows, "notes": notes, "warnings": warnings}, indent=2))
         return 0
@@ -257,7 +262,23 @@ def run(args):
               f"{row['Q_per_w']:12.5g} {err:8.1e}" + ("" if row["valid"] else "  not valid (see warning)"))
     for n in notes:
         print("note: " + n)
+    if args.out:
+        print(f"wrote {args.out}" + (f" and {sidecar_path(args.out)}" if _csv(args.out) else ""))
     return 0
+
+
+def _csv(path) -> bool:
+    return not str(path).lower().endswith(".nc")
+
+
+def _sidecar(path, inputs, notes, warnings):
+    """The strip and the conditions of a CSV's rows beside it (``F.csv.json``, as drive's and
+    estimate's): the CSV keeps one header row; a NetCDF file carries them itself."""
+    if _csv(path):
+        meta = {"inputs": dict(inputs, half_thickness_e=0.5 * inputs["thickness_total"]), "notes": notes,
+                "warnings": warnings, "units": "SI (m, C, V, A, W, 1/m)"}
+        with atomic_write(sidecar_path(path)) as fh:
+            fh.write(dumps(meta, indent=2) + "\n")
 
 
 def _write(path, results, rows):

@@ -96,7 +96,7 @@ def test_csv_and_netcdf_outputs(capsys, tmp_path):
         assert list(ds["model"].values) == ["constant", "linear", "affine"]
         assert float(ds["Q"].sel(model="affine")[0]) == float(r.Q[0])
         assert ds["Q"].attrs["units"] == "C"
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["s.csv", "s.nc"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s.csv", "s.csv.json", "s.nc"]  # the CSV with its strip beside it
 
 
 # ---- --waveform: the time domain -----------------------------------------------------------------
@@ -164,3 +164,17 @@ def test_time_domain_with_a_load_prints_no_nan_mean_power(capsys):
 
     assert not re.search(r"(?<![A-Za-z_])nan(?![A-Za-z_])", out, re.I)  # ("Donnan" is a word)
     assert "mean power n/a W" in out and "mean power not computed" in out
+
+
+@pytest.mark.parametrize("extra", [[], ["--waveform", "sine:1mm@1Hz", "--duration", "1s", "--points", "5"]])
+def test_sense_csv_has_its_strip_beside_it(tmp_path, capsys, extra):
+    """The CSV keeps its columns; the strip (total and half thickness) and notes go in F.csv.json."""
+    import json
+
+    out = tmp_path / "s.csv"
+    args = ["sense", "--thickness", "150um", "--out", str(out)] + (extra or ["--curvature", "2/m"])
+    assert main(args) == 0
+    assert capsys.readouterr().out.rstrip().endswith(f"wrote {out} and {out}.json")
+    meta = json.loads((tmp_path / "s.csv.json").read_text())
+    assert meta["inputs"]["thickness_total"] == 150e-6 and meta["inputs"]["half_thickness_e"] == 75e-6
+    assert meta["notes"]
