@@ -93,6 +93,9 @@ def _fit_line(f) -> str:
     if not math.isfinite(f["r"]):
         return (f"{head}: constant over the range ({f['prefactor']:.4g}): no power law to fit, exponent 0"
                 f"{thr}")
+    if f["n"] == 2:
+        return (f"{head} ~ {f['prefactor']:.4g} * {f['variable']}^{f['exponent']:.4g} "
+                f"(n=2, left out {f['n_left_out']}: {f['note']}){thr}")
     return (f"{head} ~ {f['prefactor']:.4g} * {f['variable']}^{f['exponent']:.4g} "
             f"(r={f['r']:.5f}, n={f['n']}, left out {f['n_left_out']}){thr}")
 

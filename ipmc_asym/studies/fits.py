@@ -68,6 +68,8 @@ def fit_power_law(x, y, mask=None) -> dict:
     sx, sy = np.std(lx), np.std(ly)
     if sx > 0 and sy > 1e-12 * max(1.0, np.max(np.abs(ly))):
         out["r"] = float(np.mean((lx - lx.mean()) * (ly - ly.mean())) / (sx * sy))
+        if n == 2:  # a line passes through any two points: |r| = 1 says nothing of a power law
+            out["note"] = "2 points: the exponent is the slope between them, no test of a power law (r = +-1 always)"
     return out
 
 

@@ -158,3 +158,11 @@ def test_cli_sweep_spread_csv_and_refusal(capsys):
     assert float(row["w_model_min"]) <= float(row["w"]) <= float(row["w_model_max"])
     assert main(["sweep", "--vary", "length=1cm:3cm:3", "--spread", "--scheduler", "local"]) == 2
     assert "--spread" in capsys.readouterr().err
+
+
+def test_two_points_make_no_test_of_a_power_law():
+    """Through two points any exponent fits with |r| = 1: the fit says so instead of reading as a check."""
+    f = fit_power_law([1.0, 2.0], [3.0, 7.0])
+    assert f["n"] == 2 and f["exponent"] == pytest.approx(np.log(7 / 3) / np.log(2), rel=1e-12)
+    assert "no test of a power law" in f["note"]
+    assert "note" not in fit_power_law([1.0, 2.0, 4.0], [3.0, 7.0, 13.0])
