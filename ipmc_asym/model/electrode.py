@@ -222,6 +222,10 @@ def beam_label(electrode: Electrode = NO_ELECTRODE) -> str:
     if not electrode.present:
         return "bare membrane (E I_p, no electrode layer)"
     metal = electrode.metal or "metal"
+    bulk = electrode.metal in METALS and electrode.modulus == METALS[electrode.metal][0]
+    # the preset is the solid metal's: said, since it decides most of the stiffness
+    caveat = (f"; E_m is solid {metal}'s: a porous or cracked plated layer is softer, --electrode-modulus sets a "
+              "measured one") if bulk else ""
     return (f"membrane + two {metal} layers t_m = {electrode.thickness * 1e6:.4g} um each, "
             f"E_m = {electrode.modulus:.4g} Pa, rho_m = {electrode.density:.4g} kg/m^3 (composite section; "
-            "strain check on the membrane's face)")
+            f"strain check on the membrane's face{caveat})")
