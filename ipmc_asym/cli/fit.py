@@ -8,6 +8,7 @@ import sys
 from ipmc_asym.base.jsonio import dumps
 from ipmc_asym.base.registry import fidelity_names, model_names
 from ipmc_asym.base.settings import MAX_DATA_ROWS_CEILING, MAX_MULTISTART_CEILING
+from ipmc_asym.base.units import fmt_length
 from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import (
     add_output_option,
@@ -154,8 +155,13 @@ def run(args) -> int:
             plot_fit(res, args.plot)
         else:
             plot_fit_dynamic(res, args.plot)
+    # the strip the rows were computed for where a file gives no geometry column (spectra and time
+    # series always: their electrode area scales every current and impedance)
+    strip_doc = {"length": strip.length, "width_total": strip.width, "thickness_total": strip.thickness,
+                 "half_thickness_e": strip.e,
+                 "columns_from_files": {d.source: list(getattr(d, "file_columns", ())) for d in files}}
     if args.json:
-        print(dumps(res.as_dict(), indent=2))
+        print(dumps(dict(res.as_dict(), strip=strip_doc), indent=2))
     else:
         if res.chi2_red is not None:
             gof = f"chi2_red = {res.chi2_red:.4g} (with the given sigma)"
@@ -166,6 +172,10 @@ def run(args) -> int:
                    f"columns, so no chi2 goodness of fit)")
         print(f"fit of {source}: {res.n_points} measured values, model {res.model}, fidelity {res.fidelity}, "
               f"{gof}")
+        given_cols = sorted({c for d in files for c in getattr(d, "file_columns", ())} - {"voltage"})
+        print(f"strip: L = {fmt_length(strip.length)}, total width 2l = {fmt_length(strip.width)}, total thickness "
+              f"2e = {fmt_length(strip.thickness)}" + (f" (where a file gives no {'/'.join(given_cols)} column)"
+                                                      if given_cols else ""))
         if material.electrode.present:
             print(f"beam: {beam_label(material.electrode)} (start values of a freed layer parameter)")
         print(f"{'parameter':16s} {'value':>12s} {'stderr':>10s} {'95% interval (profile)':>28s}  unit")

@@ -184,3 +184,14 @@ def test_a_strip_option_the_file_overrides_is_said(capsys):
     assert "--length is not used for fit_synthetic.csv: its length column" in err and "--width is not used" not in err
     assert main(base) == 0
     assert "is not used" not in capsys.readouterr().err
+
+
+def test_fit_says_the_strip_its_rows_assumed(capsys):
+    """A spectrum's fit depends on the electrode area: the strip is in the text and the JSON."""
+    path = os.path.join(ROOT, "examples", "dynamic_spectrum.csv")
+    assert main(["fit", path, "--free", "D", "--no-progress", "--json", "--width", "4mm"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["strip"]["width_total"] == 4e-3 and doc["strip"]["half_thickness_e"] == doc["strip"]["thickness_total"] / 2
+    assert doc["strip"]["columns_from_files"] == {"dynamic_spectrum.csv": []}
+    assert main(["fit", path, "--free", "D", "--no-progress", "--width", "4mm"]) == 0
+    assert "strip: L = 2 cm, total width 2l = 4 mm, total thickness 2e = " in capsys.readouterr().out
