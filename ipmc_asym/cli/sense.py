@@ -30,6 +30,7 @@ from ipmc_asym.cli.common import (
 from ipmc_asym.forward.estimate import model_list
 from ipmc_asym.forward.sensing import DEFAULT_NU, SENSE_SUPPORTS, sense
 from ipmc_asym.io.fileio import atomic_write
+from ipmc_asym.model.spread import spread_of
 
 #: curvature units (1/m); a bare number is 1/m
 _CURVATURE = {"1/m": 1.0, "m^-1": 1.0, "/m": 1.0, "1/mm": 1e3, "mm^-1": 1e3, "/mm": 1e3, "1/cm": 1e2, "cm^-1": 1e2,
@@ -243,11 +244,17 @@ def run(args):
              "(docs/sensing.md): its actuation and sensing do not derive from one free energy"]
     inputs = {"length": strip.length, "width_total": strip.width, "thickness_total": strip.thickness,
               "support": args.support, "load": args.load, "nu": args.nu, "c_moy": material.C_moy}
+    # the model-form spread over the permittivity models shown, as estimate and charge give it
+    spread = ({k: spread_of({r["model"]: r[k] for r in rows}, max(max(r["error"], r["error_V_oc"]) for r in rows))
+               for k in ("Q", "V_oc", "Q_per_w")} if len(rows) > 1 else None)
     if args.out:
         _write(args.out, results, rows)
         _sidecar(args.out, inputs, notes, warnings)
     if args.json:
-        print(dumps({"inputs": inputs, "results": rows, "notes": notes, "warnings": warnings}, indent=2))
+        doc = {"inputs": inputs, "results": rows, "notes": notes, "warnings": warnings}
+        if spread is not None:
+            doc["model_spread"] = spread
+        print(dumps(doc, indent=2))
         return 0
     r0 = next(iter(results.values()))
     print(f"IPMC strip as a sensor: L = {fmt_length(strip.length)}, total width 2l = {fmt_length(strip.width)}, "
@@ -260,6 +267,13 @@ def run(args):
         err = max(row["error"], row["error_V_oc"])
         print(f"{row['model']:9s} {row['fidelity_used']:9s} {row[first[0]]:14.6g} {row[second[0]]:14.6g} "
               f"{row['Q_per_w']:12.5g} {err:8.1e}" + ("" if row["valid"] else "  not valid (see warning)"))
+    if spread is not None:
+        print(f"model-form spread over the {len(rows)} permittivity models:")
+        for k, unit in (("Q", "C"), ("V_oc", "V"), ("Q_per_w", "C/m")):
+            d = spread[k]
+            ratio = "" if d["ratio"] is None else f" (x{d['ratio']:.3g})"
+            print(f"  {k + ' [' + unit + ']':14s} {d['min']:.4g} .. {d['max']:.4g}{ratio}   numerical rel.err <= "
+                  f"{d['numerical_error']:.1e}")
     for n in notes:
         print("note: " + n)
     if args.out:

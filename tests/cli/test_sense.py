@@ -178,3 +178,13 @@ def test_sense_csv_has_its_strip_beside_it(tmp_path, capsys, extra):
     meta = json.loads((tmp_path / "s.csv.json").read_text())
     assert meta["inputs"]["thickness_total"] == 150e-6 and meta["inputs"]["half_thickness_e"] == 75e-6
     assert meta["notes"]
+
+
+def test_sense_gives_the_model_form_spread(capsys):
+    assert main(["sense", "--tip-displacement", "1mm", "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    q = [r["Q"] for r in doc["results"]]
+    s = doc["model_spread"]["Q"]
+    assert (s["min"], s["max"]) == (min(q), max(q)) and s["ratio"] == pytest.approx(max(map(abs, q)) / min(map(abs, q)))
+    assert main(["sense", "--tip-displacement", "1mm", "--model", "constant", "--json"]) == 0
+    assert "model_spread" not in json.loads(capsys.readouterr().out)  # one model: no spread to give
