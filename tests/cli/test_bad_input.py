@@ -99,3 +99,12 @@ def test_a_material_file_of_an_unknown_schema_is_refused(tmp_path, capsys):
     p.write_text(text.replace("\nschema = 1\n", "\nschema = 99\n"), encoding="utf-8")
     for argv in (["materials", str(p)], ["estimate", "--material", str(p)]):
         assert "schema = 99 is not supported; supported: 1" in _refused(capsys, argv)
+
+
+@pytest.mark.parametrize("voltage", ["1", "-1"])
+def test_profiles_a_bvp_that_diverges_is_refused_with_the_debye_length(capsys, voltage):
+    # 100 nm at C_moy 10 mol/m^3 is 0.012 Debye lengths: the affine solve diverges (b = ln B1 ~ 1e10)
+    line = _refused(capsys, ["profiles", "--c-moy", "10", "--thickness", "100nm", "--model", "affine",
+                             "--voltage", voltage])
+    assert "BVP for the affine profiles did not converge" in line, line
+    assert "0.0119 Debye lengths" in line and "a thickness, C_moy or voltage nearer the nominal" in line, line
