@@ -281,9 +281,12 @@ def drive_chunks(wave, duration, points, *, strip: Strip | None = None, model="c
                 over = lc[f"{k}_error"] > LINE_TOL * scale
                 if np.any(over):
                     i = int(np.argmax(over))
+                    n = line.segments
                     raise ValueError(f"line_segments: the electrode line's discretisation error on {k} exceeds "
-                                     f"{LINE_TOL:g} of the response at t = {t[i]:.4g} s with {2 * line.segments} "
-                                     f"segments; raise line_segments (now {line.segments}, at most {MAX_SEGMENTS})")
+                                     f"{LINE_TOL:g} of the response at t = {t[i]:.4g} s with line_segments = {n} "
+                                     f"(the reported line of {2 * n} segments against the {n} of its error estimate); "
+                                     f"raise line_segments (--line-segments on the command line) above {n}, at most "
+                                     f"{MAX_SEGMENTS}")
                 peak[k] = float(scale[-1])
         warns = assumption_warnings(fr)
         valid = np.logical_and.reduce([checks[c] for c in CHECKS])

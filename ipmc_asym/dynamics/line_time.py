@@ -122,7 +122,8 @@ class LineStepper:
             raise ValueError(f"sheet_resistance must be > 0 Ohm/sq for the line (0: the uniform strip); got {Rs!r}")
         n = int(segments)
         if not 2 <= n <= MAX_SEGMENTS:
-            raise ValueError(f"line segments must be an integer in [2, {MAX_SEGMENTS}]; got {segments!r}")
+            raise ValueError(f"line_segments must be an integer in [2, {MAX_SEGMENTS}] (--line-segments on the "
+                             f"command line); got {segments!r}")
         self.fun, self.strip, self.m = phi0_fun, strip, material
         self.VT = groups.thermal_voltage(material)
         self.tau = float(time_constant(strip.thickness, perm, material))

@@ -108,3 +108,10 @@ def test_profiles_a_bvp_that_diverges_is_refused_with_the_debye_length(capsys, v
                              "--voltage", voltage])
     assert "BVP for the affine profiles did not converge" in line, line
     assert "0.0119 Debye lengths" in line and "a thickness, C_moy or voltage nearer the nominal" in line, line
+
+
+@pytest.mark.parametrize("command", [["step"], ["drive", "--waveform", "step:1V", "--duration", "1s"]])
+def test_an_underresolved_line_names_line_segments_and_its_doubled_line_consistently(capsys, command):
+    line = _refused(capsys, command + ["--sheet-resistance", "2.5", "--diffusion", "1e-8"])
+    assert ("with line_segments = 16 (the reported line of 32 segments against the 16 of its error estimate); "
+            "raise line_segments (--line-segments on the command line) above 16, at most 512") in line, line
