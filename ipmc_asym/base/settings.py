@@ -84,6 +84,13 @@ C_MOY_RANGE = (1e-3, 1e8)
 #: time (1e-320 s) makes the ramp's slope V/TR overflow
 MIN_TIME = 1.0 / FREQUENCY_RANGE[1]
 
+#: longest output time of the transient PNP, in diffusion times e^2/D (its own time unit, the slowest of
+#: the model: a step's strip is at rest after a few, and a waveform's cost grows with its periods).
+#: solve_ivp's BDF cannot step past ~1e290 of them ("Required step size is less than spacing between
+#: numbers", measured on the nominal strip and at D = 1e10); 1e12 is far past any use and far from that,
+#: and at least 1e12 tau (e^2/D >= ~1.5 tau on every accepted strip), looser than the circuit's substeps
+MAX_PNP_DIFFUSION_TIMES = 1e12
+
 #: relative rounding floor of the error estimate of corrected / quadrature (the two terms are
 #: assembled with cancellations; measured <= 2.3e-12 against the BVP on 1 um - 10 mm x 0.1 mV - 20 V)
 ROUNDING_ERROR = 1e-11

@@ -50,6 +50,8 @@ def test_the_ends_of_the_diffusion_range_run(capsys):
 
 @pytest.mark.parametrize("argv, named", [
     (["step", "--duration", "1e308"], "duration is too long for the reduced model's fixed substeps"),
+    (["step", "--duration", "1e308", "--fidelity", "pnp"], "duration: the transient PNP runs at most 1e+12 diffusion "
+                                                           "times e^2/D (1e+14 s here, 2.96e+15 tau"),
     (["sense", "--curvature", "1e308"], "curvature: |value| up to 1e+09 1/m allowed"),
     (["sense", "--tip-displacement", "1e308"], "tip_displacement: |value| up to 1000 m allowed"),
     (["sense", "--curvature", "1e308", "--nu", "0.5", "--length", "10m"], "curvature: |value| up to"),
