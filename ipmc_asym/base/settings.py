@@ -146,6 +146,10 @@ MAX_DPI_CEILING = 2400
 #: output points of step and freq: held in memory with every column (~100-200 B a point with the
 #: beam's outputs): 1e6 points are ~0.2 GB, 10 times the default cap
 MAX_POINTS_CEILING = 10**6
+#: one input file (--max-input-size, bytes): read whole into memory and parsed there (the text and its
+#: parsed rows or tables take several times the file's size); a fit's MAX_DATA_ROWS_CEILING rows are
+#: ~50 MB of CSV: 1 GiB is 16 times the default cap (base.inputs.MAX_INPUT_BYTES, 64 MiB)
+MAX_INPUT_BYTES_CEILING = 2**30
 
 #: beam regimes outside the model (fits leave these points out)
 OUTSIDE_REGIMES = ("past-quarter-turn", "multi-turn")

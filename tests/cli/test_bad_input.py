@@ -117,3 +117,15 @@ def test_an_underresolved_line_names_line_segments_and_its_doubled_line_consiste
     line = _refused(capsys, command + ["--sheet-resistance", "2.5", "--diffusion", "1e-8"])
     assert ("with line_segments = 16 (the reported line of 32 segments against the 16 of its error estimate); "
             "raise line_segments (--line-segments on the command line) above 16, at most 512") in line, line
+
+
+@pytest.mark.parametrize("size", ["2GiB", "1.5GB", "1e300"])
+def test_the_input_size_cap_has_a_ceiling(capsys, size):
+    line = _refused(capsys, ["scene", str(EXAMPLES / "uq_nominal.toml"), "--max-input-size", size])
+    assert ("--max-input-size must be a size from 1 to 1073741824 bytes (1 GiB; the ceiling of this cap: memory "
+            f"stays bounded); got '{size}'") in line, line
+
+
+def test_the_input_size_cap_runs_at_its_ceiling(capsys):
+    assert main(["scene", str(EXAMPLES / "uq_nominal.toml"), "--max-input-size", "1GiB", "--json"]) == 0
+    capsys.readouterr()
