@@ -79,6 +79,12 @@ DIFFUSION_RANGE = (1e-30, 1e10)
 #: (tests/model/test_params.py)
 C_MOY_RANGE = (1e-3, 1e8)
 
+#: largest sheet resistance R_s (Ohm/sq) of an electrode: a numerical guard, not a physical limit (plated
+#: Pt on Nafion measures ~1-100 Ohm/sq; 1e12 is an insulating film's).  At 1e308 the electrode line's
+#: arrays overflow (step, drive: "array must not contain infs or NaNs"); up to this cap freq's outputs
+#: are finite and step's line refuses in one line where its segments do not resolve it
+MAX_SHEET_RESISTANCE = 1e12
+
 #: shortest time span (s) a waveform's ramp time or period and a drive's duration may have: the period
 #: of the highest frequency a spectrum accepts (FREQUENCY_RANGE), a numerical guard.  A subnormal ramp
 #: time (1e-320 s) makes the ramp's slope V/TR overflow

@@ -53,8 +53,8 @@ from ipmc_asym.model.params import (
     Material,
     Strip,
     bending_stiffness,
-    check_finite,
     check_positive,
+    check_sheet_resistance,
 )
 from ipmc_asym.model.permittivity import get_model
 
@@ -113,10 +113,7 @@ def _resolve(wave):
 
 
 def _sheet(sheet_resistance, beam):
-    Rs = check_finite("sheet_resistance", sheet_resistance, "a finite number >= 0 Ohm/sq")
-    if Rs < 0.0:
-        raise ValueError(f"sheet_resistance must be a finite number >= 0 Ohm/sq; got {sheet_resistance!r}")
-    return Rs
+    return check_sheet_resistance(sheet_resistance)
 
 
 def _support(support, electrode, strip, Rs):

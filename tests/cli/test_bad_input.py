@@ -37,6 +37,9 @@ def _refused(capsys, argv):
     (["step", "--diffusion", "1e-320"], "--diffusion must be a finite number within 1e-30..1e+10 m^2/s"),
     (["estimate", "--c-moy", "1e-320"], "--c-moy must be a finite number within 0.001..1e+08 mol/m^3"),
     (["charge", "--c-moy", "1e12"], "--c-moy must be a finite number within 0.001..1e+08 mol/m^3"),
+    (["step", "--sheet-resistance", "1e308"], "--sheet-resistance must be within 0..1e+12 Ohm/sq"),
+    (["drive", "--waveform", "step:1V", "--duration", "1s", "--sheet-resistance", "1e13"],
+     "--sheet-resistance must be within 0..1e+12 Ohm/sq"),
 ])
 def test_a_diffusion_coefficient_or_concentration_out_of_range_names_the_option(capsys, argv, named):
     assert named in _refused(capsys, argv)
