@@ -132,3 +132,10 @@ def test_the_input_size_cap_has_a_ceiling(capsys, size):
 def test_the_input_size_cap_runs_at_its_ceiling(capsys):
     assert main(["scene", str(EXAMPLES / "uq_nominal.toml"), "--max-input-size", "1GiB", "--json"]) == 0
     capsys.readouterr()
+
+
+@pytest.mark.parametrize("argv", [["sense", "--waveform", "sine:1mm@1Hz", "--duration", "1s", "--points", "1e308"],
+                                  ["drive", "--waveform", "step:1V", "--duration", "1s", "--points", "1e308"]])
+def test_points_past_the_cap_is_said_as_a_number_not_300_digits(capsys, argv):
+    line = _refused(capsys, argv)
+    assert line.endswith("; got 1e+308"), line
