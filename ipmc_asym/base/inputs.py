@@ -32,22 +32,36 @@ _FACTORS = {None: 1, "B": 1, "kB": 10**3, "KB": 10**3, "MB": 10**6, "GB": 10**9,
             "KiB": 2**10, "kiB": 2**10, "MiB": 2**20, "GiB": 2**30, "TiB": 2**40}
 
 
-def parse_size(text, what: str = "--max-input-size") -> int:
-    """``"64MB"``, ``"1GiB"``, ``"5e6"`` (bytes) -> an integer number of bytes >= 1.
+def parse_size(text, what: str = "--max-input-size", maximum: int | None = None) -> int:
+    """``"64MB"``, ``"1GiB"``, ``"5e6"`` (bytes) -> an integer number of bytes >= 1 (and <= ``maximum``,
+    the ceiling of a cap, where given).
 
     Raises
     ------
     ValueError
-        One line naming ``what`` and the accepted forms.
+        One line naming ``what`` and the accepted forms (or the ceiling).
     """
     m = _SIZE.match(str(text))
     n = None
     if m and m.group(2) in _FACTORS:
         v = float(m.group(1)) * _FACTORS[m.group(2)]
-        n = int(v) if v == v and 1 <= v < 2**63 else None
+        n = int(v) if v == v and 1 <= v < 2**63 else (2**63 if v >= 2**63 else None)
     if n is None:
         raise ValueError(f"{what} must be a size in bytes >= 1, e.g. 64MB, 1GiB or 5e6; got {text!r}")
+    if maximum is None and n >= 2**63:
+        raise ValueError(f"{what} must be a size below 2^63 bytes; got {text!r}")
+    if maximum is not None and n > maximum:
+        raise ValueError(f"{what} must be a size from 1 to {maximum} bytes ({_binary(maximum)}; the ceiling of this "
+                         f"cap: memory stays bounded); got {text!r}")
     return n
+
+
+def _binary(n: int) -> str:
+    """``n`` bytes in the largest binary unit that divides it (1 GiB, 64 MiB), else in bytes."""
+    for unit, f in (("TiB", 2**40), ("GiB", 2**30), ("MiB", 2**20), ("KiB", 2**10)):
+        if n % f == 0:
+            return f"{n // f} {unit}"
+    return f"{n} B"
 
 
 def max_input_bytes() -> int:

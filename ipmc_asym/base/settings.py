@@ -83,10 +83,23 @@ DIFFUSION_RANGE = (1e-30, 1e10)
 #: (tests/model/test_params.py)
 C_MOY_RANGE = (1e-3, 1e8)
 
+#: largest sheet resistance R_s (Ohm/sq) of an electrode: a numerical guard, not a physical limit (plated
+#: Pt on Nafion measures ~1-100 Ohm/sq; 1e12 is an insulating film's).  At 1e308 the electrode line's
+#: arrays overflow (step, drive: "array must not contain infs or NaNs"); up to this cap freq's outputs
+#: are finite and step's line refuses in one line where its segments do not resolve it
+MAX_SHEET_RESISTANCE = 1e12
+
 #: shortest time span (s) a waveform's ramp time or period and a drive's duration may have: the period
 #: of the highest frequency a spectrum accepts (FREQUENCY_RANGE), a numerical guard.  A subnormal ramp
 #: time (1e-320 s) makes the ramp's slope V/TR overflow
 MIN_TIME = 1.0 / FREQUENCY_RANGE[1]
+
+#: longest output time of the transient PNP, in diffusion times e^2/D (its own time unit, the slowest of
+#: the model: a step's strip is at rest after a few, and a waveform's cost grows with its periods).
+#: solve_ivp's BDF cannot step past ~1e290 of them ("Required step size is less than spacing between
+#: numbers", measured on the nominal strip and at D = 1e10); 1e12 is far past any use and far from that,
+#: and at least 1e12 tau (e^2/D >= ~1.5 tau on every accepted strip), looser than the circuit's substeps
+MAX_PNP_DIFFUSION_TIMES = 1e12
 
 #: relative rounding floor of the error estimate of corrected / quadrature (the two terms are
 #: assembled with cancellations; measured <= 2.3e-12 against the BVP on 1 um - 10 mm x 0.1 mV - 20 V)
@@ -143,6 +156,10 @@ MAX_DPI_CEILING = 2400
 #: output points of step and freq: held in memory with every column (~100-200 B a point with the
 #: beam's outputs): 1e6 points are ~0.2 GB, 10 times the default cap
 MAX_POINTS_CEILING = 10**6
+#: one input file (--max-input-size, bytes): read whole into memory and parsed there (the text and its
+#: parsed rows or tables take several times the file's size); a fit's MAX_DATA_ROWS_CEILING rows are
+#: ~50 MB of CSV: 1 GiB is 16 times the default cap (base.inputs.MAX_INPUT_BYTES, 64 MiB)
+MAX_INPUT_BYTES_CEILING = 2**30
 
 #: beam regimes outside the model (fits leave these points out)
 OUTSIDE_REGIMES = ("past-quarter-turn", "multi-turn")

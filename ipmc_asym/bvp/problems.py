@@ -157,6 +157,9 @@ class AffineProblem:
     def profiles(self, z, u, b):
         """Return ``C, y, D`` on the nodes, ``y`` clipped to the physical ``[b - A2, b]``."""
         s, D = u[0], u[1]
+        # a diverged iterate (a failed solve) can carry b far above EXP_MAX: capped, it stays
+        # finite for the caller's refusal; a converged b is a few units at most (B1 ~ A2)
+        b = min(b, EXP_MAX)
         if self.A1 == 0.0:
             cw = max(math.exp(b - self.A2), TINY)  # exp may underflow above ~700 V/25.9 mV
             C = np.clip(s / self.A0, cw, math.exp(b))
@@ -235,7 +238,7 @@ class CustomProblem:
         return np.vstack((y, D, cumtrapz(q, z)))
 
     def profiles(self, z, u, b):
-        y = np.clip(u[0], b - self.A2, b)
+        y = np.clip(u[0], b - self.A2, min(b, EXP_MAX))  # a diverged iterate's b: as AffineProblem.profiles
         return np.exp(y), y, u[1]
 
 

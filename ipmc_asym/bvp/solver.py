@@ -56,6 +56,7 @@ from ipmc_asym.base.results import Panel, ResultMixin, ResultSpec
 from ipmc_asym.base.settings import BVP_MAX_NODES, BVP_MAX_NODES_FIRST, BVP_TOL, BVP_TOL_FALLBACK
 from ipmc_asym.bvp.mesh import first_spacings, initial_guess, make_mesh
 from ipmc_asym.bvp.problems import (
+    EXP_MAX,
     TINY,
     AffineProblem,
     CustomProblem,
@@ -336,7 +337,10 @@ def _finish(res, prob, g, g_signed, name, t0, how) -> BVPResult:
     b = float(res.p[0])
     C, y, D = prob.profiles(z, res.y, b)
     A2, A3 = g.A2, g.A3
-    if res.sol is None:
+    # b = ln B1 of a converged solution is a few units (B1 ~ A2 at most); above EXP_MAX it is
+    # the last iterate of a diverged solve, which has no B1 nor I to report
+    diverged = not b <= EXP_MAX
+    if res.sol is None or diverged:
         I = float("nan")
     elif isinstance(prob, AffineProblem) and g.A1 == 0.0:
         Iy = moment_y_linear(res.sol, z, g, b, float(res.y[1, 0]))
@@ -348,7 +352,7 @@ def _finish(res, prob, g, g_signed, name, t0, how) -> BVPResult:
     # linear model: eps -> A0 C(-1) ~ B1 e^{-A2} A0 at the anode, E is huge there (floored
     # denominator only to stay finite when exp(-A2) underflows)
     E = D / np.maximum(eps, TINY)
-    B1 = math.exp(b)
+    B1 = math.inf if diverged else math.exp(b)
     success = bool(res.status == 0 and np.isfinite(I))
     msg = res.message + how
     if g_signed.sign < 0:  # mirror image z -> -z, potential referenced to the face z = +1
@@ -356,14 +360,14 @@ def _finish(res, prob, g, g_signed, name, t0, how) -> BVPResult:
         C, y = C[::-1].copy(), y[::-1].copy()
         D, E = -D[::-1], -E[::-1]
         phi = phi[::-1] - 1.0
-        B1 = math.exp(b - A2)
+        B1 = math.inf if diverged else math.exp(b - A2)
         I = -I
     p = C / A2 - A3 * phi
     rms = float(np.max(res.rms_residuals)) if res.rms_residuals is not None else float("nan")
     return BVPResult(z=z, C=C, phi=phi, E=E, D=D, rhoZ=C - 1.0, p=p, y=y, B1=B1, I=I,
                      groups=g_signed, model=name, success=success, status=int(res.status),
                      message=msg, niter=int(res.niter), n_nodes=int(z.size),
-                     max_rms_residual=rms, bc_residual=_bc_res(prob, res),
+                     max_rms_residual=rms, bc_residual=math.inf if diverged else _bc_res(prob, res),
                      seconds=time.perf_counter() - t0, sol=res.sol)
 
 

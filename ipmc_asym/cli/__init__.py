@@ -21,6 +21,7 @@ from ipmc_asym import __version__
 from ipmc_asym.base.inputs import MAX_INPUT_BYTES, input_size_cap, max_input_bytes, parse_size
 from ipmc_asym.base.interrupt import check as check_interrupted
 from ipmc_asym.base.interrupt import exit_status, handling_signals
+from ipmc_asym.base.settings import MAX_INPUT_BYTES_CEILING
 
 __all__ = ["main", "build_parser", "COMMANDS", "UsageError", "PLUGIN_GROUP", "plugin_commands", "load_plugin"]
 
@@ -141,9 +142,13 @@ def _add_input_cap(p):
 
     if "--max-input-size" in p._option_string_actions:
         return
-    p.add_argument("--max-input-size", type=arg_type(parse_size, "--max-input-size"), default=MAX_INPUT_BYTES,
+    def size(text):
+        return parse_size(text, "--max-input-size", MAX_INPUT_BYTES_CEILING)
+
+    p.add_argument("--max-input-size", type=arg_type(size, "--max-input-size"), default=MAX_INPUT_BYTES,
                    metavar="SIZE", help=f"refuse an input file larger than this (e.g. 64MB, 1GiB; default "
-                                        f"{MAX_INPUT_BYTES // 2**20} MiB): memory stays bounded")
+                                        f"{MAX_INPUT_BYTES // 2**20} MiB, at most {MAX_INPUT_BYTES_CEILING // 2**30} GiB): "
+                                        "memory stays bounded")
 
 
 def main(argv=None) -> int:

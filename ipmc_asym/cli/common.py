@@ -16,7 +16,7 @@ import sys
 import numpy as np
 
 from ipmc_asym.base.jsonio import dumps
-from ipmc_asym.base.settings import FREQUENCY_RANGE, MIN_THICKNESS
+from ipmc_asym.base.settings import FREQUENCY_RANGE, MAX_SHEET_RESISTANCE, MIN_THICKNESS
 from ipmc_asym.base.units import (
     fmt_length,
     parse_diffusion,
@@ -728,8 +728,9 @@ waveform_type = arg_type(_waveform, "--waveform")
 
 def _sheet_conv(text):
     v = parse_sheet_resistance("--sheet-resistance", text)
-    if v < 0:
-        raise ValueError(f"--sheet-resistance must be >= 0 Ohm/sq (e.g. 2.5ohm/sq); got {text!r}")
+    if not 0.0 <= v <= MAX_SHEET_RESISTANCE:
+        raise ValueError(f"--sheet-resistance must be within 0..{MAX_SHEET_RESISTANCE:g} Ohm/sq (e.g. 2.5ohm/sq; a "
+                         f"numerical guard: the electrode line overflows past it); got {text!r}")
     return v
 
 

@@ -124,7 +124,7 @@ def _note_warnings(ch, seen, counts):
 
 def run(args):
     if args.points > MAX_DRIVE_POINTS:
-        raise ValueError(f"--points must be at most {MAX_DRIVE_POINTS:g}; got {args.points}")
+        raise ValueError(f"--points must be at most {MAX_DRIVE_POINTS:g}; got {args.points:.6g}")
     if args.json and args.points > MAX_JSON_POINTS:
         raise ValueError(f"--json holds every row in memory: --points at most {MAX_JSON_POINTS:g} (use --out F.csv)")
     support, electrode = support_from_args(args)
@@ -135,7 +135,7 @@ def run(args):
     stated = tol is not None or args.fidelity == "pnp"
     if stated and args.points > MAX_STATED_POINTS:
         raise ValueError(f"--points with --tol or --solver pnp (solved in memory, the PNP's profiles at every output "
-                         f"time) must be at most {MAX_STATED_POINTS}; got {args.points}")
+                         f"time) must be at most {MAX_STATED_POINTS}; got {args.points:.6g}")
     if args.out:
         check_output_path(args.out, "file", formats=(".csv",))
         check_output_path(sidecar_path(args.out), "file")

@@ -121,7 +121,7 @@ def _check_time_args(args):
     if args.duration is None:
         raise ValueError("--waveform needs --duration (e.g. --duration 100s)")
     if args.points > MAX_SENSE_POINTS:
-        raise ValueError(f"--points must be at most {MAX_SENSE_POINTS:g}; got {args.points}")
+        raise ValueError(f"--points must be at most {MAX_SENSE_POINTS:g}; got {args.points:.6g}")
     if args.json and args.points > MAX_JSON_ROWS:
         raise ValueError(f"--json holds every row in memory: --points at most {MAX_JSON_ROWS:g} (use --out F.csv)")
     for flag, v in (("--fidelity", args.fidelity != "leading"), ("--tol", args.tol is not None),

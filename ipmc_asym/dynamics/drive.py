@@ -53,8 +53,8 @@ from ipmc_asym.model.params import (
     Material,
     Strip,
     bending_stiffness,
-    check_finite,
     check_positive,
+    check_sheet_resistance,
 )
 from ipmc_asym.model.permittivity import get_model
 
@@ -113,10 +113,7 @@ def _resolve(wave):
 
 
 def _sheet(sheet_resistance, beam):
-    Rs = check_finite("sheet_resistance", sheet_resistance, "a finite number >= 0 Ohm/sq")
-    if Rs < 0.0:
-        raise ValueError(f"sheet_resistance must be a finite number >= 0 Ohm/sq; got {sheet_resistance!r}")
-    return Rs
+    return check_sheet_resistance(sheet_resistance)
 
 
 def _support(support, electrode, strip, Rs):
@@ -281,9 +278,12 @@ def drive_chunks(wave, duration, points, *, strip: Strip | None = None, model="c
                 over = lc[f"{k}_error"] > LINE_TOL * scale
                 if np.any(over):
                     i = int(np.argmax(over))
+                    n = line.segments
                     raise ValueError(f"line_segments: the electrode line's discretisation error on {k} exceeds "
-                                     f"{LINE_TOL:g} of the response at t = {t[i]:.4g} s with {2 * line.segments} "
-                                     f"segments; raise line_segments (now {line.segments}, at most {MAX_SEGMENTS})")
+                                     f"{LINE_TOL:g} of the response at t = {t[i]:.4g} s with line_segments = {n} "
+                                     f"(the reported line of {2 * n} segments against the {n} of its error estimate); "
+                                     f"raise line_segments (--line-segments on the command line) above {n}, at most "
+                                     f"{MAX_SEGMENTS}")
                 peak[k] = float(scale[-1])
         warns = assumption_warnings(fr)
         valid = np.logical_and.reduce([checks[c] for c in CHECKS])

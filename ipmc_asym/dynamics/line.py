@@ -59,8 +59,8 @@ from ipmc_asym.model.params import (
     Material,
     Strip,
     bending_stiffness,
-    check_finite,
     check_finite_response,
+    check_sheet_resistance,
 )
 
 __all__ = ["LineResult", "line_response", "line_factors", "voltage_profile", "moment_modal_integral",
@@ -374,9 +374,7 @@ def line_response(f, *, strip: Strip | None = None, model="constant", material: 
     s = Strip() if strip is None else strip
     m = NAFION_LI if material is None else material
     Rs = m.sheet_resistance if sheet_resistance is None else sheet_resistance
-    Rs = check_finite("sheet_resistance", Rs, "a finite number >= 0 Ohm/sq")
-    if Rs < 0.0:
-        raise ValueError(f"sheet_resistance must be a finite number >= 0 Ohm/sq; got {sheet_resistance!r}")
+    Rs = check_sheet_resistance(Rs)
     u = frequency_response(f, strip=s, model=model, material=m, method=method, voltage=voltage,
                            reference_points=0)
     L = s.length

@@ -40,7 +40,7 @@ from ipmc_asym.integral.api import paper_model_id
 from ipmc_asym.kernels.charge import GL_W, GL_X
 from ipmc_asym.kernels.charge_time import integrate_line
 from ipmc_asym.model import groups
-from ipmc_asym.model.params import Material, Strip, check_finite
+from ipmc_asym.model.params import Material, Strip, check_sheet_resistance
 from ipmc_asym.model.permittivity import Permittivity
 
 __all__ = ["LineStepper", "LineBeamDynamics", "line_weights", "DEFAULT_SEGMENTS", "MAX_SEGMENTS", "ERROR_FACTOR"]
@@ -117,12 +117,13 @@ class LineStepper:
 
     def __init__(self, phi0_fun, strip: Strip, perm: Permittivity, material: Material, sheet_resistance,
                  segments: int = DEFAULT_SEGMENTS, substeps: int = 2):
-        Rs = check_finite("sheet_resistance", sheet_resistance, "a finite number > 0 Ohm/sq")
+        Rs = check_sheet_resistance(sheet_resistance)
         if Rs <= 0.0:
             raise ValueError(f"sheet_resistance must be > 0 Ohm/sq for the line (0: the uniform strip); got {Rs!r}")
         n = int(segments)
         if not 2 <= n <= MAX_SEGMENTS:
-            raise ValueError(f"line segments must be an integer in [2, {MAX_SEGMENTS}]; got {segments!r}")
+            raise ValueError(f"line_segments must be an integer in [2, {MAX_SEGMENTS}] (--line-segments on the "
+                             f"command line); got {segments!r}")
         self.fun, self.strip, self.m = phi0_fun, strip, material
         self.VT = groups.thermal_voltage(material)
         self.tau = float(time_constant(strip.thickness, perm, material))

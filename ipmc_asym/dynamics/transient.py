@@ -54,7 +54,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ipmc_asym.dynamics.electrode import charge_scale, layer_voltage
+from ipmc_asym.base.settings import MAX_PNP_DIFFUSION_TIMES
+from ipmc_asym.dynamics.electrode import charge_scale, layer_voltage, time_constant
 from ipmc_asym.dynamics.waveforms import voltage_rate
 from ipmc_asym.kernels._generated import b1_exact
 from ipmc_asym.kernels.bernoulli import bernoulli_array
@@ -818,6 +819,7 @@ def solve_transient(t, phi0_fun, strip: Strip, model="constant", material: Mater
     no charging from ~1e-20 V).
     """
     tt = np.asarray(t, dtype=float).reshape(-1)
+    check_pnp_duration(tt[-1] if tt.size else 0.0, strip, model, material)
     vmax = float(np.max(np.abs(phi0_fun(np.linspace(tt[0], tt[-1], 2001))))) if tt.size else 0.0
     kw = dict(cells_per_debye=cells_per_debye, ratio=ratio, h_core=h_core, refine=refine, rtol=rtol, atol=atol,
               method=method, energy=energy, profiles=profiles, moment=moment, tol=tol, max_cells=max_cells,
@@ -825,6 +827,19 @@ def solve_transient(t, phi0_fun, strip: Strip, model="constant", material: Mater
     if not 0.0 < vmax < SMALL_SIGNAL_V or energy:  # (the energy balance is quadratic in phi0: solved as it is)
         return _solve_direct(t, phi0_fun, strip, model, material, **kw)
     return _small_signal(t, phi0_fun, vmax, strip, model, material, kw)
+
+
+def check_pnp_duration(duration, strip: Strip, model, material: Material) -> float:
+    """Refuse a duration (s) past :data:`~ipmc_asym.base.settings.MAX_PNP_DIFFUSION_TIMES` diffusion
+    times ``e^2/D`` in one line, before any run (the integrator would fail near the top of the doubles)."""
+    t_d = strip.e * strip.e / float(material.D)
+    span = MAX_PNP_DIFFUSION_TIMES * t_d
+    if not float(duration) <= span:
+        tau = float(time_constant(strip.thickness, model, material))
+        raise ValueError(f"duration: the transient PNP runs at most {MAX_PNP_DIFFUSION_TIMES:.0e} diffusion times "
+                         f"e^2/D ({span:.3g} s here, {span / tau:.3g} tau; a step's strip is at rest after a few); "
+                         f"got {float(duration):.3g} s (--duration on the command line)")
+    return float(duration)
 
 
 #: below this ``max |phi0|`` (V) :func:`solve_transient` solves the small-signal limit, scaled from

@@ -34,6 +34,7 @@ from ipmc_asym.base.settings import (
     DIFFUSION_RANGE,
     FREQUENCY_RANGE,
     MAX_DIMENSION,
+    MAX_SHEET_RESISTANCE,
     MAX_VOLTAGE,
     MIN_DIMENSION,
     MIN_THICKNESS,
@@ -243,6 +244,13 @@ def check_diffusion(value, name: str = "cation diffusion coefficient D") -> floa
     return check_within(name, value, DIFFUSION_RANGE, "m^2/s", "a numerical guard: every dynamic time scales as 1/D")
 
 
+def check_sheet_resistance(value, name: str = "sheet_resistance") -> float:
+    """``value`` (Ohm/sq, each electrode) within 0..:data:`~ipmc_asym.base.settings.MAX_SHEET_RESISTANCE`,
+    else one line naming ``name``."""
+    return check_within(name, value, (0.0, MAX_SHEET_RESISTANCE), "Ohm/sq",
+                        "a numerical guard: the electrode line overflows past it")
+
+
 def check_c_moy(value, name: str = "c_moy") -> float:
     """``value`` (mol/m^3) within :data:`ipmc_asym.base.settings.C_MOY_RANGE`, else one line naming ``name``."""
     return check_within(name, value, C_MOY_RANGE, "mol/m^3",
@@ -323,8 +331,7 @@ class Material:
         sl = check_finite("strain_limit", self.strain_limit, "in the open interval (0, 1)")
         if not 0.0 < sl < 1.0:
             raise ValueError(f"strain_limit must be in the open interval (0, 1), e.g. 0.01; got {self.strain_limit!r}")
-        if check_finite("sheet_resistance", self.sheet_resistance, "a finite number >= 0 Ohm/sq") < 0.0:
-            raise ValueError(f"sheet_resistance must be a finite number >= 0 Ohm/sq; got {self.sheet_resistance!r}")
+        check_sheet_resistance(self.sheet_resistance)
         check_finite("v1", self.v1, "a finite number of m^3/mol")
         check_positive("v2", self.v2, "m^3/mol")
         check_positive("M1", self.M1, "kg/mol")

@@ -99,7 +99,14 @@ def profile(model="constant", strip: Strip | None = None, material: Material = N
         return debye_hueckel_profile(model, strip, material)
     res = solve(strip, model, material)
     if not res.success:
-        raise RuntimeError(f"BVP for the {model} profiles did not converge: {res.message}")
+        # the solver converges over the nominal strips; where it does not, the usual cause is a
+        # strip far thinner or thicker than its Debye length, which the message says
+        lam_m = float(res.groups.debye) * 0.5 * strip.thickness
+        raise RuntimeError(
+            f"BVP for the {res.model} profiles did not converge ({res.message.rstrip('.')}) at thickness "
+            f"{strip.thickness:.3g} m = {strip.thickness / lam_m:.3g} Debye lengths ({lam_m:.3g} m at C_moy "
+            f"{float(material.C_moy):.3g} mol/m^3), {strip.voltage:g} V: a thickness, C_moy or voltage nearer "
+            "the nominal (200 um, some 6e3 Debye lengths) or another model")
     return res
 
 

@@ -187,3 +187,15 @@ def test_b1_guess_limits():
     assert bvp.b1_guess(1e-3, 0.0, A2) == pytest.approx(2 / (1 + math.exp(-A2)), rel=1e-14)
     B = bvp.b1_guess(8.8e-4, 4.4e-6, A2)
     assert 8.8e-4 / 2 * B * B + (4.4e-6 - 8.8e-4) * B - 4.4e-6 * A2 == pytest.approx(0, abs=1e-15)
+
+
+def test_a_diverged_solve_is_a_failure_without_overflow():
+    # 0.012 Debye lengths thick: the affine solve's last iterate has b = ln B1 ~ 1e10, past exp's range
+    # (NumPy's default floating-point handling, as the CLI runs it: solve_bvp then iterates that far)
+    mat = NAFION_LI.with_(c_moy=10.0)
+    with np.errstate(all="warn", under="ignore"):
+        r = solve(Strip(thickness=1e-7, voltage=1.0), "affine", mat)
+        with pytest.raises(RuntimeError, match="did not converge"):
+            moment_integral_bvp(1e-7, 1.0, "affine", mat)
+    assert not r.success
+    assert r.B1 == math.inf and math.isnan(r.I) and np.all(np.isfinite(r.C))

@@ -26,7 +26,9 @@ def _refused(capsys, argv):
     err = capsys.readouterr().err
     numeric = [str(w.message) for w in caught if issubclass(w.category, RuntimeWarning)]
     assert not numeric, numeric
-    lines = [ln for ln in err.splitlines() if ln.strip() and not ln.startswith("ipmc-asym: warning:")]
+    # a warning, or the one-off line that the kernels compile (a cold cache), is not the refusal
+    lines = [ln for ln in err.splitlines() if ln.strip() and not ln.startswith(
+        ("ipmc-asym: warning:", "ipmc-asym: compiling", "ipmc_asym: compiling"))]
     assert rc == 2 and len(lines) == 1, err
     assert "Warning" not in err and "Traceback" not in err
     return lines[0]
@@ -37,6 +39,9 @@ def _refused(capsys, argv):
     (["step", "--diffusion", "1e-320"], "--diffusion must be a finite number within 1e-30..1e+10 m^2/s"),
     (["estimate", "--c-moy", "1e-320"], "--c-moy must be a finite number within 0.001..1e+08 mol/m^3"),
     (["charge", "--c-moy", "1e12"], "--c-moy must be a finite number within 0.001..1e+08 mol/m^3"),
+    (["step", "--sheet-resistance", "1e308"], "--sheet-resistance must be within 0..1e+12 Ohm/sq"),
+    (["drive", "--waveform", "step:1V", "--duration", "1s", "--sheet-resistance", "1e13"],
+     "--sheet-resistance must be within 0..1e+12 Ohm/sq"),
 ])
 def test_a_diffusion_coefficient_or_concentration_out_of_range_names_the_option(capsys, argv, named):
     assert named in _refused(capsys, argv)
@@ -50,6 +55,8 @@ def test_the_ends_of_the_diffusion_range_run(capsys):
 
 @pytest.mark.parametrize("argv, named", [
     (["step", "--duration", "1e308"], "duration is too long for the reduced model's fixed substeps"),
+    (["step", "--duration", "1e308", "--fidelity", "pnp"], "duration: the transient PNP runs at most 1e+12 diffusion "
+                                                           "times e^2/D (1e+14 s here, 2.96e+15 tau"),
     (["sense", "--curvature", "1e308"], "curvature: |value| up to 1e+09 1/m allowed"),
     (["sense", "--tip-displacement", "1e308"], "tip_displacement: |value| up to 1000 m allowed"),
     (["sense", "--curvature", "1e308", "--nu", "0.5", "--length", "10m"], "curvature: |value| up to"),
@@ -108,3 +115,38 @@ def test_a_material_file_of_an_unknown_schema_is_refused(tmp_path, capsys):
 ])
 def test_a_refusal_says_what_to_write_instead(capsys, argv, said):
     assert said in _refused(capsys, argv)
+
+
+@pytest.mark.parametrize("voltage", ["1", "-1"])
+def test_profiles_a_bvp_that_diverges_is_refused_with_the_debye_length(capsys, voltage):
+    # 100 nm at C_moy 10 mol/m^3 is 0.012 Debye lengths: the affine solve diverges (b = ln B1 ~ 1e10)
+    line = _refused(capsys, ["profiles", "--c-moy", "10", "--thickness", "100nm", "--model", "affine",
+                             "--voltage", voltage])
+    assert "BVP for the affine profiles did not converge" in line, line
+    assert "0.0119 Debye lengths" in line and "a thickness, C_moy or voltage nearer the nominal" in line, line
+
+
+@pytest.mark.parametrize("command", [["step"], ["drive", "--waveform", "step:1V", "--duration", "1s"]])
+def test_an_underresolved_line_names_line_segments_and_its_doubled_line_consistently(capsys, command):
+    line = _refused(capsys, command + ["--sheet-resistance", "2.5", "--diffusion", "1e-8"])
+    assert ("with line_segments = 16 (the reported line of 32 segments against the 16 of its error estimate); "
+            "raise line_segments (--line-segments on the command line) above 16, at most 512") in line, line
+
+
+@pytest.mark.parametrize("size", ["2GiB", "1.5GB", "1e300"])
+def test_the_input_size_cap_has_a_ceiling(capsys, size):
+    line = _refused(capsys, ["scene", str(EXAMPLES / "uq_nominal.toml"), "--max-input-size", size])
+    assert ("--max-input-size must be a size from 1 to 1073741824 bytes (1 GiB; the ceiling of this cap: memory "
+            f"stays bounded); got '{size}'") in line, line
+
+
+def test_the_input_size_cap_runs_at_its_ceiling(capsys):
+    assert main(["scene", str(EXAMPLES / "uq_nominal.toml"), "--max-input-size", "1GiB", "--json"]) == 0
+    capsys.readouterr()
+
+
+@pytest.mark.parametrize("argv", [["sense", "--waveform", "sine:1mm@1Hz", "--duration", "1s", "--points", "1e308"],
+                                  ["drive", "--waveform", "step:1V", "--duration", "1s", "--points", "1e308"]])
+def test_points_past_the_cap_is_said_as_a_number_not_300_digits(capsys, argv):
+    line = _refused(capsys, argv)
+    assert line.endswith("; got 1e+308"), line

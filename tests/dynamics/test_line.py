@@ -358,3 +358,13 @@ def test_cli_sheet_resistance_with_the_dynamic_beam_a_bias_and_an_export(capsys,
     assert main(plain + ["--sheet-resistance", "0"]) == 0
     b = json.loads(capsys.readouterr().out)
     assert all(a[k] == b[k] for k in ("Z_re", "Z_im", "w_amp", "w_phase", "theta_amp", "F_amp", "F_phase"))
+
+
+def test_a_sheet_resistance_past_the_guard_is_refused_in_one_line():
+    from ipmc_asym.dynamics.drive import drive_response
+    from ipmc_asym.dynamics.line import line_response
+
+    for call in (lambda: line_response([1.0], sheet_resistance=1e300),
+                 lambda: drive_response("step:1V", 0.01, 11, beam="quasi-static", sheet_resistance=1e308)):
+        with pytest.raises(ValueError, match=r"sheet_resistance must be a finite number within 0\.\.1e\+12 Ohm/sq"):
+            call()

@@ -122,7 +122,7 @@ def test_line_chunks_are_one_run():
 def test_refusals():
     with pytest.raises(ValueError, match="sheet_resistance"):
         drive_response("step:1V", 0.01, 11, beam="quasi-static", sheet_resistance=-1.0)
-    with pytest.raises(ValueError, match="line segments"):
+    with pytest.raises(ValueError, match=r"line_segments must be an integer in \[2, 512\] \(--line-segments"):
         drive_response("step:1V", 0.01, 11, beam="quasi-static", sheet_resistance=1.0, line_segments=10**6)
     with pytest.raises(ValueError, match="sheet_resistance"):
         LineStepper(waveform("step", 1.0), S, PERM, NAFION_LI, 0.0)

@@ -639,3 +639,11 @@ def test_current_at_the_jump_is_withheld_only_where_it_does_not_converge():
     assert _jump_withheld(t0, levels(0.7), err)[0]  # too slow for the stated error to cover the tail
     assert not _jump_withheld(np.array([1e-6]), levels(2.0), err)[0]  # not at the jump
     assert not _jump_withheld(t0, levels(2.0, d=1e-9), err)[0]  # changes at the rounding level
+
+
+def test_a_duration_past_the_pnp_cap_is_refused_before_any_run():
+    # the nominal strip's diffusion time e^2/D is 100 s: the cap is 1e14 s; BDF fails near 1e300 s
+    for t_end in (1e15, 1e308):
+        with pytest.raises(ValueError, match=r"duration: the transient PNP runs at most 1e\+12 diffusion times "
+                                             r"e\^2/D \(1e\+14 s here, 2.96e\+15 tau"):
+            solve_transient(np.array([0.0, t_end]), waveform("step", 1.0), S0, "constant", NAFION_LI)
