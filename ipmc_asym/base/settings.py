@@ -83,6 +83,12 @@ DIFFUSION_RANGE = (1e-30, 1e10)
 #: (tests/model/test_params.py)
 C_MOY_RANGE = (1e-3, 1e8)
 
+#: longest Kelvin-Voigt creep time tau_v = eta_E/E (s) of the beam: a numerical guard.  Past it the time
+#: step's first-order-hold particular solution cancels to its last digits (tau_v dM/dt against the creep
+#: it leaves: 3 % off an exact creep at tau_v = 8e4 s, 2e-4 at 8e3 s); at 1e3 s a strip creeps 1e-4 of its
+#: way in 0.1 s, far past critical damping of every mode (the first at ~0.01 s on the nominal strip)
+MAX_CREEP_TIME = 1e3
+
 #: largest sheet resistance R_s (Ohm/sq) of an electrode: a numerical guard, not a physical limit (plated
 #: Pt on Nafion measures ~1-100 Ohm/sq; 1e12 is an insulating film's).  At 1e308 the electrode line's
 #: arrays overflow (step, drive: "array must not contain infs or NaNs"); up to this cap freq's outputs

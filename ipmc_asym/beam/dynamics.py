@@ -58,6 +58,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.polynomial import Polynomial as P
 
+from ipmc_asym.base.settings import MAX_CREEP_TIME
 from ipmc_asym.kernels.jit import jit
 from ipmc_asym.model.electrode import composite_mass, membrane_share
 from ipmc_asym.model.params import Material, bending_stiffness, check_positive
@@ -122,6 +123,11 @@ class Beam:
         eta = float(viscous_modulus)
         if not (math.isfinite(eta) and eta >= 0.0):
             raise ValueError(f"viscous modulus must be a finite number >= 0 Pa s; got {viscous_modulus!r}")
+        if eta / material.E > MAX_CREEP_TIME:
+            raise ValueError(f"viscous modulus {eta:g} Pa s: its creep time eta_E/E = {eta / material.E:.3g} s is past "
+                             f"{MAX_CREEP_TIME:g} s (settings.MAX_CREEP_TIME, a numerical guard; up to "
+                             f"{MAX_CREEP_TIME * material.E:.3g} Pa s with E = {material.E:.3g} Pa: a strip far past "
+                             "critical damping, which creeps 1e-4 of its way in 0.1 s there)")
         # the composite section with metal layers (material.electrode): stiffness and mass of the
         # three layers; the viscosity acts on the membrane's share E_p I_p of the stiffness only
         el = material.electrode
@@ -720,15 +726,23 @@ def _propagate(t, M, S, omega, tau_v, P, rhoAL, q0, v0, y0, ys0, out_q, out_dq, 
                     Sx *= ea
                 else:
                     mu = math.sqrt(mu2)
-                    if mu * h < 1e-4:
-                        ea = math.exp(-a * h)
-                        C = ea * (1.0 + 0.5 * mu2 * h * h)
-                        Sx = ea * h * (1.0 + mu2 * h * h / 6.0)
-                    else:
-                        e1 = math.exp((mu - a) * h)
-                        e2 = math.exp((-mu - a) * h)
-                        C = 0.5 * (e1 + e2)
-                        Sx = 0.5 * (e1 - e2) / mu
+                    if mu * h >= 1e-4:
+                        # overdamped: the roots s2 = -(a + mu) and s1 = w^2/s2 (their product is w^2).
+                        # s1 = mu - a as written cancels where a >> w (a heavy viscous modulus: it came
+                        # out 0 for the upper modes, which then never crept)
+                        s2 = -(a + mu)
+                        s1 = w * w / s2
+                        e1 = math.exp(s1 * h)
+                        e2 = math.exp(s2 * h)
+                        d = 1.0 / (s1 - s2)
+                        p11[n] = (s1 * e2 - s2 * e1) * d
+                        p12[n] = (e1 - e2) * d
+                        p21[n] = -w * w * p12[n]
+                        p22[n] = (s1 * e1 - s2 * e2) * d
+                        continue
+                    ea = math.exp(-a * h)
+                    C = ea * (1.0 + 0.5 * mu2 * h * h)
+                    Sx = ea * h * (1.0 + mu2 * h * h / 6.0)
                 p11[n] = C + a * Sx
                 p12[n] = Sx
                 p21[n] = -w * w * Sx

@@ -38,7 +38,7 @@ from ipmc_asym.dynamics.line import line_response
 from ipmc_asym.dynamics.line_time import DEFAULT_SEGMENTS
 from ipmc_asym.dynamics.waveforms import Waveform, check_drive_voltage, parse_waveform
 from ipmc_asym.forward.model import CHECKS
-from ipmc_asym.model.params import NAFION_LI, Material, Strip, check_finite
+from ipmc_asym.model.params import NAFION_LI, Material, Strip, check_sheet_resistance
 
 __all__ = ["DEFAULT_BEAM", "TIME_PATHS", "ERROR_COLUMNS", "AUTO_TOL", "AUTO_WORK", "WORK_PER_SECOND", "Drive",
            "TimeResponse", "stated_tol", "time_path", "time_response", "spectrum", "sampling_note"]
@@ -257,9 +257,7 @@ def time_path(*, fidelity="circuit", tol=None, beam=DEFAULT_BEAM, sheet_resistan
     check_choice("fidelity", fidelity, STEP_FIDELITIES)
     check_choice("beam", beam, BEAM_CHOICES)
     check_choice("beam_grid", beam_grid, BEAM_GRIDS)
-    Rs = check_finite("sheet_resistance", sheet_resistance, "a finite number >= 0 Ohm/sq")
-    if Rs < 0.0:
-        raise ValueError(f"sheet_resistance must be a finite number >= 0 Ohm/sq; got {sheet_resistance!r}")
+    Rs = check_sheet_resistance(sheet_resistance)
     stepped = ("line" if Rs > 0.0 else
                "stream" if support == "clamped-clamped" or electrode is not None else None)
     if stepped is not None:

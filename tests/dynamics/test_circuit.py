@@ -253,3 +253,25 @@ def test_drive_substep_follows_the_fastest_component():
     w = parse_waveform("step:1V+square:0.1V@5kHz")
     assert drive_substep(w, tau, 5e-3) == pytest.approx(1.0 / (STEPS_PER_PERIOD * 5e3 * tau), rel=1e-15)
     assert drive_substep(lambda t: 0.0 * t, tau, 5e-3) == 5e-3  # a bare callable states no frequency
+
+
+@pytest.mark.parametrize("creep_time", [8.0, 1e3])
+def test_a_heavily_damped_beam_creeps_as_the_kelvin_voigt_law_says(creep_time):
+    """Far past critical damping every mode creeps at 1/tau_v: w follows tau_v w' + w = w_qs (the
+    quasi-static deflection), integrated here on its own (implicit Euler). The modal step's slow
+    root, written mu - a, cancelled there (the upper modes never crept: x120 at tau_v = 8e3 s)."""
+    import ipmc_asym as ia
+
+    s = Strip()
+    qs = ia.time_response(s, 1.0, duration=0.17, points=2001, tol=None).result
+    t, wq = np.asarray(qs.t), np.asarray(qs.w)
+    w = np.zeros_like(t)
+    for i in range(1, t.size):
+        h = t[i] - t[i - 1]
+        w[i] = (w[i - 1] + h / creep_time * wq[i]) / (1.0 + h / creep_time)
+    eta = creep_time * NAFION_LI.E
+    r = ia.time_response(s, 1.0, duration=0.17, points=2001, tol=None, beam="dynamic", viscous_modulus=eta).result
+    assert np.asarray(r.w)[-1] == pytest.approx(w[-1], rel=1e-3)
+    with pytest.raises(ValueError, match="settings.MAX_CREEP_TIME"):
+        ia.time_response(s, 1.0, duration=0.17, points=11, tol=None, beam="dynamic", viscous_modulus=eta * 1.01
+                         if creep_time == 1e3 else 1e308)
