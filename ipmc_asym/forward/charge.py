@@ -11,7 +11,6 @@ from ipmc_asym.base.settings import VALIDITY_LIMIT
 from ipmc_asym.forward.estimate import SPREAD_NOTE, model_list, spread_variants
 from ipmc_asym.forward.model import model_notes, voltage_reason
 from ipmc_asym.integral.charge import charge_escalated
-from ipmc_asym.model import groups
 from ipmc_asym.model.params import NAFION_LI, Material, Strip
 from ipmc_asym.model.permittivity import MODELS
 from ipmc_asym.model.spread import spread_of
@@ -39,6 +38,7 @@ def charge_report(strip: Strip, material: Material = NAFION_LI, model: str = "al
     are built objects (checked when built).
     """
     models = model_list(model)
+    notes = model_notes(strip.voltage, material, models)  # from the inputs alone
     variants = spread_variants(material)
     beyond = voltage_reason(strip.voltage)
     # every point the report needs, the rows first, then each model and C_moy form of the spread
@@ -103,5 +103,4 @@ def charge_report(strip: Strip, material: Material = NAFION_LI, model: str = "al
               "note": SPREAD_NOTE}
     inputs = {"length": strip.length, "width_total": strip.width, "thickness_total": strip.thickness,
               "half_thickness_e": strip.e, "voltage": strip.voltage, "c_moy": material.C_moy}
-    notes = [CHARGE_NOTE] + model_notes(strip.voltage, groups.A2(strip.voltage, material), [r["model"] for r in rows])
-    return {"inputs": inputs, "results": rows, "notes": notes, "warnings": warnings, "model_spread": spread}
+    return {"inputs": inputs, "results": rows, "notes": [CHARGE_NOTE] + notes, "warnings": warnings, "model_spread": spread}

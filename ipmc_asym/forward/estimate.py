@@ -23,7 +23,6 @@ from ipmc_asym.base.registry import check_choice
 from ipmc_asym.base.results import Panel, ResultMixin, ResultSpec
 from ipmc_asym.forward.escalation import Escalated, check_tol, moment_escalating
 from ipmc_asym.forward.model import CHECKS, FREE_STRIP_KEYS, MECHANICAL_KEYS, _forward, assumption_warnings, model_notes
-from ipmc_asym.model import groups
 from ipmc_asym.model.electrode import beam_label
 from ipmc_asym.model.groups import pressure_beta
 from ipmc_asym.model.params import (
@@ -276,6 +275,7 @@ def estimate_document(strip: Strip, material: Material = NAFION_LI, model: str =
     ``I = None``; the command refuses it, a Python caller may keep the others.
     """
     models = model_list(model)
+    notes = model_notes(strip.voltage, material, models)  # from the inputs alone
     base = Request(models[0], fidelity, tol, escalate, pressure_term)
     reqs = [base] + [base.with_model(MODELS[m]) for m in models[1:]]
     rows, spread_rows = _rows(strip, material, reqs, on_invalid, True)
@@ -298,7 +298,6 @@ def estimate_document(strip: Strip, material: Material = NAFION_LI, model: str =
     }
     if thickness_note:
         inputs["thickness_source"] = thickness_note
-    notes = model_notes(strip.voltage, groups.A2(strip.voltage, material), [r["model"] for r in rows])
     return {"inputs": inputs, "results": rows, "model_spread": spread, "notes": notes}
 
 

@@ -72,10 +72,11 @@ __all__ = ["forward", "ForwardResult", "CHECKS", "NUMERICAL_CHECKS", "ASSUMPTION
 LINEAR_SATURATION_A2 = 8.0
 
 
-def model_notes(voltage, A2, models) -> list:
-    """Notes on what the model does or leaves out at this voltage (V; ``A2`` its group), for the
+def model_notes(voltage, material, models) -> list:
+    """Notes on what the model does or leaves out at this voltage (V) and ``material``, for the
     permittivity ``models`` shown: said beside the numbers, nothing flagged (the numbers are the
     model's).  The linear model's saturation (paper section 6.3) and water's electrolysis."""
+    A2 = groups.A2(voltage, material)
     notes = []
     if "linear" in models and float(A2) >= LINEAR_SATURATION_A2:
         notes.append(f"linear model (eps proportional to C): from A2 = F|phi0|/(R T) ~ {LINEAR_SATURATION_A2:g} "
