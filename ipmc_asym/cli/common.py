@@ -39,7 +39,8 @@ __all__ = ["UsageError", "Parser", "add_strip_options", "add_material_options", 
            "material_from_args", "strip_from_args", "strip_and_material",
            "arg_type", "count_type", "join_negative_values", "fmt_num", "c_moy_label", "length_type", "pressure_type",
            "voltage_type", "tol_type", "time_tol_type",
-           "first_run_notice", "spread_count", "diffusion_type", "sidecar_path", "DOCUMENT_FORMATS", "add_document_out", "given",
+           "first_run_notice", "spread_count", "diffusion_type", "sidecar_path", "DOCUMENT_FORMATS", "add_document_out",
+           "given", "RecordGiven",
            "write_document", "column_rows", "add_size_option", "check_size_caps", "cap_type",
            "add_output_option", "check_outputs",
            "seed_type", "model_help", "viscous_modulus_type", "duration_type", "waveform_type", "sheet_resistance_type",
@@ -435,7 +436,7 @@ def c_moy_label(material) -> str:
     return f"{material.C_moy:.6g} mol/m^3 ({how})"
 
 
-class _Given(argparse.Action):
+class RecordGiven(argparse.Action):
     """Store the value and record that the option was given (``given(args, dest)``): where its
     default and a value typed equal to it differ in meaning (``step --waveform`` with ``--voltage``)."""
 
@@ -446,21 +447,21 @@ class _Given(argparse.Action):
 
 def given(args, dest: str) -> bool:
     """Whether the option whose destination is ``dest`` was given on the command line (options
-    stored by :class:`_Given`)."""
+    stored by :class:`RecordGiven`)."""
     return dest in (getattr(args, "_given", ()) or ())
 
 
 def add_strip_options(p, *, voltage=True, mechanics=True):
     """The strip/material options shared by several commands (SI or with units); ``mechanics``:
     the command reports beam outputs (``--strain-limit``)."""
-    p.add_argument("--length", type=length_type("length"), default=0.02, action=_Given,
+    p.add_argument("--length", type=length_type("length"), default=0.02, action=RecordGiven,
                    help="strip length L (default 2cm)")
-    p.add_argument("--width", type=length_type("width"), default=5e-3, action=_Given, help="TOTAL width 2l (default 5mm)")
-    p.add_argument("--thickness", type=length_type("thickness"), default=None, action=_Given,
+    p.add_argument("--width", type=length_type("width"), default=5e-3, action=RecordGiven, help="TOTAL width 2l (default 5mm)")
+    p.add_argument("--thickness", type=length_type("thickness"), default=None, action=RecordGiven,
                    help="TOTAL membrane thickness 2e (default: the material set's typical thickness, e.g. 183um for "
                         "nafion-117-h, said in the output; 200um for nafion-li)")
     if voltage:
-        p.add_argument("--voltage", type=voltage_type(), default=1.0, action=_Given,
+        p.add_argument("--voltage", type=voltage_type(), default=1.0, action=RecordGiven,
                        help="voltage phi0 (default 1V; sign = direction)")
     p.add_argument("--modulus", type=pressure_type("modulus"), default=None,
                    help="Young's modulus E (default: the material set's, 1.3e8 Pa for nafion-li)")

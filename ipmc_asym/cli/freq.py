@@ -13,6 +13,7 @@ from ipmc_asym.beam.dynamics import CLAMPED_OUTPUTS
 from ipmc_asym.cli import SUMMARIES
 from ipmc_asym.cli.common import (
     CLAMPED_UNITS,
+    RecordGiven,
     _positive,
     add_beam_options,
     add_document_out,
@@ -27,6 +28,7 @@ from ipmc_asym.cli.common import (
     first_run_notice,
     fmt_num,
     frequency_type,
+    given,
     load_type,
     model_help,
     nu_type,
@@ -86,7 +88,7 @@ def register(sub):
     add_output_option(p, "--export", formats=(".json",), metavar="F.json", default=None,
                    help="write reduced-order models of V -> w and V -> charge over [--from, --to] (poles, residues, "
                         "state space, stated error; see ipmc_asym.transfer_function)")
-    p.add_argument("--export-tol", type=arg_type(_tol_type, "--export-tol"), default=1e-4,
+    p.add_argument("--export-tol", type=arg_type(_tol_type, "--export-tol"), default=1e-4, action=RecordGiven,
                    help="relative error the exported models aim at over the band, in (0, 1) (default 1e-4)")
 
 
@@ -112,6 +114,8 @@ def run(args):
         raise ValueError(f"--support {args.support} is how --mode sensing imposes the tip displacement; actuation "
                          "supports: clamped-free, clamped-pinned, clamped-clamped")
     # --export: its path and format checked before any work with every output (add_output_option)
+    if args.export is None and given(args, "export_tol"):  # said, not silently dropped
+        warn(f"--export-tol {args.export_tol:g} is not used: it is the tolerance of --export's models")
     support, electrode = support_from_args(args)
     strip, material, _ = strip_and_material(args)
     clamped = support == "clamped-clamped"

@@ -106,3 +106,13 @@ def test_a_sweep_axis_of_bare_numbers_is_held_to_the_plausible_range(capsys, tmp
     assert main(["sweep", "--vary", "thickness=200um:400um:2", "--fidelity", "leading", "--no-progress",
                  "--out", str(out)]) == 0
     assert "read as" not in capsys.readouterr().err
+
+
+def test_an_export_tolerance_without_export_is_said(capsys):
+    from ipmc_asym.cli import main
+
+    argv = ["freq", "--from", "1Hz", "--to", "10Hz", "--points", "2"]
+    assert main(argv + ["--export-tol", "1e-3"]) == 0
+    assert "--export-tol 0.001 is not used" in capsys.readouterr().err
+    assert main(argv) == 0
+    assert "is not used" not in capsys.readouterr().err
