@@ -727,9 +727,9 @@ def _propagate(t, M, S, omega, tau_v, P, rhoAL, q0, v0, y0, ys0, out_q, out_dq, 
                 else:
                     mu = math.sqrt(mu2)
                     if mu * h >= 1e-4:
-                        # overdamped: the roots s2 = -(a + mu) and s1 = w^2/s2 (their product is w^2).
-                        # s1 = mu - a as written cancels where a >> w (a heavy viscous modulus: it came
-                        # out 0 for the upper modes, which then never crept)
+                        # overdamped: the roots s2 = -(a + mu) and s1 = w^2/s2 (their product is w^2);
+                        # mu - a would cancel where a >> w (a heavy viscous modulus: 0 for the upper
+                        # modes, which would then never creep)
                         s2 = -(a + mu)
                         s1 = w * w / s2
                         e1 = math.exp(s1 * h)
