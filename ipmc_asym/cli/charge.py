@@ -12,6 +12,7 @@ from ipmc_asym.cli.common import (
     first_run_notice,
     spread_count,
     strip_and_material,
+    strip_rows,
     warn,
     write_document,
 )
@@ -37,9 +38,7 @@ def run(args):
     for w in doc["warnings"]:
         warn(w)
     if args.out is not None:
-        echo = {"thickness_total": strip.thickness, "half_thickness_e": strip.e, "voltage": strip.voltage,
-                "length": strip.length, "width_total": strip.width}
-        write_document(args.out, doc, [dict(echo, **r) for r in doc["results"]],
+        write_document(args.out, doc, strip_rows(doc["inputs"], doc["results"]),
                        {k: v for k, v in doc.items() if k != "results"})
     if args.json:
         print(dumps(doc, indent=2))

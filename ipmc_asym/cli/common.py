@@ -41,7 +41,7 @@ __all__ = ["UsageError", "Parser", "add_strip_options", "add_material_options", 
            "voltage_type", "tol_type", "time_tol_type",
            "first_run_notice", "spread_count", "diffusion_type", "sidecar_path", "DOCUMENT_FORMATS", "add_document_out",
            "given", "RecordGiven",
-           "write_document", "column_rows", "add_size_option", "check_size_caps", "cap_type",
+           "write_document", "column_rows", "strip_rows", "add_size_option", "check_size_caps", "cap_type",
            "add_output_option", "check_outputs",
            "seed_type", "model_help", "viscous_modulus_type", "duration_type", "waveform_type", "sheet_resistance_type",
            "frequency_type", "add_beam_options", "SOLVER_ALIASES", "add_solver_option", "add_line_options",
@@ -317,6 +317,16 @@ def write_document(path, doc: dict, rows: list, meta: dict) -> None:
             wr.writerow([_cell(r.get(k)) for k in cols])
     with atomic_write(sidecar_path(path)) as fh:
         fh.write(dumps(meta, indent=2) + "\n")
+
+
+#: the strip's inputs repeated in each CSV row of a one-document --out (which thickness: the names say)
+STRIP_COLUMNS = ("thickness_total", "half_thickness_e", "voltage", "length", "width_total")
+
+
+def strip_rows(inputs: dict, rows: list) -> list:
+    """``rows`` (dicts) each led by the strip's :data:`STRIP_COLUMNS` from a document's ``inputs``."""
+    echo = {k: inputs[k] for k in STRIP_COLUMNS}
+    return [dict(echo, **r) for r in rows]
 
 
 def column_rows(cols: dict) -> list:

@@ -14,6 +14,7 @@ from ipmc_asym.cli.common import (
     fmt_num,
     spread_count,
     strip_and_material,
+    strip_rows,
     tol_type,
     write_document,
 )
@@ -71,8 +72,7 @@ def run(args):
         if r["I"] is None:  # no rung valid: refuse the whole command, one line
             raise ValueError(r["warnings"][-1])
     if args.out is not None:
-        write_document(args.out, doc, [dict(_echo(inputs), **r) for r in rows],
-                       {k: v for k, v in doc.items() if k != "results"})
+        write_document(args.out, doc, strip_rows(inputs, rows), {k: v for k, v in doc.items() if k != "results"})
     if args.json:
         print(dumps(doc, indent=2))
         return 0
@@ -115,11 +115,6 @@ def run(args):
     if args.out is not None:
         print(f"wrote {args.out}")
     return 0
-
-
-def _echo(inputs) -> dict:
-    # the strip in every CSV row: which thickness is meant said by the column's name
-    return {k: inputs[k] for k in ("thickness_total", "half_thickness_e", "voltage", "length", "width_total")}
 
 
 def _print_spread(spread):

@@ -180,12 +180,11 @@ def run(args):
             fh.write(dumps(doc, indent=1))
         head["export"] = {"path": str(args.export), **{o: t.message for o, t in fits.items()}}
         bad = [o for o, t in fits.items() if not t.success]
+    doc = dict(head, **cols)  # the --json document, also what --out F.json holds
     if args.out is not None:
-        write_document(args.out, dict(head, **cols), column_rows(cols), head)
+        write_document(args.out, doc, column_rows(cols), head)
     if args.json:
-        out = dict(head)
-        out.update(cols)
-        print(dumps(out, indent=1))
+        print(dumps(doc, indent=1))
         return 0
     line = "" if args.sheet_resistance is None else f", electrode sheet resistance {args.sheet_resistance:g} Ohm/sq"
     print(f"small signal about {args.voltage:g} V, model {r.model}, method {r.method}, beam {args.beam}, total "
@@ -285,12 +284,11 @@ def _run_sensing(args):
             "load": load if isinstance(load, str) else "resistive", "load_resistance": None if not resistive else load,
             "tau": r.tau, "f_stream": r.f_stream, "f_d": r.f_d, "diffusion_coefficient": material.D,
             "units": units, "notes": r.notes, "warnings": warnings}
+    doc = dict(head, **cols)  # the --json document, also what --out F.json holds
     if args.out is not None:
-        write_document(args.out, dict(head, **cols), column_rows(cols), head)
+        write_document(args.out, doc, column_rows(cols), head)
     if args.json:
-        out = dict(head)
-        out.update(cols)
-        print(dumps(out, indent=1))
+        print(dumps(doc, indent=1))
         return 0
     print(f"IPMC strip as a sensor, small signal: model {r.model}, method {r.method}, support {support}, L = "
           f"{fmt_length(strip.length)}, 2l = {fmt_length(strip.width)}, 2e = {fmt_length(strip.thickness)}, nu = {nu:g}; "
