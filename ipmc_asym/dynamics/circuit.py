@@ -90,7 +90,7 @@ from ipmc_asym.model.permittivity import Permittivity, get_model
 __all__ = ["DYNAMIC_NOTES", "StepResult", "FrequencyResult", "core_resistance", "time_constant",
            "waveform", "step_response", "frequency_response", "circuit_response", "quasi_static_mechanics",
            "circuit_impedance_error", "circuit_band", "quiet_numerics",
-           "layer_rates", "quasi_static_forward", "check_support", "check_electrode",
+           "layer_rates", "drive_frequency", "drive_substep", "quasi_static_forward", "check_support", "check_electrode",
            "support_notes"]
 
 #: stated in every dynamic output
@@ -532,7 +532,8 @@ class CircuitStepper:
         self.VT = groups.thermal_voltage(material)
         self.tau = float(time_constant(strip.thickness, perm, material))
         self.substeps = int(substeps)
-        self.h_sub = drive_substep(phi0_fun, self.tau, 5e-3)
+        self.h_max = 5e-3  # the largest substep, tau/200, where the drive asks for no finer one
+        self.h_sub = drive_substep(phi0_fun, self.tau, self.h_max)
         self.state = np.zeros(5)
         self.rho = perm.eps0 / perm.eps_moy
         self.mid = paper_model_id(perm)
@@ -584,8 +585,7 @@ class CircuitStepper:
         """
         t = np.asarray(t, dtype=float)
         A = np.asarray(u, dtype=float) / self.VT
-        # the largest substep is 5e-3 tau (substep_grid)
-        sdot, Adot = layer_rates(A, self.fun(t) / self.VT, self.rho, self.mid, self.tau, 5e-3)
+        sdot, Adot = layer_rates(A, self.fun(t) / self.VT, self.rho, self.mid, self.tau, self.h_max)
         dphi = voltage_rate(self.fun, t, 1e-3 * self.tau)
         return self.S * sdot + self.Cg * (dphi - self.VT * Adot)
 
@@ -612,11 +612,16 @@ def layer_rates(A, psi, rho, mid, tau, h_max):
 STEPS_PER_PERIOD = 400
 
 
+def drive_frequency(fun) -> float:
+    """The fastest component (Hz) of the drive ``fun``: a waveform's ``max_frequency``, 0 where it has
+    none or ``fun`` is a bare callable (which states no frequency)."""
+    return float(getattr(fun, "max_frequency", 0.0) or 0.0)
+
+
 def drive_substep(fun, tau, h_max):
-    """The largest substep (units of ``tau``) for the drive ``fun``: ``h_max``, or finer where
-    ``fun`` is a waveform whose fastest component (``max_frequency``, Hz) needs it
-    (:data:`STEPS_PER_PERIOD`); a drive given as a bare callable states no frequency."""
-    f = float(getattr(fun, "max_frequency", 0.0) or 0.0)
+    """The largest substep (units of ``tau``) for the drive ``fun``: ``h_max``, or finer where its
+    fastest component (:func:`drive_frequency`) needs it (:data:`STEPS_PER_PERIOD`)."""
+    f = drive_frequency(fun)
     return h_max if f <= 0.0 else min(h_max, 1.0 / (STEPS_PER_PERIOD * f * tau))
 
 

@@ -29,6 +29,7 @@ from ipmc_asym.dynamics.circuit import (
     ReferenceFailed,
     StepResult,
     default_times,
+    drive_frequency,
     frequency_response,
     step_response,
     waveform,
@@ -277,7 +278,7 @@ def sampling_note(drive: Drive, duration, points: int):
     component (its ``max_frequency``): each row is the state at its time (the substeps resolve the
     drive, :func:`~ipmc_asym.dynamics.circuit.drive_substep`), but the rows do not trace the
     oscillation between them; None otherwise."""
-    f = float(getattr(drive.function, "max_frequency", 0.0) or 0.0)
+    f = drive_frequency(drive.function)
     if duration is None or f <= 0.0 or points < 2:
         return None
     dt = float(duration) / (points - 1)

@@ -119,7 +119,6 @@ class EstimateRow(ResultMixin, dict):
     def __init__(self, row: dict, strip: Strip):
         super().__init__(row)
         self.strip = strip
-        self.length = float(strip.length)
 
     def __getattr__(self, key):
         try:
@@ -144,7 +143,7 @@ class EstimateRow(ResultMixin, dict):
         th = self.get("theta")
         if th is None or self.get("x_tip") is None:  # withheld: a line with nothing to plot
             return StripLine(np.empty(0), np.empty(0), self._headline()).plot(figsize=figsize)
-        x, y = arc(th, self.length)
+        x, y = arc(th, self.strip.length)
         fig = StripLine(x, y, self._headline()).plot(figsize=figsize)
         fig.axes[0].set_aspect("equal", adjustable="datalim")  # an arc drawn as an arc
         return fig

@@ -147,7 +147,8 @@ def _from_strip(thickness, voltage, width, length):
     return (thickness, voltage, s.width if width is None else width, s.length if length is None else length)
 
 
-def charge_inputs(thickness, voltage, model="constant", width=5.0e-3, length=0.02, material: Material | None = None):
+def charge_inputs(thickness, voltage, model="constant", width=NOMINAL_STRIP.width, length=NOMINAL_STRIP.length,
+                  material: Material | None = None):
     """The checked arguments of :func:`charge` (one-line ``ValueError`` each): ``(thickness,
     voltage, perm, width, length, material)``, thickness and voltage broadcast arrays."""
     perm = get_model(model)
